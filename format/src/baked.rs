@@ -1,0 +1,203 @@
+//! The `Baked` file: one sorted triangle list and a sliding window of draws per frame.
+
+use bytemuck::{Pod, Zeroable};
+use serde::{Deserialize, Serialize};
+
+use crate::camera::FrameState;
+use crate::geometry::Geometry;
+use crate::recording::{DeviceInfo, Edge, RecordSettings};
+use crate::Hash;
+
+/// The arguments of one indexed indirect draw, laid out as the GPU reads them
+/// (`wgpu::util::DrawIndexedIndirectArgs`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable, Serialize, Deserialize)]
+pub struct DrawIndexedIndirectArgs {
+    /// Number of indices (3 per triangle).
+    pub index_count: u32,
+    /// Number of instances (always 1).
+    pub instance_count: u32,
+    /// First index in the index buffer.
+    pub first_index: u32,
+    /// Added to every index (always 0).
+    pub base_vertex: i32,
+    /// First instance (always 0).
+    pub first_instance: u32,
+}
+
+/// A frame's window: `count` draws starting at `first` in [`Baked::draws`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FrameWindow {
+    /// First draw of the frame.
+    pub first: u32,
+    /// Number of draws.
+    pub count: u32,
+}
+
+/// How a file was merged.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MergeInfo {
+    /// Strategy name (lib, lbi, ilb, ibl, bli, bil).
+    pub strategy: String,
+    /// Layout name (paper, compact).
+    pub layout: String,
+    /// Bridge policy (hidden, ignored).
+    pub bridge: String,
+    /// Whether only tie edges were kept (plays only with the depth test).
+    pub depth_only: bool,
+    /// Segment length in frames, if the path was cut into segments.
+    pub segment: Option<u32>,
+    /// Seeding used to build the matrix (interval, paper).
+    pub seeding: String,
+}
+
+/// Merge figures (the `--json` keys of `trisort merge`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MergeStats {
+    /// Triangles in the index buffer (copies).
+    pub index_triangles: u64,
+    /// Σ |V_f| over all frames.
+    pub source_triangles: u64,
+    /// |G|.
+    pub unique_visible: u64,
+    /// Mean draws per frame.
+    pub draws_per_frame_mean: f64,
+    /// Maximum draws per frame.
+    pub draws_per_frame_max: u32,
+    /// Mean over frames of triangles drawn but not visible.
+    pub drawn_not_visible_mean: f64,
+    /// Total weight of the removed intra-frame cycle edges.
+    pub unordered_samples: u64,
+    /// Merge wall time in seconds.
+    pub seconds: f64,
+}
+
+/// A baked path: everything the player needs, and what the validator needs to check it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Baked {
+    /// Version of the tool that wrote it.
+    pub tool_version: String,
+    /// Hash of the scene.
+    pub scene_hash: Hash,
+    /// Hash of the path.
+    pub path_hash: Hash,
+    /// Hashes of the recordings it was merged from (in frame order).
+    pub recording_hashes: Vec<Hash>,
+    /// Recording settings (the sample pattern at which it is exact).
+    pub settings: RecordSettings,
+    /// Recording device.
+    pub device: DeviceInfo,
+    /// How it was merged.
+    pub merge: MergeInfo,
+    /// Merge figures.
+    pub stats: MergeStats,
+    /// Geometry of G: triangle k is G-local id k.
+    pub geometry: Geometry,
+    /// Scene id of each G-local triangle (ascending).
+    pub scene_ids: Vec<u32>,
+    /// The sorted triangle list, front to back: G-local ids, one entry per copy. The index
+    /// buffer is `geometry.triangles[copies[k]]` for each k; back-to-front playback reverses it.
+    pub copies: Vec<u32>,
+    /// Indirect draws over `copies` (index units: 3 per copy), front to back.
+    pub draws: Vec<DrawIndexedIndirectArgs>,
+    /// Per frame: its window in `draws`.
+    pub frames: Vec<FrameWindow>,
+    /// Per frame: camera and node poses.
+    pub frame_states: Vec<FrameState>,
+    /// Per frame: the intra-frame cycle edges the merger removed (G-local ids). Their total
+    /// weight is `stats.unordered_samples`.
+    pub removed_edges: Vec<Vec<Edge>>,
+}
+
+impl Baked {
+    /// The index buffer in front-to-back order, as u32.
+    pub fn indices(&self) -> Vec<u32> {
+        let mut out = Vec::with_capacity(self.copies.len() * 3);
+        for &c in &self.copies {
+            out.extend_from_slice(&self.geometry.triangles[c as usize]);
+        }
+        out
+    }
+
+    /// Whether the index buffer fits u16 indices.
+    pub fn fits_u16(&self) -> bool {
+        self.geometry.vertices.len() <= u16::MAX as usize + 1
+    }
+
+    /// The draws of frame `f`, front to back.
+    pub fn frame_draws(&self, f: usize) -> &[DrawIndexedIndirectArgs] {
+        let w = self.frames[f];
+        &self.draws[w.first as usize..(w.first + w.count) as usize]
+    }
+
+    /// Checks the structural consistency a reader must rely on before using the file:
+    /// indices in range, draws inside the index buffer, windows inside the draw list, one
+    /// frame state and one removed-edge list per frame. Returns the first problem found.
+    pub fn check_structure(&self) -> Result<(), String> {
+        let g = &self.geometry;
+        let nv = g.vertices.len() as u64;
+        for (k, t) in g.triangles.iter().enumerate() {
+            if t.iter().any(|&v| v as u64 >= nv) {
+                return Err(format!("triangle {k} refers to a vertex beyond {nv}"));
+            }
+        }
+        for (k, v) in g.vertices.iter().enumerate() {
+            if v.material as usize >= g.materials.len() || v.node as usize >= g.nodes.len() {
+                return Err(format!("vertex {k} refers to a missing material or node"));
+            }
+            if !v.position.iter().all(|x| x.is_finite()) {
+                return Err(format!("vertex {k} has a non-finite position"));
+            }
+        }
+        for (k, m) in g.materials.iter().enumerate() {
+            if let Some(t) = m.base_color_texture {
+                let Some(tex) = g.textures.get(t as usize) else {
+                    return Err(format!("material {k} refers to missing texture {t}"));
+                };
+                if tex.rgba8.len() as u64 != tex.width as u64 * tex.height as u64 * 4 {
+                    return Err(format!("texture {t} has the wrong number of bytes"));
+                }
+            }
+        }
+        for (k, n) in g.nodes.iter().enumerate() {
+            if n.parent.is_some_and(|p| p as usize >= k) {
+                return Err(format!("node {k} has a parent that does not precede it"));
+            }
+        }
+        if self.scene_ids.len() != g.triangles.len() {
+            return Err("scene_ids and triangles differ in length".into());
+        }
+        let ntri = g.triangles.len() as u64;
+        if let Some(k) = self.copies.iter().position(|&c| c as u64 >= ntri) {
+            return Err(format!("copy {k} refers to a triangle beyond {ntri}"));
+        }
+        let nidx = self.copies.len() as u64 * 3;
+        for (k, d) in self.draws.iter().enumerate() {
+            if d.index_count % 3 != 0
+                || d.first_index % 3 != 0
+                || d.first_index as u64 + d.index_count as u64 > nidx
+                || d.instance_count != 1
+                || d.base_vertex != 0
+                || d.first_instance != 0
+            {
+                return Err(format!("draw {k} is malformed or outside the index buffer"));
+            }
+        }
+        for (f, w) in self.frames.iter().enumerate() {
+            if w.first as u64 + w.count as u64 > self.draws.len() as u64 {
+                return Err(format!("frame {f}'s window lies outside the draw list"));
+            }
+        }
+        if self.frame_states.len() != self.frames.len()
+            || self.removed_edges.len() != self.frames.len()
+        {
+            return Err("per-frame lists differ in length".into());
+        }
+        for (f, s) in self.frame_states.iter().enumerate() {
+            if s.poses.iter().any(|p| p.node as usize >= g.nodes.len()) {
+                return Err(format!("frame {f} poses a missing node"));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,329 @@
+//! The checked container every trisort file uses, and atomic writes.
+//!
+//! Layout (little endian):
+//!
+//! | bytes | field |
+//! |---|---|
+//! | 8 | magic: `TRISREC\0` (Recording) or `TRISBAK\0` (Baked) |
+//! | 4 | format version ([`FORMAT_VERSION`]) |
+//! | 8 | length of the compressed payload |
+//! | 8 | length of the decompressed payload |
+//! | 32 | BLAKE3 hash of the compressed payload |
+//! | n | payload: zstd(postcard(value)) |
+//!
+//! Reading never trusts the header for allocation: the payload length must match the file,
+//! the checksum is verified before decompressing, decompression stops at the declared size
+//! (which is capped), and postcard caps what it preallocates.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+/// Current version of the container and of the types inside it.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Decompressed payloads larger than this are refused (16 GiB).
+pub const MAX_PAYLOAD: u64 = 16 << 30;
+
+const HEADER_LEN: usize = 8 + 4 + 8 + 8 + 32;
+
+/// The kind of a trisort file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileKind {
+    /// A `Recording` (`trisort record`).
+    Recording,
+    /// A `Baked` file (`trisort merge`, `trisort bake`).
+    Baked,
+}
+
+impl FileKind {
+    /// The 8-byte magic.
+    pub fn magic(self) -> &'static [u8; 8] {
+        match self {
+            FileKind::Recording => b"TRISREC\0",
+            FileKind::Baked => b"TRISBAK\0",
+        }
+    }
+
+    /// A human name.
+    pub fn name(self) -> &'static str {
+        match self {
+            FileKind::Recording => "recording",
+            FileKind::Baked => "baked file",
+        }
+    }
+
+    /// Which kind of file `bytes` starts like, if any.
+    pub fn sniff(bytes: &[u8]) -> Option<FileKind> {
+        [FileKind::Recording, FileKind::Baked]
+            .into_iter()
+            .find(|k| bytes.starts_with(k.magic()))
+    }
+}
+
+/// Errors reading or writing a trisort file. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum FormatError {
+    /// An I/O error.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file does not start with the expected magic.
+    #[error("{path}: not a trisort {expected} (wrong magic bytes)")]
+    BadMagic {
+        /// The file.
+        path: PathBuf,
+        /// What was expected.
+        expected: &'static str,
+    },
+    /// The file is of another version.
+    #[error(
+        "{path}: format version {found} is not supported (this trisort reads version {supported})"
+    )]
+    Version {
+        /// The file.
+        path: PathBuf,
+        /// The version in the file.
+        found: u32,
+        /// The version this build reads.
+        supported: u32,
+    },
+    /// The file is shorter or longer than its header says.
+    #[error("{path}: truncated or padded: header says {expected} payload bytes, file has {found}")]
+    Length {
+        /// The file.
+        path: PathBuf,
+        /// Bytes the header declares.
+        expected: u64,
+        /// Bytes present.
+        found: u64,
+    },
+    /// The checksum does not match.
+    #[error("{path}: checksum mismatch: the file is corrupted")]
+    Checksum {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The payload cannot be decoded.
+    #[error("{path}: corrupted payload: {reason}")]
+    Payload {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+}
+
+/// Encodes `value` into the container bytes.
+pub fn encode<T: Serialize>(kind: FileKind, value: &T) -> Vec<u8> {
+    let raw =
+        postcard::to_stdvec(value).expect("postcard serialization of trisort types cannot fail");
+    let packed = zstd::encode_all(&raw[..], 3).expect("zstd compression into memory cannot fail");
+    let mut out = Vec::with_capacity(HEADER_LEN + packed.len());
+    out.extend_from_slice(kind.magic());
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&(packed.len() as u64).to_le_bytes());
+    out.extend_from_slice(&(raw.len() as u64).to_le_bytes());
+    out.extend_from_slice(blake3::hash(&packed).as_bytes());
+    out.extend_from_slice(&packed);
+    out
+}
+
+/// Decodes container bytes read from `path` (used only in messages).
+pub fn decode<T: DeserializeOwned>(
+    kind: FileKind,
+    bytes: &[u8],
+    path: &Path,
+) -> Result<T, FormatError> {
+    let p = || path.to_path_buf();
+    if bytes.len() < 8 || &bytes[..8] != kind.magic() {
+        return Err(FormatError::BadMagic {
+            path: p(),
+            expected: kind.name(),
+        });
+    }
+    if bytes.len() < HEADER_LEN {
+        return Err(FormatError::Length {
+            path: p(),
+            expected: HEADER_LEN as u64,
+            found: bytes.len() as u64,
+        });
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
+    if version != FORMAT_VERSION {
+        return Err(FormatError::Version {
+            path: p(),
+            found: version,
+            supported: FORMAT_VERSION,
+        });
+    }
+    let packed_len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
+    let raw_len = u64::from_le_bytes(bytes[20..28].try_into().unwrap());
+    let payload = &bytes[HEADER_LEN..];
+    if packed_len != payload.len() as u64 {
+        return Err(FormatError::Length {
+            path: p(),
+            expected: packed_len,
+            found: payload.len() as u64,
+        });
+    }
+    if blake3::hash(payload).as_bytes() != &bytes[28..60] {
+        return Err(FormatError::Checksum { path: p() });
+    }
+    if raw_len > MAX_PAYLOAD {
+        return Err(FormatError::Payload {
+            path: p(),
+            reason: format!("declared size {raw_len} bytes exceeds the limit of {MAX_PAYLOAD}"),
+        });
+    }
+    // Grow the buffer as data arrives; never preallocate what the header claims.
+    let mut raw = Vec::new();
+    let decoder = zstd::Decoder::new(payload).map_err(|e| FormatError::Payload {
+        path: p(),
+        reason: e.to_string(),
+    })?;
+    decoder
+        .take(raw_len + 1)
+        .read_to_end(&mut raw)
+        .map_err(|e| FormatError::Payload {
+            path: p(),
+            reason: format!("decompression failed: {e}"),
+        })?;
+    if raw.len() as u64 != raw_len {
+        return Err(FormatError::Payload {
+            path: p(),
+            reason: format!("decompressed to {} bytes, header says {raw_len}", raw.len()),
+        });
+    }
+    let (value, rest) = postcard::take_from_bytes::<T>(&raw).map_err(|e| FormatError::Payload {
+        path: p(),
+        reason: format!("decoding failed: {e}"),
+    })?;
+    if !rest.is_empty() {
+        return Err(FormatError::Payload {
+            path: p(),
+            reason: format!("{} trailing bytes", rest.len()),
+        });
+    }
+    Ok(value)
+}
+
+/// Reads and decodes a file of the given kind.
+pub fn read_file<T: DeserializeOwned>(kind: FileKind, path: &Path) -> Result<T, FormatError> {
+    let bytes = std::fs::read(path).map_err(|source| FormatError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    decode(kind, &bytes, path)
+}
+
+/// Writes `bytes` to `path` atomically: into a temporary file in the same directory, synced,
+/// then renamed over `path`. A crash leaves either the old file or the new one, never half.
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
+    let io = |source| FormatError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| io(std::io::Error::other("not a file path")))?;
+    let tmp = dir.join(format!(
+        ".{}.tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(io)
+}
+
+/// Encodes `value` and writes it atomically to `path`.
+pub fn write_file_atomic<T: Serialize>(
+    kind: FileKind,
+    path: &Path,
+    value: &T,
+) -> Result<(), FormatError> {
+    write_bytes_atomic(path, &encode(kind, value))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Vec<(u32, String)> {
+        (0..1000).map(|i| (i, format!("item {i}"))).collect()
+    }
+
+    #[test]
+    fn round_trip_and_atomic_write() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.rec");
+        write_file_atomic(FileKind::Recording, &path, &sample()).unwrap();
+        let back: Vec<(u32, String)> = read_file(FileKind::Recording, &path).unwrap();
+        assert_eq!(back, sample());
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names.len(), 1, "temporary file left behind: {names:?}");
+    }
+
+    #[test]
+    fn every_truncation_and_bit_flip_is_an_error() {
+        let bytes = encode(FileKind::Baked, &sample());
+        let path = Path::new("t.baked");
+        for len in 0..bytes.len() {
+            assert!(
+                decode::<Vec<(u32, String)>>(FileKind::Baked, &bytes[..len], path).is_err(),
+                "len {len}"
+            );
+        }
+        for i in (0..bytes.len()).step_by(7) {
+            let mut b = bytes.clone();
+            b[i] ^= 0x10;
+            assert!(
+                decode::<Vec<(u32, String)>>(FileKind::Baked, &b, path).is_err(),
+                "flip at {i}"
+            );
+        }
+        assert!(matches!(
+            decode::<Vec<(u32, String)>>(FileKind::Recording, &bytes, path),
+            Err(FormatError::BadMagic { .. })
+        ));
+    }
+
+    #[test]
+    fn huge_declared_size_is_refused_without_allocating() {
+        let mut bytes = encode(FileKind::Baked, &sample());
+        bytes[20..28].copy_from_slice(&(u64::MAX / 2).to_le_bytes());
+        let err = decode::<Vec<(u32, String)>>(FileKind::Baked, &bytes, Path::new("h.baked"))
+            .unwrap_err();
+        assert!(err.to_string().contains("h.baked"), "{err}");
+    }
+
+    #[test]
+    fn wrong_version_is_named() {
+        let mut bytes = encode(FileKind::Baked, &sample());
+        bytes[8..12].copy_from_slice(&99u32.to_le_bytes());
+        let err = decode::<Vec<(u32, String)>>(FileKind::Baked, &bytes, Path::new("v.baked"))
+            .unwrap_err();
+        assert!(err.to_string().contains("version 99"), "{err}");
+    }
+}

@@ -1,0 +1,128 @@
+//! The `Recording`: what the recorder saw, per frame, at one sample pattern.
+
+use serde::{Deserialize, Serialize};
+
+use crate::camera::FrameState;
+use crate::geometry::Geometry;
+use crate::Hash;
+
+/// Recording settings: together with the device they define the *sample pattern* at which a
+/// bake is exact.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordSettings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// MSAA sample count (1 or 4; 4 uses the standard sample positions).
+    pub samples: u32,
+    /// Accumulated opacity at which a sample counts as saturated (default 0.998).
+    pub saturation: f32,
+    /// Opacity at which transmissive glass is recorded (default 0: see-through).
+    pub glass_opacity: f32,
+    /// Safety bound on peel layers per frame; a frame that hits it is truncated.
+    pub max_layers: u32,
+}
+
+impl Default for RecordSettings {
+    fn default() -> Self {
+        RecordSettings {
+            width: 512,
+            height: 512,
+            samples: 4,
+            saturation: 0.998,
+            glass_opacity: 0.0,
+            max_layers: 256,
+        }
+    }
+}
+
+/// The device a recording was made on.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DeviceInfo {
+    /// Adapter name (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)").
+    pub adapter: String,
+    /// Driver name and version.
+    pub driver: String,
+    /// Backend (Vulkan, Gl, Metal, Dx12).
+    pub backend: String,
+}
+
+/// A depth-order edge at one frame: `from` lies in front of `to` at `weight` samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+pub struct Edge {
+    /// The triangle in front (scene id in a Recording, G-local id in a Baked file).
+    pub from: u32,
+    /// The triangle behind.
+    pub to: u32,
+    /// Number of samples at which `from` is the peel-order neighbour in front of `to`.
+    pub weight: u32,
+}
+
+/// Which phases a recording holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Phase {
+    /// Phase 1 only: per-frame visible sets; `covered` and `edges` are empty.
+    Visibility,
+    /// Phases 1 and 2: visible sets and the graphs of G.
+    Graphs,
+}
+
+/// One frame's record.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FrameRecord {
+    /// Frame index on the path.
+    pub frame: u32,
+    /// V_f: visible triangles (scene ids, ascending).
+    pub visible: Vec<u32>,
+    /// C_f ⊆ G: triangles of G with at least one fragment (ascending; phase 2).
+    /// The ignore list is G \ C_f.
+    pub covered: Vec<u32>,
+    /// E_f: front → back edges between peel-order neighbours, sorted by (from, to), weights
+    /// in samples (phase 2).
+    pub edges: Vec<Edge>,
+    /// Peel passes used (phase 1, phase 2).
+    pub layers: [u32; 2],
+    /// Whether `max_layers` stopped the peel before it was complete.
+    pub truncated: bool,
+}
+
+/// A recording of a frame range of one path over one scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Recording {
+    /// Version of the tool that wrote it.
+    pub tool_version: String,
+    /// Hash of the scene (its geometry, materials, textures and nodes).
+    pub scene_hash: Hash,
+    /// Hash of the path's frames.
+    pub path_hash: Hash,
+    /// Recording settings.
+    pub settings: RecordSettings,
+    /// The device it was recorded on.
+    pub device: DeviceInfo,
+    /// Which phases it holds.
+    pub phase: Phase,
+    /// Number of triangles in the scene (scene ids are below this).
+    pub scene_triangles: u32,
+    /// Every frame of the path (camera and poses), not only the recorded range, so frame
+    /// ranges recorded on different machines can be merged.
+    pub frame_states: Vec<FrameState>,
+    /// Recorded frames, ascending by frame index, a contiguous half-open range.
+    pub frames: Vec<FrameRecord>,
+    /// G: the triangles visible in at least one frame of the whole path (ascending scene
+    /// ids). For a `Visibility` recording: the union over its own range only.
+    pub unique_visible: Vec<u32>,
+    /// Geometry of G (triangle k is scene triangle `unique_visible[k]`); empty for a
+    /// `Visibility` recording.
+    pub geometry: Geometry,
+}
+
+impl Recording {
+    /// The half-open range of recorded frames.
+    pub fn frame_range(&self) -> std::ops::Range<u32> {
+        match (self.frames.first(), self.frames.last()) {
+            (Some(a), Some(b)) => a.frame..b.frame + 1,
+            _ => 0..0,
+        }
+    }
+}

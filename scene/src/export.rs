@@ -1,0 +1,1 @@
+//! glTF export of a scene.

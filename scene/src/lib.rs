@@ -1,0 +1,195 @@
+//! Scenes for trisort: glTF 2.0 import, the procedural demo car and glTF export.
+//!
+//! This crate exists apart from `recorder` so that the dependency rules of the design hold:
+//! `paths` needs scenes (node names, animations, bounds) but no GPU, and the merger and player
+//! must not depend on `gltf`.
+#![deny(missing_docs)]
+
+use serde::{Deserialize, Serialize};
+use trisort_format::Geometry;
+
+/// A scene ready for recording: the full geometry plus what paths need (animations, cameras)
+/// and what `inspect` reports.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// Display name (file stem, or "demo car").
+    pub name: String,
+    /// All triangles of the scene; a triangle's index is its scene id.
+    pub geometry: Geometry,
+    /// Animations of node transforms.
+    pub animations: Vec<Animation>,
+    /// Cameras placed in the scene.
+    pub cameras: Vec<SceneCamera>,
+    /// Counts for `inspect`.
+    pub stats: SceneStats,
+    /// Warnings and notes from import (skipped primitives, ignored extensions, …).
+    pub notes: Vec<String>,
+}
+
+/// Which node property an animation channel drives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Property {
+    /// Translation (3 values per key).
+    Translation,
+    /// Rotation as a unit quaternion x, y, z, w (4 values per key).
+    Rotation,
+    /// Scale (3 values per key).
+    Scale,
+}
+
+/// Keyframe interpolation of an animation channel (glTF sampler interpolation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Interpolation {
+    /// Linear (slerp for rotations).
+    Linear,
+    /// Step: hold the previous key.
+    Step,
+    /// Cubic Hermite spline; values hold (in-tangent, value, out-tangent) per key.
+    CubicSpline,
+}
+
+/// One animated property of one node.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Channel {
+    /// Target node index.
+    pub node: u32,
+    /// Animated property.
+    pub property: Property,
+    /// Interpolation.
+    pub interpolation: Interpolation,
+    /// Key times in seconds, ascending.
+    pub times: Vec<f32>,
+    /// Key values, flattened: per key 3 or 4 components, ×3 for cubic splines.
+    pub values: Vec<f32>,
+}
+
+/// A named set of channels.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Animation {
+    /// Name (may be empty).
+    pub name: String,
+    /// Channels.
+    pub channels: Vec<Channel>,
+}
+
+/// A perspective camera attached to a node (its view is the inverse of the node's world
+/// transform; it looks down the node's −Z).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneCamera {
+    /// Camera name (may be empty).
+    pub name: String,
+    /// Node carrying the camera.
+    pub node: u32,
+    /// Vertical field of view in radians.
+    pub yfov: f64,
+    /// Near plane.
+    pub znear: f64,
+    /// Far plane, `None` for infinite.
+    pub zfar: Option<f64>,
+    /// Aspect ratio if the file fixes one.
+    pub aspect: Option<f64>,
+}
+
+/// Counts reported by `trisort inspect` for a scene.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SceneStats {
+    /// Triangles after expanding instances, strips and fans.
+    pub triangles: u64,
+    /// Triangles with zero area (kept, counted).
+    pub zero_area_triangles: u64,
+    /// Meshes in the file.
+    pub meshes: u64,
+    /// Primitives in the file (triangle primitives counted once per mesh, not per instance).
+    pub primitives: u64,
+    /// Nodes in the file.
+    pub nodes: u64,
+    /// Materials in the file.
+    pub materials: u64,
+    /// Textures decoded.
+    pub textures: u64,
+    /// Animations.
+    pub animations: u64,
+    /// Cameras.
+    pub cameras: u64,
+}
+
+impl Scene {
+    /// A stable hash of the geometry (vertices, triangles, materials, textures, nodes): the
+    /// scene identity stored in recordings and baked files.
+    pub fn hash(&self) -> trisort_format::Hash {
+        let bytes = postcard::to_stdvec(&self.geometry).expect("geometry serializes");
+        trisort_format::hash_bytes(&bytes)
+    }
+
+    /// World-space axis-aligned bounding box of all triangles at the rest pose, as
+    /// (min, max). Returns `None` for a scene without triangles.
+    pub fn bounds(&self) -> Option<(glam::DVec3, glam::DVec3)> {
+        let g = &self.geometry;
+        if g.triangles.is_empty() {
+            return None;
+        }
+        let world = trisort_format::world_transforms(&g.nodes, &[]);
+        let mut lo = glam::DVec3::splat(f64::INFINITY);
+        let mut hi = glam::DVec3::splat(f64::NEG_INFINITY);
+        let mut used = vec![false; g.vertices.len()];
+        for t in &g.triangles {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        for (v, _) in g.vertices.iter().zip(&used).filter(|(_, u)| **u) {
+            let p =
+                world[v.node as usize].transform_point3(glam::Vec3::from(v.position).as_dvec3());
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        Some((lo, hi))
+    }
+
+    /// Index of the first node with this name.
+    pub fn node_by_name(&self, name: &str) -> Option<u32> {
+        self.geometry
+            .nodes
+            .iter()
+            .position(|n| n.name == name)
+            .map(|i| i as u32)
+    }
+}
+
+pub mod demo_car;
+pub mod export;
+pub mod gltf_import;
+
+/// Environment variable naming the folder of the shared test scenes.
+pub const SCENES_ENV: &str = "TRISORT_SCENES";
+/// Environment variable that, when set to `1` (CI sets it), turns a missing test scene into a
+/// test failure instead of a skip.
+pub const REQUIRE_SCENES_ENV: &str = "TRISORT_REQUIRE_SCENES";
+
+/// Locates a shared test scene for tests and benchmarks: `$TRISORT_SCENES/<rel>`, by default
+/// `<workspace>/../shared/scenes/<rel>`.
+///
+/// Returns `None` (the caller skips, printing why) when the file is missing, unless
+/// `TRISORT_REQUIRE_SCENES=1`, in which case it panics: CI must never skip a real-scene test.
+pub fn test_scene(rel: &str) -> Option<std::path::PathBuf> {
+    let dir = std::env::var_os(SCENES_ENV)
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| {
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes")
+        });
+    let path = dir.join(rel);
+    if path.is_file() {
+        return Some(path);
+    }
+    if std::env::var(REQUIRE_SCENES_ENV).as_deref() == Ok("1") {
+        panic!(
+            "test scene {} is missing and {REQUIRE_SCENES_ENV}=1",
+            path.display()
+        );
+    }
+    eprintln!(
+        "skipping: test scene {} not found (set {SCENES_ENV})",
+        path.display()
+    );
+    None
+}

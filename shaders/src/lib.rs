@@ -1,0 +1,2 @@
+//! WGSL shared by the recorder, the player and the reference.
+#![deny(missing_docs)]
