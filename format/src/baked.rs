@@ -49,6 +49,22 @@ pub struct MergeInfo {
     pub segment: Option<u32>,
     /// Seeding used to build the matrix (interval, paper).
     pub seeding: String,
+    /// The non-empty cells of the upper-triangular matrix (of every segment), in index-buffer
+    /// order: what `trisort inspect --matrix` draws (the paper's Figure 14).
+    pub cells: Vec<MatrixCell>,
+}
+
+/// One non-empty cell (i, j) of the merge matrix: its copies are drawn in frames i..=j.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MatrixCell {
+    /// First frame (row i).
+    pub first_frame: u32,
+    /// Last frame (column j), ≥ `first_frame`.
+    pub last_frame: u32,
+    /// Position of the cell's first copy in [`Baked::copies`].
+    pub first_copy: u32,
+    /// Number of copies (triangles) in the cell.
+    pub triangles: u32,
 }
 
 /// Merge figures (the `--json` keys of `trisort merge`).
@@ -68,8 +84,13 @@ pub struct MergeStats {
     pub drawn_not_visible_mean: f64,
     /// Total weight of the removed intra-frame cycle edges.
     pub unordered_samples: u64,
-    /// Merge wall time in seconds.
+    /// Merge wall time in seconds. The merger leaves it 0 in the file so identical inputs
+    /// give byte-identical files; the CLI reports the time it measured.
     pub seconds: f64,
+    /// Edges of the final per-cell constraint graphs (union over the cell's frames).
+    pub cell_constraint_edges: u64,
+    /// The same after transitive reduction (its gain: how many edges were redundant).
+    pub cell_constraint_edges_reduced: u64,
 }
 
 /// A baked path: everything the player needs, and what the validator needs to check it.

@@ -18,7 +18,7 @@ pub mod container;
 pub mod geometry;
 pub mod recording;
 
-pub use baked::{Baked, DrawIndexedIndirectArgs, FrameWindow, MergeInfo, MergeStats};
+pub use baked::{Baked, DrawIndexedIndirectArgs, FrameWindow, MatrixCell, MergeInfo, MergeStats};
 pub use camera::{world_transforms, Camera, FrameState, NodePose};
 pub use container::{read_file, write_file_atomic, FileKind, FormatError, FORMAT_VERSION};
 pub use geometry::{AlphaMode, Geometry, Material, Node, Texture, Vertex};

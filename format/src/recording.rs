@@ -81,6 +81,11 @@ pub struct FrameRecord {
     /// E_f: front → back edges between peel-order neighbours, sorted by (from, to), weights
     /// in samples (phase 2).
     pub edges: Vec<Edge>,
+    /// Ties: the edges of E_f between fragments of *equal* depth, `from` being the one the
+    /// peel put in front (the lower id), weighted by the number of samples showing the tie
+    /// (phase 2). A depth-only bake (`merge --depth-only`) keeps only these: with the depth
+    /// test on, the draw order matters only where depths are equal.
+    pub ties: Vec<Edge>,
     /// Peel passes used (phase 1, phase 2).
     pub layers: [u32; 2],
     /// Whether `max_layers` stopped the peel before it was complete.
@@ -118,6 +123,12 @@ pub struct Recording {
 }
 
 impl Recording {
+    /// The recording's identity: BLAKE3 of its postcard encoding (what a [`crate::Baked`]
+    /// stores in `recording_hashes`; independent of the container's compression).
+    pub fn content_hash(&self) -> Hash {
+        crate::hash_bytes(&postcard::to_allocvec(self).expect("a Recording always serializes"))
+    }
+
     /// The half-open range of recorded frames.
     pub fn frame_range(&self) -> std::ops::Range<u32> {
         match (self.frames.first(), self.frames.last()) {
