@@ -1,0 +1,165 @@
+//! Headless device setup shared by every GPU stage, and the CI rule for missing adapters.
+
+/// Environment variable that, when `1` (CI sets it), turns a missing GPU adapter into a test
+/// failure instead of a skip.
+pub const REQUIRE_GPU_ENV: &str = "TRISORT_REQUIRE_GPU";
+
+/// Errors setting up the GPU.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// No adapter was found.
+    #[error("no GPU adapter found ({0}); on a machine without a GPU install Mesa's lavapipe: apt-get install mesa-vulkan-drivers")]
+    NoAdapter(String),
+    /// The device could not be created.
+    #[error("could not create a GPU device on {adapter}: {reason}")]
+    Device {
+        /// Adapter name.
+        adapter: String,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// A device with what trisort learned about its adapter.
+pub struct Gpu {
+    /// The adapter.
+    pub adapter: wgpu::Adapter,
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// Adapter information (name, driver, backend).
+    pub info: wgpu::AdapterInfo,
+}
+
+/// Features trisort uses when the adapter has them.
+pub fn wanted_features() -> wgpu::Features {
+    wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+        | wgpu::Features::PRIMITIVE_INDEX
+        | wgpu::Features::TIMESTAMP_QUERY
+        | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+        | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES
+        | wgpu::Features::PIPELINE_STATISTICS_QUERY
+}
+
+impl Gpu {
+    /// Opens the default adapter headless (no surface) with the adapter's own limits and the
+    /// [`wanted_features`] it supports. `WGPU_BACKEND` and `WGPU_ADAPTER_NAME` select as in
+    /// wgpu.
+    pub fn new() -> Result<Gpu, GpuError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter =
+            pollster::block_on(
+                instance.request_adapter(&wgpu::RequestAdapterOptions {
+                    power_preference: wgpu::PowerPreference::from_env()
+                        .unwrap_or(wgpu::PowerPreference::HighPerformance),
+                    force_fallback_adapter: false,
+                    compatible_surface: None,
+                    apply_limit_buckets: false,
+                }),
+            )
+            .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let features = adapter.features() & wanted_features();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("trisort"),
+            required_features: features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::Device {
+            adapter: info.name.clone(),
+            reason: e.to_string(),
+        })?;
+        Ok(Gpu {
+            adapter,
+            device,
+            queue,
+            info,
+        })
+    }
+
+    /// For tests: a device, or `None` (the test skips, saying why) when there is no adapter,
+    /// unless `TRISORT_REQUIRE_GPU=1`, in which case a missing adapter panics.
+    pub fn for_tests() -> Option<Gpu> {
+        match Gpu::new() {
+            Ok(g) => Some(g),
+            Err(e) if std::env::var(REQUIRE_GPU_ENV).as_deref() == Ok("1") => {
+                panic!("{e} and {REQUIRE_GPU_ENV}=1")
+            }
+            Err(e) => {
+                eprintln!("skipping GPU test: {e}");
+                None
+            }
+        }
+    }
+
+    /// One line describing the adapter, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Mesa 22.3.6)`.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ({:?}, {} {})",
+            self.info.name, self.info.backend, self.info.driver, self.info.driver_info
+        )
+    }
+
+    /// Reads back a buffer region synchronously (copies into a mappable staging buffer).
+    pub fn read_buffer(&self, buffer: &wgpu::Buffer, offset: u64, size: u64) -> Vec<u8> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
+        self.queue.submit([enc.finish()]);
+        self.map_read(&staging)
+    }
+
+    /// Maps a `MAP_READ` buffer after the queue has finished with it, and returns its bytes.
+    pub fn map_read(&self, staging: &wgpu::Buffer) -> Vec<u8> {
+        let slice = staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| r.expect("buffer mapping failed"));
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("GPU device lost while waiting for a readback");
+        let out = slice.get_mapped_range().expect("mapped range").to_vec();
+        staging.unmap();
+        out
+    }
+
+    /// Reads back a 2D RGBA8/BGRA8/R32 texture (4 bytes per texel, one sample, mip 0, layer 0)
+    /// as tightly packed rows.
+    pub fn read_texture_4bpp(&self, texture: &wgpu::Texture) -> Vec<u8> {
+        let (w, h) = (texture.width(), texture.height());
+        let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("texture readback"),
+            size: row as u64 * h as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
+            texture.size(),
+        );
+        self.queue.submit([enc.finish()]);
+        let padded = self.map_read(&staging);
+        let mut out = Vec::with_capacity((w * h * 4) as usize);
+        for y in 0..h as usize {
+            out.extend_from_slice(&padded[y * row as usize..][..(w * 4) as usize]);
+        }
+        out
+    }
+}

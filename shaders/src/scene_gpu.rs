@@ -1,0 +1,390 @@
+//! GPU resources of a scene shared by every pipeline: the vertex buffer, the materials, the
+//! base-colour texture array, and per-frame uniforms and camera-relative node matrices bound by
+//! dynamic offset (group 0 of [`crate::COMMON`]).
+
+use bytemuck::{Pod, Zeroable};
+use trisort_format::{AlphaMode, FrameState, Geometry, Vertex};
+use wgpu::util::DeviceExt;
+
+/// Vertex buffer layout of [`Vertex`] (locations 0–4 of `VertexIn`).
+pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
+    0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32, 4 => Uint32
+];
+
+/// The vertex buffer layout for pipelines.
+pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &VERTEX_ATTRIBUTES,
+    }
+}
+
+/// The `Frame` uniform of the shared WGSL.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniform {
+    /// Projection matrix.
+    pub proj: [[f32; 4]; 4],
+    /// View-space light direction (xyz) and ambient (w).
+    pub light: [f32; 4],
+    /// Glass opacity, width, height, sample count.
+    pub params: [f32; 4],
+}
+
+/// The `MaterialGpu` struct of the shared WGSL.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct MaterialGpu {
+    base_color: [f32; 4],
+    emissive: [f32; 4],
+    params: [f32; 4],
+    uv_scale: [f32; 4],
+}
+
+/// The view-space light of every pipeline: towards upper left behind the viewer; ambient 0.35.
+pub const LIGHT: [f32; 4] = [-0.3, 0.6, 0.75, 0.35];
+
+/// How frames are drawn: image size, sample count and glass opacity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// MSAA samples.
+    pub samples: u32,
+    /// Opacity of transmissive glass.
+    pub glass_opacity: f32,
+}
+
+/// Scene resources on the GPU.
+pub struct SceneGpu {
+    /// Vertex buffer.
+    pub vertices: wgpu::Buffer,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    /// Bind group layout of group 0.
+    pub layout: wgpu::BindGroupLayout,
+    /// Bind group 0 (bind with [`SceneGpu::offsets`]).
+    pub bind_group: wgpu::BindGroup,
+    frame_stride: u64,
+    node_stride: u64,
+    frames: u32,
+}
+
+fn align(x: u64, a: u64) -> u64 {
+    x.div_ceil(a) * a
+}
+
+/// Creates the bind group layout of group 0.
+pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("trisort scene"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: vf,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(
+                        std::mem::size_of::<FrameUniform>() as u64
+                    ),
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: vf,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: true,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: vf,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 4,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ],
+    })
+}
+
+impl SceneGpu {
+    /// Uploads the geometry, materials, textures and the uniforms of every frame.
+    ///
+    /// Textures share one array: each layer is as large as the largest texture, and a
+    /// texture smaller than that fills the top-left corner (its uv scaled to fit), so one bind
+    /// group serves every material. Node matrices are computed in f64 and cast once.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+    ) -> SceneGpu {
+        let limits = device.limits();
+        let vertex_bytes: &[u8] = if geometry.vertices.is_empty() {
+            &[0u8; std::mem::size_of::<Vertex>()]
+        } else {
+            bytemuck::cast_slice(&geometry.vertices)
+        };
+        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("vertices"),
+            contents: vertex_bytes,
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+
+        // Texture array.
+        let (tw, th) = geometry
+            .textures
+            .iter()
+            .fold((1u32, 1u32), |(w, h), t| (w.max(t.width), h.max(t.height)));
+        let max_dim = limits.max_texture_dimension_2d;
+        let (tw, th) = (tw.min(max_dim), th.min(max_dim));
+        let layers = geometry.textures.len().max(1) as u32;
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("base colour textures"),
+            size: wgpu::Extent3d {
+                width: tw,
+                height: th,
+                depth_or_array_layers: layers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let mut uv_scales = Vec::new();
+        for (layer, t) in geometry.textures.iter().enumerate() {
+            let (w, h) = (t.width.min(tw), t.height.min(th));
+            // Rows beyond the device limit are cropped (documented limitation).
+            let mut data = Vec::with_capacity((w * h * 4) as usize);
+            for y in 0..h as usize {
+                data.extend_from_slice(&t.rgba8[y * t.width as usize * 4..][..w as usize * 4]);
+            }
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: layer as u32,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &data,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(w * 4),
+                    rows_per_image: Some(h),
+                },
+                wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+            );
+            uv_scales.push([w as f32 / tw as f32, h as f32 / th as f32]);
+        }
+        if geometry.textures.is_empty() {
+            queue.write_texture(
+                texture.as_image_copy(),
+                &[255u8; 4],
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4),
+                    rows_per_image: Some(1),
+                },
+                wgpu::Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        let texture_view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("base colour"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+
+        // Materials.
+        let mut mats: Vec<MaterialGpu> = geometry
+            .materials
+            .iter()
+            .map(|m| {
+                let mode = match m.alpha_mode {
+                    AlphaMode::Opaque => 0.0,
+                    AlphaMode::Mask => 1.0,
+                    AlphaMode::Blend => 2.0,
+                };
+                let (layer, scale) = match m.base_color_texture {
+                    Some(t) if (t as usize) < uv_scales.len() => (t as f32, uv_scales[t as usize]),
+                    _ => (-1.0, [1.0, 1.0]),
+                };
+                MaterialGpu {
+                    base_color: m.base_color,
+                    emissive: [m.emissive[0], m.emissive[1], m.emissive[2], m.transmission],
+                    params: [
+                        mode,
+                        m.alpha_cutoff,
+                        if m.double_sided { 1.0 } else { 0.0 },
+                        layer,
+                    ],
+                    uv_scale: [scale[0], scale[1], 0.0, 0.0],
+                }
+            })
+            .collect();
+        if mats.is_empty() {
+            mats.push(MaterialGpu::zeroed());
+        }
+        let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("materials"),
+            contents: bytemuck::cast_slice(&mats),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+
+        // Per-frame uniforms and node matrices.
+        let frame_stride = align(
+            std::mem::size_of::<FrameUniform>() as u64,
+            limits.min_uniform_buffer_offset_alignment as u64,
+        );
+        let node_count = geometry.nodes.len().max(1) as u64;
+        let node_stride = align(
+            node_count * 64,
+            limits.min_storage_buffer_offset_alignment as u64,
+        );
+        let nframes = frames.len().max(1) as u64;
+        let mut frame_bytes = vec![0u8; (frame_stride * nframes) as usize];
+        let mut node_bytes = vec![0u8; (node_stride * nframes) as usize];
+        for (f, state) in frames.iter().enumerate() {
+            let u = frame_uniform(state, view);
+            frame_bytes[f * frame_stride as usize..][..std::mem::size_of::<FrameUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
+            let mats = trisort_format::camera::node_view_matrices(&geometry.nodes, state);
+            let m: Vec<[f32; 16]> = mats.iter().map(|m| m.to_cols_array()).collect();
+            let b: &[u8] = bytemuck::cast_slice(&m);
+            node_bytes[f * node_stride as usize..][..b.len()].copy_from_slice(b);
+        }
+        let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("frame uniforms"),
+            contents: &frame_bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let node_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("node matrices"),
+            contents: &node_bytes,
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let layout = bind_group_layout(device);
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("trisort scene"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &frame_buffer,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniform>() as u64),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &node_buffer,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(node_count * 64),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: materials.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&texture_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+            ],
+        });
+        SceneGpu {
+            vertices,
+            vertex_count: geometry.vertices.len() as u32,
+            layout,
+            bind_group,
+            frame_stride,
+            node_stride,
+            frames: frames.len() as u32,
+        }
+    }
+
+    /// Number of frames uploaded.
+    pub fn frames(&self) -> u32 {
+        self.frames
+    }
+
+    /// The dynamic offsets that bind frame `f`'s uniforms and node matrices.
+    pub fn offsets(&self, f: u32) -> [u32; 2] {
+        assert!(f < self.frames.max(1), "frame {f} out of range");
+        [
+            (f as u64 * self.frame_stride) as u32,
+            (f as u64 * self.node_stride) as u32,
+        ]
+    }
+}
+
+/// The `Frame` uniform for one frame at a view.
+pub fn frame_uniform(state: &FrameState, view: View) -> FrameUniform {
+    let aspect = view.width as f64 / view.height as f64;
+    let proj = state.camera.projection(aspect).as_mat4();
+    FrameUniform {
+        proj: proj.to_cols_array_2d(),
+        light: LIGHT,
+        params: [
+            view.glass_opacity,
+            view.width as f32,
+            view.height as f32,
+            view.samples as f32,
+        ],
+    }
+}
