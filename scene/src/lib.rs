@@ -157,8 +157,12 @@ impl Scene {
 }
 
 pub mod demo_car;
+mod error;
 pub mod export;
 pub mod gltf_import;
+
+pub use error::SceneError;
+pub use gltf_import::{load, load_slice};
 
 /// Environment variable naming the folder of the shared test scenes.
 pub const SCENES_ENV: &str = "TRISORT_SCENES";
