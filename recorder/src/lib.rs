@@ -1,2 +1,368 @@
-//! The recorder: GPU depth peeling per frame and per sample into occlusion graphs.
+//! The recorder: GPU depth peeling per frame and per MSAA sample into visibility sets and
+//! occlusion graphs (DESIGN.md § Recorder; paper 003 §3.1, §4.1).
+//!
+//! Phase 1 (visibility) peels every triangle of the scene until each sample is saturated
+//! (accumulated opacity ≥ the threshold) or has no fragment left: the triangles reached before
+//! saturation form V_f, and their union over the whole path is G. Phase 2 (graphs) peels only
+//! G, completely: every triangle seen is covered (C_f), and consecutive fragments at a sample
+//! give an edge front → back weighted by the samples showing it (E_f); equal-depth neighbours
+//! are also listed as ties.
+//!
+//! Each layer is one render pass: triangles in ascending id order, depth test `Less`, the
+//! depth written explicitly, and fragments whose (depth, id) key is not greater than the
+//! previous layer's at that sample discarded (see `shaders/src/wgsl/peel.wgsl`). Samples that
+//! are finished are masked so later layers do no work there.
 #![deny(missing_docs)]
+
+pub mod partial;
+mod peeler;
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use trisort_format::{
+    DeviceInfo, Edge, FrameRecord, FrameState, Geometry, Hash, Phase, RecordSettings, Recording,
+};
+use trisort_shaders::gpu::Gpu;
+use trisort_shaders::scene_gpu::View;
+
+use peeler::Peeler;
+
+/// Errors while recording.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    /// The device lacks something the recorder needs.
+    #[error("unsupported device: {0}")]
+    Unsupported(String),
+    /// The GPU device was lost or a wait failed; finished frames are kept in the partial folder.
+    #[error("GPU device error: {0} (finished frames are kept; rerun to resume)")]
+    Device(String),
+    /// The options do not fit the inputs.
+    #[error("{0}")]
+    Invalid(String),
+    /// Writing or reading partial results failed.
+    #[error(transparent)]
+    Format(#[from] trisort_format::FormatError),
+}
+
+/// What to record.
+#[derive(Clone, Debug)]
+pub struct RecordJob<'a> {
+    /// The full scene geometry (scene ids are indices of its triangles).
+    pub geometry: &'a Geometry,
+    /// Every frame of the path.
+    pub frames: &'a [FrameState],
+    /// Scene hash (stored in the recording).
+    pub scene_hash: Hash,
+    /// Path hash (stored in the recording).
+    pub path_hash: Hash,
+    /// Settings.
+    pub settings: RecordSettings,
+    /// Frames to record (half-open); `None` for all.
+    pub range: Option<Range<u32>>,
+    /// Phase 1 only (`Visibility`) or both (`Graphs`).
+    pub phase: Phase,
+    /// For phase 2 of a range: G from the union of phase-1 recordings of the whole path; `None`
+    /// to run phase 1 over every frame of the path first.
+    pub known_visible: Option<Vec<u32>>,
+}
+
+/// Progress reports while recording.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// 1 or 2.
+    pub phase: u8,
+    /// Frame just finished.
+    pub frame: u32,
+    /// Frames finished in this phase (including resumed ones).
+    pub done: u32,
+    /// Frames in this phase.
+    pub total: u32,
+    /// Layers peeled for this frame.
+    pub layers: u32,
+}
+
+/// The device description stored in recordings.
+pub fn device_info(gpu: &Gpu) -> DeviceInfo {
+    DeviceInfo {
+        adapter: gpu.info.name.clone(),
+        driver: format!("{} {}", gpu.info.driver, gpu.info.driver_info)
+            .trim()
+            .to_string(),
+        backend: format!("{:?}", gpu.info.backend),
+    }
+}
+
+fn check_job(job: &RecordJob) -> Result<Range<u32>, RecordError> {
+    let n = job.frames.len() as u32;
+    let s = &job.settings;
+    if n == 0 {
+        return Err(RecordError::Invalid("the path has no frames".into()));
+    }
+    let range = job.range.clone().unwrap_or(0..n);
+    if range.start >= range.end || range.end > n {
+        return Err(RecordError::Invalid(format!(
+            "frame range {}..{} is empty or outside the path's 0..{n}",
+            range.start, range.end
+        )));
+    }
+    if s.width == 0 || s.height == 0 || s.width > 16384 || s.height > 16384 {
+        return Err(RecordError::Invalid(format!(
+            "size {}x{} is out of range (1..16384)",
+            s.width, s.height
+        )));
+    }
+    if s.samples != 1 && s.samples != 4 {
+        return Err(RecordError::Invalid(format!(
+            "{} samples: only 1 and 4 are supported",
+            s.samples
+        )));
+    }
+    if !(s.saturation > 0.0 && s.saturation <= 1.0) {
+        return Err(RecordError::Invalid(format!(
+            "saturation {} must be in (0, 1]",
+            s.saturation
+        )));
+    }
+    if !(0.0..=1.0).contains(&s.glass_opacity) {
+        return Err(RecordError::Invalid(format!(
+            "glass opacity {} must be in [0, 1]",
+            s.glass_opacity
+        )));
+    }
+    if s.max_layers == 0 {
+        return Err(RecordError::Invalid("max layers must be at least 1".into()));
+    }
+    Ok(range)
+}
+
+fn view_of(s: &RecordSettings) -> View {
+    View {
+        width: s.width,
+        height: s.height,
+        samples: s.samples,
+        glass_opacity: s.glass_opacity,
+    }
+}
+
+/// Phase 1 of one frame: the visible set, layers used, and whether `max_layers` truncated it.
+fn visibility_frame(
+    peeler: &Peeler,
+    frame: u32,
+    s: &RecordSettings,
+) -> Result<(Vec<u32>, u32, bool), RecordError> {
+    let slots = peeler.slots();
+    let mut transmittance = vec![1.0f32; slots];
+    let mut visible = vec![];
+    let residual = 1.0 - s.saturation;
+    let (layers, truncated) = peeler.peel(frame, s.max_layers, |_, layer, done| {
+        for i in 0..slots {
+            let id = layer.ids[i];
+            if id == 0 || done[i] != 0 {
+                continue;
+            }
+            // Reached before saturation: visible (its own opacity does not matter).
+            visible.push(id - 1);
+            transmittance[i] *= 1.0 - layer.alpha[i];
+            if transmittance[i] <= residual {
+                done[i] = 1;
+            }
+        }
+        Ok(true)
+    })?;
+    visible.sort_unstable();
+    visible.dedup();
+    Ok((visible, layers, truncated))
+}
+
+/// Phase 2 of one frame over G (`g` = scene ids of the drawn list): covered set, edges, ties.
+fn graph_frame(
+    peeler: &Peeler,
+    frame: u32,
+    g: &[u32],
+    s: &RecordSettings,
+) -> Result<(Vec<u32>, Vec<Edge>, Vec<Edge>, u32, bool), RecordError> {
+    let slots = peeler.slots();
+    let mut last_id = vec![0u32; slots];
+    let mut last_depth = vec![0f32; slots];
+    let mut covered = vec![false; g.len()];
+    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut ties: HashMap<(u32, u32), u32> = HashMap::new();
+    let (layers, truncated) = peeler.peel(frame, s.max_layers, |_, layer, _| {
+        for i in 0..slots {
+            let id = layer.ids[i];
+            if id == 0 {
+                continue;
+            }
+            covered[(id - 1) as usize] = true;
+            let prev = last_id[i];
+            if prev != 0 {
+                let key = (g[(prev - 1) as usize], g[(id - 1) as usize]);
+                *edges.entry(key).or_default() += 1;
+                if layer.depth[i] == last_depth[i] {
+                    *ties.entry(key).or_default() += 1;
+                }
+            }
+            last_id[i] = id;
+            last_depth[i] = layer.depth[i];
+        }
+        Ok(true)
+    })?;
+    let covered: Vec<u32> = covered
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| **c)
+        .map(|(k, _)| g[k])
+        .collect();
+    let to_edges = |m: HashMap<(u32, u32), u32>| {
+        let mut v: Vec<Edge> = m
+            .into_iter()
+            .map(|((from, to), weight)| Edge { from, to, weight })
+            .collect();
+        v.sort_unstable();
+        v
+    };
+    Ok((covered, to_edges(edges), to_edges(ties), layers, truncated))
+}
+
+/// Records a job. Finished frames are stored in `partial` (if given) as they finish, and
+/// frames already there (from an interrupted run with the same inputs) are not recorded
+/// again. The result is deterministic: identical inputs give identical recordings.
+pub fn record(
+    gpu: &Gpu,
+    job: &RecordJob,
+    partial: Option<&partial::PartialDir>,
+    mut progress: impl FnMut(Progress),
+) -> Result<Recording, RecordError> {
+    let range = check_job(job)?;
+    let s = job.settings;
+    let view = view_of(&s);
+    let n = job.frames.len() as u32;
+    let all_ids: Vec<u32> = (0..job.geometry.triangles.len() as u32).collect();
+
+    // Phase 1 over the frames whose visibility decides G.
+    let phase1_range = match (&job.known_visible, job.phase) {
+        (Some(_), _) => range.clone(),
+        (None, Phase::Graphs) => 0..n,
+        (None, Phase::Visibility) => range.clone(),
+    };
+    let mut vis: HashMap<u32, (Vec<u32>, u32, bool)> = HashMap::new();
+    {
+        let todo: Vec<u32> = phase1_range
+            .clone()
+            .filter(|&f| match partial.and_then(|p| p.load_visibility(f)) {
+                Some(v) => {
+                    vis.insert(f, v);
+                    false
+                }
+                None => true,
+            })
+            .collect();
+        let total = phase1_range.len() as u32;
+        let mut done = total - todo.len() as u32;
+        if !todo.is_empty() {
+            let peeler = Peeler::new(gpu, job.geometry, &all_ids, job.frames, view)?;
+            for f in todo {
+                let v = visibility_frame(&peeler, f, &s)?;
+                if let Some(p) = partial {
+                    p.store_visibility(f, &v)?;
+                }
+                done += 1;
+                progress(Progress {
+                    phase: 1,
+                    frame: f,
+                    done,
+                    total,
+                    layers: v.1,
+                });
+                vis.insert(f, v);
+            }
+        }
+    }
+    let g: Vec<u32> = match &job.known_visible {
+        Some(g) => g.clone(),
+        None => {
+            let mut g: Vec<u32> = vis.values().flat_map(|v| v.0.iter().copied()).collect();
+            g.sort_unstable();
+            g.dedup();
+            g
+        }
+    };
+    if g.windows(2).any(|w| w[0] >= w[1])
+        || g.last()
+            .is_some_and(|&t| t as usize >= job.geometry.triangles.len())
+    {
+        return Err(RecordError::Invalid(
+            "the visible set G is not sorted or names triangles the scene lacks".into(),
+        ));
+    }
+
+    let mut frames: Vec<FrameRecord> = range
+        .clone()
+        .map(|f| {
+            let (visible, l1, t1) = vis.remove(&f).expect("phase 1 covered the range");
+            FrameRecord {
+                frame: f,
+                visible,
+                layers: [l1, 0],
+                truncated: t1,
+                ..Default::default()
+            }
+        })
+        .collect();
+
+    if job.phase == Phase::Graphs {
+        let total = frames.len() as u32;
+        let mut done_count = 0;
+        let mut peeler = None;
+        for rec in frames.iter_mut() {
+            let f = rec.frame;
+            let result = match partial.and_then(|p| p.load_graph(f)) {
+                Some(r) => r,
+                None => {
+                    if peeler.is_none() {
+                        peeler = Some(Peeler::new(gpu, job.geometry, &g, job.frames, view)?);
+                    }
+                    let r = graph_frame(peeler.as_ref().unwrap(), f, &g, &s)?;
+                    if let Some(p) = partial {
+                        p.store_graph(f, &r)?;
+                    }
+                    r
+                }
+            };
+            let (covered, edges, ties, layers, truncated) = result;
+            rec.covered = covered;
+            rec.edges = edges;
+            rec.ties = ties;
+            rec.layers[1] = layers;
+            rec.truncated |= truncated;
+            done_count += 1;
+            progress(Progress {
+                phase: 2,
+                frame: f,
+                done: done_count,
+                total,
+                layers,
+            });
+        }
+    }
+
+    let geometry = if job.phase == Phase::Graphs {
+        job.geometry.subset(&g)
+    } else {
+        Geometry::default()
+    };
+    Ok(Recording {
+        tool_version: trisort_format::TOOL_VERSION.to_string(),
+        scene_hash: job.scene_hash,
+        path_hash: job.path_hash,
+        settings: s,
+        device: device_info(gpu),
+        phase: job.phase,
+        scene_triangles: job.geometry.triangles.len() as u32,
+        frame_states: job.frames.to_vec(),
+        frames,
+        unique_visible: g,
+        geometry,
+    })
+}

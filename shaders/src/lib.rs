@@ -16,9 +16,73 @@ pub const COMMON: &str = include_str!("wgsl/common.wgsl");
 /// Entry points of the GPU smoke test (one triangle through the shared transform).
 pub const SMOKE: &str = include_str!("wgsl/smoke.wgsl");
 
+/// Entry points of the player (`vs_player`, `fs_player_straight`, `fs_player_premultiplied`).
+pub const PLAYER: &str = include_str!("wgsl/player.wgsl");
+
+/// Depth peeling entry points (`vs_peel`, `fs_peel`); compose with [`peel_shader`].
+pub const PEEL: &str = include_str!("wgsl/peel.wgsl");
+
+/// The compute pass that gathers a peel layer per sample; compose with [`gather_shader`].
+pub const GATHER: &str = include_str!("wgsl/gather.wgsl");
+
+/// Fills the texture-type placeholders of the peel and gather shaders for a sample count:
+/// multisampled textures for `samples > 1`, plain ones for a single sample.
+fn peel_types(body: &str, samples: u32) -> String {
+    let (ids, depth, sample) = if samples > 1 {
+        (
+            "texture_multisampled_2d<u32>",
+            "texture_depth_multisampled_2d",
+            "i32(sample)",
+        )
+    } else {
+        ("texture_2d<u32>", "texture_depth_2d", "0")
+    };
+    body.replace("PREV_IDS_TYPE", ids)
+        .replace("PREV_DEPTH_TYPE", depth)
+        .replace(
+            "LOAD_PREV_DEPTH",
+            &format!("textureLoad(prev_depth, coord, {sample})"),
+        )
+        .replace(
+            "LOAD_PREV_IDS",
+            &format!("textureLoad(prev_ids, coord, {sample})"),
+        )
+        .replace(
+            "LOAD_LAYER_IDS",
+            &format!(
+                "textureLoad(layer_ids, coord, {})",
+                sample.replace("sample", "s")
+            ),
+        )
+        .replace(
+            "LOAD_LAYER_DEPTH",
+            &format!(
+                "textureLoad(layer_depth, coord, {})",
+                sample.replace("sample", "s")
+            ),
+        )
+}
+
+/// The complete peel shader for a sample count (needs `Features::PRIMITIVE_INDEX`).
+pub fn peel_shader(samples: u32) -> String {
+    compose(&["primitive_index"], &peel_types(PEEL, samples))
+}
+
+/// The complete gather shader for a sample count (stand-alone: no shared bindings).
+pub fn gather_shader(samples: u32) -> String {
+    peel_types(GATHER, samples)
+}
+
 /// Every shader of the crate by name, composed and ready to compile (used by the naga test).
 pub fn all() -> Vec<(&'static str, String)> {
-    vec![("smoke", compose(&[], SMOKE))]
+    vec![
+        ("smoke", compose(&[], SMOKE)),
+        ("player", compose(&[], PLAYER)),
+        ("peel 1x", peel_shader(1)),
+        ("peel 4x", peel_shader(4)),
+        ("gather 1x", gather_shader(1)),
+        ("gather 4x", gather_shader(4)),
+    ]
 }
 
 /// Composes a module: `enable` directives first (WGSL requires them before any declaration),

@@ -1,0 +1,512 @@
+//! The GPU depth peeler: one render pass per layer, then a gather pass and a readback.
+
+use std::ops::Range;
+
+use trisort_format::{FrameState, Geometry};
+use trisort_shaders::gpu::Gpu;
+use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use wgpu::util::DeviceExt;
+
+use crate::RecordError;
+
+/// One peel layer read back: per sample (id + 1 or 0, alpha, depth).
+pub(crate) struct Layer {
+    /// Per sample: drawn position + 1, 0 where the layer has no fragment.
+    pub ids: Vec<u32>,
+    /// Per sample: the fragment's opacity.
+    pub alpha: Vec<f32>,
+    /// Per sample: the fragment's depth.
+    pub depth: Vec<f32>,
+}
+
+/// Most triangles drawn by one draw call (keeps single draws and primitive ids modest).
+const CHUNK_TRIANGLES: u32 = 1 << 22;
+
+/// The peeling pipeline for one scene at one view.
+pub(crate) struct Peeler<'g> {
+    gpu: &'g Gpu,
+    scene: SceneGpu,
+    pipeline: wgpu::RenderPipeline,
+    peel_layout: wgpu::BindGroupLayout,
+    gather_pipeline: wgpu::ComputePipeline,
+    gather_layout: wgpu::BindGroupLayout,
+    index: wgpu::Buffer,
+    triangles: u32,
+    depth: [wgpu::Texture; 2],
+    ids: [wgpu::Texture; 2],
+    done: wgpu::Buffer,
+    out: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    params: wgpu::Buffer,
+    params_stride: u64,
+    dims: wgpu::Buffer,
+    view: View,
+}
+
+const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+impl<'g> Peeler<'g> {
+    /// Sets up peeling of `triangles` (indices into `geometry.triangles`, ascending: this is
+    /// the draw order, and a fragment's id is its position in this list).
+    pub fn new(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        triangles: &[u32],
+        frames: &[FrameState],
+        view: View,
+    ) -> Result<Self, RecordError> {
+        let device = &gpu.device;
+        if !device.features().contains(wgpu::Features::PRIMITIVE_INDEX) {
+            return Err(RecordError::Unsupported(format!(
+                "{} lacks PRIMITIVE_INDEX",
+                gpu.describe()
+            )));
+        }
+        let ff = gpu.adapter.get_texture_format_features(ID_FORMAT);
+        if !ff.flags.sample_count_supported(view.samples)
+            || (view.samples > 1
+                && !device
+                    .features()
+                    .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES))
+        {
+            return Err(RecordError::Unsupported(format!(
+                "{} cannot render {ID_FORMAT:?} ids at {}x MSAA",
+                gpu.describe(),
+                view.samples
+            )));
+        }
+        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("peel"),
+            source: wgpu::ShaderSource::Wgsl(trisort_shaders::peel_shader(view.samples).into()),
+        });
+        let ms = view.samples > 1;
+        let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Texture {
+                sample_type,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: ms,
+            },
+            count: None,
+        };
+        let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("peel"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(16),
+                    },
+                    count: None,
+                },
+                tex(1, wgpu::TextureSampleType::Depth),
+                tex(2, wgpu::TextureSampleType::Uint),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("peel"),
+            bind_group_layouts: &[Some(&scene.layout), Some(&peel_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("peel"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_peel"),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout())],
+            },
+            // One pipeline for all materials: single-sided ones discard back faces in the shader.
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: wgpu::MultisampleState {
+                count: view.samples,
+                mask: !0,
+                alpha_to_coverage_enabled: false,
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_peel"),
+                compilation_options: Default::default(),
+                targets: &[Some(ID_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+
+        let gather_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("gather"),
+            source: wgpu::ShaderSource::Wgsl(trisort_shaders::gather_shader(view.samples).into()),
+        });
+        let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gather"),
+            entries: &[
+                tex(0, wgpu::TextureSampleType::Uint),
+                tex(1, wgpu::TextureSampleType::Depth),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let gather_pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gather"),
+            bind_group_layouts: &[Some(&gather_layout)],
+            immediate_size: 0,
+        });
+        let gather_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("gather"),
+            layout: Some(&gather_pl),
+            module: &gather_module,
+            entry_point: Some("gather"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+
+        let mut index_data: Vec<u32> = Vec::with_capacity(triangles.len() * 3);
+        for &t in triangles {
+            index_data.extend_from_slice(&geometry.triangles[t as usize]);
+        }
+        if index_data.is_empty() {
+            index_data.extend_from_slice(&[0, 0, 0]);
+        }
+        let index = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("peel indices"),
+            contents: bytemuck::cast_slice(&index_data),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        let size = wgpu::Extent3d {
+            width: view.width,
+            height: view.height,
+            depth_or_array_layers: 1,
+        };
+        let target = |label, format| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: view.samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let slots = view.width as u64 * view.height as u64 * view.samples as u64;
+        let out_size = slots * 16;
+        let max_binding = device.limits().max_storage_buffer_binding_size as u64;
+        if out_size > max_binding {
+            return Err(RecordError::Unsupported(format!(
+                "{}x{} at {}x needs a {out_size}-byte gather buffer; the device binds at most {max_binding}",
+                view.width, view.height, view.samples
+            )));
+        }
+        let done = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("done"),
+            size: slots * 4,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let out = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gathered"),
+            size: out_size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gathered readback"),
+            size: out_size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let chunks = (triangles.len() as u64)
+            .div_ceil(CHUNK_TRIANGLES as u64)
+            .max(1)
+            * 2;
+        let params_stride = 256u64.max(device.limits().min_uniform_buffer_offset_alignment as u64);
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("peel params"),
+            size: params_stride * chunks,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let dims = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("dims"),
+            contents: bytemuck::cast_slice(&[view.width, view.height, view.samples, 0]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        Ok(Peeler {
+            gpu,
+            scene,
+            pipeline,
+            peel_layout,
+            gather_pipeline,
+            gather_layout,
+            index,
+            triangles: triangles.len() as u32,
+            depth: [
+                target("depth a", DEPTH_FORMAT),
+                target("depth b", DEPTH_FORMAT),
+            ],
+            ids: [target("ids a", ID_FORMAT), target("ids b", ID_FORMAT)],
+            done,
+            out,
+            staging,
+            params,
+            params_stride,
+            dims,
+            view,
+        })
+    }
+
+    /// Number of samples in one layer.
+    pub fn slots(&self) -> usize {
+        self.view.width as usize * self.view.height as usize * self.view.samples as usize
+    }
+
+    /// Peels one frame: calls `on_layer` with each layer; it updates `done` (per sample, true
+    /// once the sample needs no further layers) and returns whether to continue. Stops when a
+    /// layer has no fragment, `on_layer` says stop, or after `max_layers` layers. Returns the
+    /// number of layers peeled and whether fragments remained after the last one allowed.
+    pub fn peel(
+        &self,
+        frame: u32,
+        max_layers: u32,
+        mut on_layer: impl FnMut(u32, &Layer, &mut [u32]) -> Result<bool, RecordError>,
+    ) -> Result<(u32, bool), RecordError> {
+        let gpu = self.gpu;
+        let slots = self.slots();
+        let mut done = vec![0u32; slots];
+        gpu.queue
+            .write_buffer(&self.done, 0, bytemuck::cast_slice(&done));
+        let chunk_ranges: Vec<Range<u32>> = (0..self.triangles.div_ceil(CHUNK_TRIANGLES).max(1))
+            .map(|c| c * CHUNK_TRIANGLES..((c + 1) * CHUNK_TRIANGLES).min(self.triangles))
+            .collect();
+        let n = chunk_ranges.len();
+        for (first, offset_group) in [(1u32, 0usize), (0, n)] {
+            for (c, r) in chunk_ranges.iter().enumerate() {
+                let p = [r.start, self.view.width, self.view.samples, first];
+                gpu.queue.write_buffer(
+                    &self.params,
+                    (offset_group + c) as u64 * self.params_stride,
+                    bytemuck::cast_slice(&p),
+                );
+            }
+        }
+        let mut layer_no = 0u32;
+        loop {
+            if layer_no == max_layers {
+                // Is anything left? Peel one more layer without keeping it.
+                let layer = self.layer(frame, layer_no, &chunk_ranges)?;
+                let left = layer
+                    .ids
+                    .iter()
+                    .zip(&done)
+                    .any(|(&id, &d)| id != 0 && d == 0);
+                return Ok((layer_no, left));
+            }
+            let layer = self.layer(frame, layer_no, &chunk_ranges)?;
+            layer_no += 1;
+            if layer
+                .ids
+                .iter()
+                .zip(&done)
+                .all(|(&id, &d)| id == 0 || d != 0)
+            {
+                return Ok((layer_no - 1, false));
+            }
+            // A sample with no fragment in this layer has none in any later one.
+            for (d, &id) in done.iter_mut().zip(&layer.ids) {
+                if id == 0 {
+                    *d = 1;
+                }
+            }
+            let go_on = on_layer(layer_no - 1, &layer, &mut done)?;
+            if !go_on || done.iter().all(|&d| d != 0) {
+                return Ok((layer_no, false));
+            }
+            gpu.queue
+                .write_buffer(&self.done, 0, bytemuck::cast_slice(&done));
+        }
+    }
+
+    fn layer(
+        &self,
+        frame: u32,
+        layer_no: u32,
+        chunks: &[Range<u32>],
+    ) -> Result<Layer, RecordError> {
+        let device = &self.gpu.device;
+        let cur = (layer_no % 2) as usize;
+        let prev = 1 - cur;
+        let dv = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let depth_views = [dv(&self.depth[0]), dv(&self.depth[1])];
+        let id_views = [dv(&self.ids[0]), dv(&self.ids[1])];
+        let peel_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("peel"),
+            layout: &self.peel_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.params,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(16),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&depth_views[prev]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&id_views[prev]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: self.done.as_entire_binding(),
+                },
+            ],
+        });
+        let gather_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gather"),
+            layout: &self.gather_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&id_views[cur]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&depth_views[cur]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.out.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: self.dims.as_entire_binding(),
+                },
+            ],
+        });
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("peel layer"),
+        });
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("peel layer"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &id_views[cur],
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_views[cur],
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+            pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
+            pass.set_index_buffer(self.index.slice(..), wgpu::IndexFormat::Uint32);
+            let group = if layer_no == 0 { 0 } else { chunks.len() };
+            for (c, r) in chunks.iter().enumerate() {
+                if r.is_empty() {
+                    continue;
+                }
+                pass.set_bind_group(
+                    1,
+                    &peel_bg,
+                    &[((group + c) as u64 * self.params_stride) as u32],
+                );
+                pass.draw_indexed(r.start * 3..r.end * 3, 0, 0..1);
+            }
+        }
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.gather_pipeline);
+            pass.set_bind_group(0, &gather_bg, &[]);
+            pass.dispatch_workgroups(self.view.width.div_ceil(8), self.view.height.div_ceil(8), 1);
+        }
+        enc.copy_buffer_to_buffer(&self.out, 0, &self.staging, 0, self.out.size());
+        self.gpu.queue.submit([enc.finish()]);
+        let slice = self.staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        self.gpu
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RecordError::Device(e.to_string()))?;
+        let slots = self.slots();
+        let mut layer = Layer {
+            ids: Vec::with_capacity(slots),
+            alpha: Vec::with_capacity(slots),
+            depth: Vec::with_capacity(slots),
+        };
+        {
+            let data = slice
+                .get_mapped_range()
+                .map_err(|e| RecordError::Device(e.to_string()))?;
+            let words: &[u32] = bytemuck::cast_slice(&data);
+            for s in words.chunks_exact(4) {
+                layer.ids.push(s[0]);
+                layer.alpha.push(f32::from_bits(s[1]));
+                layer.depth.push(f32::from_bits(s[2]));
+            }
+        }
+        self.staging.unmap();
+        Ok(layer)
+    }
+}
