@@ -26,6 +26,7 @@ use trisort_format::{
 use trisort_shaders::gpu::Gpu;
 use trisort_shaders::scene_gpu::View;
 
+use partial::{Graph, Visibility};
 use peeler::Peeler;
 
 /// Errors while recording.
@@ -150,7 +151,7 @@ fn visibility_frame(
     peeler: &Peeler,
     frame: u32,
     s: &RecordSettings,
-) -> Result<(Vec<u32>, u32, bool), RecordError> {
+) -> Result<Visibility, RecordError> {
     let slots = peeler.slots();
     let mut transmittance = vec![1.0f32; slots];
     let mut visible = vec![];
@@ -181,7 +182,7 @@ fn graph_frame(
     frame: u32,
     g: &[u32],
     s: &RecordSettings,
-) -> Result<(Vec<u32>, Vec<Edge>, Vec<Edge>, u32, bool), RecordError> {
+) -> Result<Graph, RecordError> {
     let slots = peeler.slots();
     let mut last_id = vec![0u32; slots];
     let mut last_depth = vec![0f32; slots];
@@ -313,9 +314,8 @@ pub fn record(
 
     if job.phase == Phase::Graphs {
         let total = frames.len() as u32;
-        let mut done_count = 0;
         let mut peeler = None;
-        for rec in frames.iter_mut() {
+        for (k, rec) in frames.iter_mut().enumerate() {
             let f = rec.frame;
             let result = match partial.and_then(|p| p.load_graph(f)) {
                 Some(r) => r,
@@ -336,11 +336,10 @@ pub fn record(
             rec.ties = ties;
             rec.layers[1] = layers;
             rec.truncated |= truncated;
-            done_count += 1;
             progress(Progress {
                 phase: 2,
                 frame: f,
-                done: done_count,
+                done: k as u32 + 1,
                 total,
                 layers,
             });

@@ -237,7 +237,7 @@ impl<'g> Peeler<'g> {
         };
         let slots = view.width as u64 * view.height as u64 * view.samples as u64;
         let out_size = slots * 16;
-        let max_binding = device.limits().max_storage_buffer_binding_size as u64;
+        let max_binding = device.limits().max_storage_buffer_binding_size;
         if out_size > max_binding {
             return Err(RecordError::Unsupported(format!(
                 "{}x{} at {}x needs a {out_size}-byte gather buffer; the device binds at most {max_binding}",
