@@ -1,2 +1,325 @@
-//! The merger: per-frame occlusion graphs into one sorted triangle list and a sliding window.
+//! The merger: per-frame occlusion graphs into one sorted triangle list and a sliding window
+//! of draws per frame (paper 003 §3.2, §4.2, §5; DESIGN § Merger, which corrects the paper).
+//!
+//! Pure CPU: [`Recording`]s in, a [`Baked`] file out. The steps, one file each:
+//!
+//! | step | file |
+//! |---|---|
+//! | input checks, G-local frame graphs | `graph.rs` |
+//! | cycle breaking inside a frame (weighted Eades–Lin–Smyth per SCC) | [`cycles`] |
+//! | strategy order and layouts (cell keys) | [`strategy`] |
+//! | cells, copies, per-cell constraint graphs | `cells.rs` |
+//! | seeding and interval splitting | `split.rs` |
+//! | the paper's diagonal-by-diagonal seeding | `paper.rs` |
+//! | serialization (Kahn levels, vertex-cache order) | `serialize.rs` |
+//! | transitive reduction of final graphs | [`reduction`] |
+//! | index buffer, windows and statistics | `assemble.rs` |
+//! | synthetic recordings for tests and benchmarks | [`synth`] |
+//!
+//! **Rules** (DESIGN § Merger; the `trisort-verify` crate checks them from the two files
+//! alone), for every frame f:
+//! 1. every t ∈ V_f is drawn exactly once, no triangle twice, and every copy spans at least
+//!    one frame where its triangle is visible;
+//! 2. a copy may span a frame where its triangle is not visible only as the bridge policy
+//!    allows ([`Bridge`]);
+//! 3. with E_f* = E_f minus the removed intra-frame cycle edges: if b is reachable from a in
+//!    E_f* through any triangles, drawn or not, and both are drawn, a is drawn before b.
 #![deny(missing_docs)]
+
+mod assemble;
+mod cells;
+pub mod cycles;
+mod graph;
+mod paper;
+pub mod reduction;
+mod serialize;
+mod split;
+pub mod strategy;
+pub mod synth;
+
+use std::ops::Range;
+
+use rayon::prelude::*;
+use trisort_format::{Baked, MatrixCell, Recording};
+
+pub use strategy::{Layout, Strategy};
+
+/// Which strategy to use (paper §5.1), or `Auto` to try all six.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StrategyChoice {
+    /// L, I, B.
+    Lib,
+    /// L, B, I.
+    Lbi,
+    /// I, L, B.
+    Ilb,
+    /// I, B, L.
+    Ibl,
+    /// B, L, I.
+    Bli,
+    /// B, I, L.
+    Bil,
+    /// Every strategy; the best by [`merge`]'s objective.
+    #[default]
+    Auto,
+}
+
+impl StrategyChoice {
+    /// The strategies this choice tries.
+    pub fn strategies(self) -> Vec<Strategy> {
+        match self {
+            StrategyChoice::Lib => vec![Strategy::Lib],
+            StrategyChoice::Lbi => vec![Strategy::Lbi],
+            StrategyChoice::Ilb => vec![Strategy::Ilb],
+            StrategyChoice::Ibl => vec![Strategy::Ibl],
+            StrategyChoice::Bli => vec![Strategy::Bli],
+            StrategyChoice::Bil => vec![Strategy::Bil],
+            StrategyChoice::Auto => Strategy::ALL.to_vec(),
+        }
+    }
+}
+
+/// Which layout to use, or `Auto` to try both.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LayoutChoice {
+    /// The paper's (rows for LIB/BIL, diagonals otherwise).
+    Paper,
+    /// The compact one (≤ max(f+1, F−f) ranges per window).
+    Compact,
+    /// Both; the best by [`merge`]'s objective.
+    #[default]
+    Auto,
+}
+
+impl LayoutChoice {
+    /// The layouts this choice tries.
+    pub fn layouts(self) -> Vec<Layout> {
+        match self {
+            LayoutChoice::Paper => vec![Layout::Paper],
+            LayoutChoice::Compact => vec![Layout::Compact],
+            LayoutChoice::Auto => Layout::ALL.to_vec(),
+        }
+    }
+}
+
+/// Where a copy may span frames in which its triangle is not visible (DESIGN rule 2).
+///
+/// A copy always starts and ends at frames where its triangle is visible; this decides what
+/// the frames between may be.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Bridge {
+    /// Any frame where the triangle is not visible: covered but hidden (t ∈ C_f \ V_f, costs
+    /// fill, and the copy is then ordered there like any drawn triangle), or with no fragment
+    /// at all (t ∉ C_f, the ignore list: drawing it changes nothing).
+    #[default]
+    Hidden,
+    /// Only frames where the triangle has no fragment (t ∉ C_f): drawing it changes nothing
+    /// and costs no fill.
+    Ignored,
+}
+
+impl Bridge {
+    /// Lower-case name (`hidden`, `ignored`), as stored in [`trisort_format::MergeInfo`].
+    pub fn name(self) -> &'static str {
+        match self {
+            Bridge::Hidden => "hidden",
+            Bridge::Ignored => "ignored",
+        }
+    }
+}
+
+/// How the matrix is seeded before interval splitting makes it valid.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Seeding {
+    /// One copy per maximal bridgeable run of a triangle's visible frames (the specification).
+    #[default]
+    Interval,
+    /// The paper's diagonal-by-diagonal merge of adjacent cells (§3.2, Figures 4 and 12),
+    /// with copies trimmed so rule 1 holds; interval splitting then repairs what it misses.
+    Paper,
+}
+
+impl Seeding {
+    /// Lower-case name (`interval`, `paper`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Seeding::Interval => "interval",
+            Seeding::Paper => "paper",
+        }
+    }
+}
+
+/// Merge options (the flags of `trisort merge`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MergeOptions {
+    /// Strategy (default `Auto`).
+    pub strategy: StrategyChoice,
+    /// Layout (default `Auto`).
+    pub layout: LayoutChoice,
+    /// Bridge policy (default `Hidden`).
+    pub bridge: Bridge,
+    /// Keep only tie edges ([`trisort_format::FrameRecord::ties`]); the bake then plays only
+    /// with the depth test.
+    pub depth_only: bool,
+    /// Cut the path into segments of this many frames, each with its own matrix, so draws per
+    /// frame stay bounded on long paths.
+    pub segment: Option<u32>,
+    /// Seeding (default `Interval`).
+    pub seeding: Seeding,
+}
+
+/// Why recordings could not be merged. Variants name the recording (its index in the slice
+/// given to [`merge`]) and, where it applies, the frame and triangle.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    /// No recording was given.
+    #[error("no recording to merge")]
+    NoRecordings,
+    /// A recording holds only phase 1 (visibility).
+    #[error("recording {recording} has no graphs (phase 1 only); record phase 2 first")]
+    NotGraphs {
+        /// Index of the recording.
+        recording: usize,
+    },
+    /// A recording differs from the first in something that must be equal.
+    #[error("recording {recording} differs from recording 0 in its {what}")]
+    Mismatch {
+        /// Index of the recording.
+        recording: usize,
+        /// What differs.
+        what: &'static str,
+    },
+    /// A recording holds no frame.
+    #[error("recording {recording} holds no frame")]
+    NoFrames {
+        /// Index of the recording.
+        recording: usize,
+    },
+    /// The frame ranges do not follow each other.
+    #[error("recording {recording} covers frames {found:?}, but frame {expected} comes next")]
+    NotContiguous {
+        /// Index of the recording.
+        recording: usize,
+        /// The frame that should start it.
+        expected: u32,
+        /// Its range.
+        found: Range<u32>,
+    },
+    /// The recordings end before the path does.
+    #[error("the recordings cover frames 0..{covered} of a {total}-frame path")]
+    MissingFrames {
+        /// Frames covered.
+        covered: u32,
+        /// Frames of the path.
+        total: u32,
+    },
+    /// A frame names a triangle outside G.
+    #[error("recording {recording}, frame {frame}: triangle {triangle} is not in G")]
+    UnknownTriangle {
+        /// Index of the recording.
+        recording: usize,
+        /// Frame.
+        frame: u32,
+        /// Scene triangle id.
+        triangle: u32,
+    },
+    /// A frame record is malformed.
+    #[error("recording {recording}, frame {frame}: {why}")]
+    BadFrame {
+        /// Index of the recording.
+        recording: usize,
+        /// Frame.
+        frame: u32,
+        /// What is wrong.
+        why: String,
+    },
+    /// `segment` is zero.
+    #[error("segment length must be at least one frame")]
+    ZeroSegment,
+}
+
+/// Merges recordings (contiguous frame ranges of one scene and path, any order) into a
+/// [`Baked`] file whose draws satisfy rules 1–3 at every frame.
+///
+/// For every strategy × layout the options allow (in parallel with rayon), each segment is
+/// seeded, split until valid and serialized; the result kept is the best by the objective
+/// (fewest index triangles, then fewest draws in the worst frame, then the first in
+/// [`Strategy::ALL`] × [`Layout::ALL`] order). Output ids are G-local. The result is
+/// deterministic — the same inputs give the same bytes whatever the thread count — so
+/// `stats.seconds` is left 0 (callers measure and report the time).
+///
+/// Errors when the recordings are not frame ranges of one path recorded with graphs (see
+/// [`MergeError`]).
+pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, MergeError> {
+    if opts.segment == Some(0) {
+        return Err(MergeError::ZeroSegment);
+    }
+    let input = graph::check_recordings(recordings)?;
+    let index_of = |r: &Recording| {
+        recordings
+            .iter()
+            .position(|x| std::ptr::eq(x, r))
+            .unwrap_or(0)
+    };
+    let jobs: Vec<(usize, &Recording, &trisort_format::FrameRecord)> = input
+        .recordings
+        .iter()
+        .flat_map(|&r| r.frames.iter().map(move |fr| (index_of(r), r, fr)))
+        .collect();
+    let graphs: Vec<graph::FrameGraph> = jobs
+        .par_iter()
+        .map(|&(k, r, fr)| graph::frame_graph(k, r, fr, opts.depth_only))
+        .collect::<Result<_, _>>()?;
+    let first = input.recordings[0];
+    let g = first.unique_visible.len();
+    let mut visible_frames: Vec<Vec<u32>> = vec![Vec::new(); g];
+    for (f, fg) in graphs.iter().enumerate() {
+        for &t in &fg.visible {
+            visible_frames[t as usize].push(f as u32);
+        }
+    }
+    let cx = split::Context {
+        graphs: &graphs,
+        visible_frames: &visible_frames,
+        bridge: opts.bridge,
+    };
+    let len = opts.segment.unwrap_or(input.frames.max(1));
+    let segments: Vec<Range<u32>> = (0..input.frames)
+        .step_by(len as usize)
+        .map(|s| s..(s + len).min(input.frames))
+        .collect();
+    let combos: Vec<(Strategy, Layout)> = opts
+        .strategy
+        .strategies()
+        .into_iter()
+        .flat_map(|s| opts.layout.layouts().into_iter().map(move |l| (s, l)))
+        .collect();
+    let triangles = &first.geometry.triangles;
+    let results: Vec<assemble::Assembled> = combos
+        .par_iter()
+        .map(|&(s, l)| assemble::build(&cx, &segments, s, l, opts.seeding, triangles))
+        .collect();
+    let best = results
+        .into_iter()
+        .enumerate()
+        .min_by_key(|(k, a)| (a.copies.len(), a.draws_per_frame_max(), *k))
+        .map(|(_, a)| a)
+        .expect("at least one strategy and layout");
+    let recording_hashes: Vec<trisort_format::Hash> = input
+        .recordings
+        .par_iter()
+        .map(|r| r.content_hash())
+        .collect();
+    Ok(best.into_baked(first, recording_hashes, &graphs, opts))
+}
+
+/// The non-empty cells of a baked file's matrix as `(first frame, last frame, triangles)`, in
+/// index-buffer order: the data of `trisort inspect --matrix` (the paper's Figure 14).
+pub fn cell_counts(baked: &Baked) -> Vec<(u32, u32, u32)> {
+    baked
+        .merge
+        .cells
+        .iter()
+        .map(|c: &MatrixCell| (c.first_frame, c.last_frame, c.triangles))
+        .collect()
+}

@@ -1,0 +1,455 @@
+//! Building the matrix of one segment by interval splitting (DESIGN § Merger, "Building the
+//! matrix"): seed each triangle with copies spanning its visible frames (bridged per the
+//! policy), then split until rules 1–3 hold.
+//!
+//! Every round finds, on a snapshot of the copies,
+//! - *inter-cell conflicts*: at frame f, a drawn ancestor x of drawn y in E_f* (through any
+//!   triangles) whose cell comes later in the layout than y's. Found in linear time per frame
+//!   by carrying, in topological order, the latest cell of any drawn ancestor;
+//! - *cell cycles*: cycles in a cell's union-over-frames constraint graph (the camera turned
+//!   around), found by Kahn's algorithm and a walk back through the left-over vertices;
+//!
+//! and then fixes each one whose copies are still untouched this round:
+//! - a conflict (x, y, f) by the cheapest of the splits "cut before f", "cut after f",
+//!   "isolate f" and "drop f" (the last only where the triangle is not visible at f) of x
+//!   and/or y after which f's piece of x lies in an earlier cell than f's piece of y, in the
+//!   same cell (the cell's own order then decides), or f is no longer drawn. Cost = new
+//!   copies; ties keep the longer pieces;
+//! - a cycle by splitting one multi-frame copy on it between the frames that demand its
+//!   incoming and its outgoing edge, in the middle of the gap that separates them.
+//!
+//! Pieces are trimmed to the triangle's visible frames inside them, and a piece with no
+//! visible frame is dropped, so a copy always spans a visible frame and bridging only ever
+//! shrinks. Each fix adds a copy or shortens one; copies are bounded by Σ|V_f|, so the loop
+//! terminates, at worst at one copy per frame on the diagonal, which is always valid. When a
+//! round finds nothing the copies satisfy rules 1–3: with no inter-cell conflict every path
+//! between drawn copies rises in the layout, so the only remaining demands lie inside cells,
+//! and those graphs are acyclic.
+
+use std::ops::Range;
+
+use rayon::prelude::*;
+
+use crate::cells::{cell_edges, CellGraph, CellOrder, Copy, CopyLookup, NONE};
+use crate::cycles::csr;
+use crate::graph::FrameGraph;
+use crate::Bridge;
+
+/// What the splitter works on.
+pub(crate) struct Context<'a> {
+    /// Every frame's graph (global frame index).
+    pub graphs: &'a [FrameGraph],
+    /// Per G-local triangle: the frames where it is visible, ascending.
+    pub visible_frames: &'a [Vec<u32>],
+    /// Bridging policy.
+    pub bridge: Bridge,
+}
+
+impl Context<'_> {
+    /// Whether a copy of `t` may span frame `f` where `t` is not visible.
+    fn bridgeable(&self, t: u32, f: u32) -> bool {
+        match self.bridge {
+            Bridge::Hidden => true,
+            Bridge::Ignored => !self.graphs[f as usize].is_covered(t),
+        }
+    }
+
+    /// The piece `[p, q]` of triangle `t` trimmed to its visible frames, if any.
+    fn trim(&self, t: u32, p: u32, q: u32) -> Option<(u32, u32)> {
+        let vis = &self.visible_frames[t as usize];
+        let a = vis.partition_point(|&f| f < p);
+        let b = vis.partition_point(|&f| f <= q);
+        (a < b).then(|| (vis[a], vis[b - 1]))
+    }
+}
+
+/// Seeds: per triangle, maximal runs of its visible frames inside `seg` whose gaps are
+/// bridgeable. Sorted by (triangle, first frame).
+pub(crate) fn seed_intervals(cx: &Context<'_>, seg: Range<u32>) -> Vec<Copy> {
+    let per_tri: Vec<Vec<Copy>> = (0..cx.visible_frames.len() as u32)
+        .into_par_iter()
+        .map(|t| {
+            let vis = &cx.visible_frames[t as usize];
+            let lo = vis.partition_point(|&f| f < seg.start);
+            let hi = vis.partition_point(|&f| f < seg.end);
+            let mut out = Vec::new();
+            let mut run: Option<(u32, u32)> = None;
+            for &f in &vis[lo..hi] {
+                run = match run {
+                    Some((a, b)) if (b + 1..f).all(|g| cx.bridgeable(t, g)) => Some((a, f)),
+                    Some((a, b)) => {
+                        out.push(Copy {
+                            t,
+                            first: a,
+                            last: b,
+                        });
+                        Some((f, f))
+                    }
+                    None => Some((f, f)),
+                };
+            }
+            if let Some((a, b)) = run {
+                out.push(Copy {
+                    t,
+                    first: a,
+                    last: b,
+                });
+            }
+            out
+        })
+        .collect();
+    per_tri.into_iter().flatten().collect()
+}
+
+/// The split copies of one segment.
+pub(crate) struct Splitting {
+    /// Final copies (rules 1–3 hold for them with the segment's cell order).
+    pub copies: Vec<Copy>,
+}
+
+/// Splits `copies` (of segment `seg`, ordered by `order`) until no conflict and no cell cycle
+/// is left. See the module documentation for the policy.
+pub(crate) fn split_until_valid(
+    cx: &Context<'_>,
+    seg: Range<u32>,
+    order: CellOrder,
+    mut copies: Vec<Copy>,
+) -> Splitting {
+    loop {
+        let lookup = CopyLookup::new(&copies);
+        let conflicts = find_conflicts(cx, seg.clone(), order, &copies, &lookup);
+        let cycles = find_cell_cycles(cx, seg.clone(), &copies, &lookup);
+        if conflicts.is_empty() && cycles.is_empty() {
+            return Splitting { copies };
+        }
+        let mut touched = vec![false; copies.len()];
+        let mut plans: Vec<(u32, Vec<(u32, u32)>)> = Vec::new();
+        // Group the conflicts by pair: one fix considers every frame where the pair conflicts.
+        let mut pairs: Vec<(u32, u32, u32)> =
+            conflicts.iter().map(|&(f, x, y)| (x, y, f)).collect();
+        pairs.sort_unstable();
+        let mut groups: Vec<&[(u32, u32, u32)]> =
+            pairs.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)).collect();
+        groups.sort_by_key(|g| (g[0].2, g[0].0, g[0].1));
+        for g in groups {
+            let (x, y) = (g[0].0, g[0].1);
+            if touched[x as usize] || touched[y as usize] {
+                continue;
+            }
+            let frames: Vec<u32> = g.iter().map(|e| e.2).collect();
+            let (px, py) = fix_conflict(cx, order, copies[x as usize], copies[y as usize], &frames);
+            touched[x as usize] = true;
+            touched[y as usize] = true;
+            plans.push((x, px));
+            plans.push((y, py));
+        }
+        for &(x, m) in &cycles {
+            if touched[x as usize] {
+                continue;
+            }
+            touched[x as usize] = true;
+            let c = copies[x as usize];
+            let pieces = [cx.trim(c.t, c.first, m), cx.trim(c.t, m + 1, c.last)];
+            plans.push((x, pieces.into_iter().flatten().collect()));
+        }
+        for (x, pieces) in plans {
+            let t = copies[x as usize].t;
+            debug_assert!(!pieces.is_empty(), "a split keeps the visible frames");
+            for (k, &(a, b)) in pieces.iter().enumerate() {
+                let c = Copy {
+                    t,
+                    first: a,
+                    last: b,
+                };
+                if k == 0 {
+                    copies[x as usize] = c;
+                } else {
+                    copies.push(c);
+                }
+            }
+        }
+    }
+}
+
+/// Inter-cell conflicts of every frame of the segment: `(f, x, y)` with x the drawn ancestor
+/// of drawn y whose cell is latest in the layout, later than y's. Ordered by frame, then by
+/// y's position in the topological order.
+fn find_conflicts(
+    cx: &Context<'_>,
+    seg: Range<u32>,
+    order: CellOrder,
+    copies: &[Copy],
+    lookup: &CopyLookup,
+) -> Vec<(u32, u32, u32)> {
+    let per_frame: Vec<Vec<(u32, u32, u32)>> = seg
+        .into_par_iter()
+        .map(|f| {
+            let fg = &cx.graphs[f as usize];
+            let n = fg.nodes.len();
+            // (key + 1, copy) of the latest drawn ancestor; 0 = none.
+            let mut best = vec![(0u64, NONE); n];
+            let mut out = Vec::new();
+            for &v in &fg.topo {
+                let v = v as usize;
+                let k = lookup.at(copies, fg.nodes[v], f);
+                let mut carry = best[v];
+                if k != NONE {
+                    let c = copies[k as usize];
+                    let key = order.key(c.first, c.last) + 1;
+                    if best[v].0 > key {
+                        out.push((f, best[v].1, k));
+                    }
+                    carry = carry.max((key, k));
+                }
+                for &w in fg.successors(v as u32) {
+                    let b = &mut best[w as usize];
+                    *b = (*b).max(carry);
+                }
+            }
+            out
+        })
+        .collect();
+    per_frame.into_iter().flatten().collect()
+}
+
+/// The pieces the splits of copy `c` considered for a conflict at frames `lo..=hi` can leave,
+/// each trimmed: keep; cut before lo; cut after hi; both (isolating lo..=hi); cut after lo;
+/// isolate lo; and, where `c.t` is not visible there, drop lo..=hi or drop lo.
+fn split_options(cx: &Context<'_>, c: Copy, lo: u32, hi: u32) -> Vec<Vec<(u32, u32)>> {
+    let trim = |p: u32, q: u32| if p > q { None } else { cx.trim(c.t, p, q) };
+    let (a, b) = (c.first, c.last);
+    let pieces = |cuts: &[(u32, u32)]| -> Vec<(u32, u32)> {
+        cuts.iter().filter_map(|&(p, q)| trim(p, q)).collect()
+    };
+    let mut options = vec![vec![(a, b)]];
+    if lo > a {
+        options.push(pieces(&[(a, lo - 1), (lo, b)]));
+    }
+    if hi < b {
+        options.push(pieces(&[(a, hi), (hi + 1, b)]));
+    }
+    if lo > a && hi < b {
+        options.push(pieces(&[(a, lo - 1), (lo, hi), (hi + 1, b)]));
+    }
+    if lo < hi {
+        options.push(pieces(&[(a, lo), (lo + 1, b)]));
+        if lo > a {
+            options.push(pieces(&[(a, lo - 1), (lo, lo), (lo + 1, b)]));
+        }
+    }
+    let invisible = |p: u32, q: u32| cx.trim(c.t, p, q).is_none();
+    if invisible(lo, hi) {
+        let mut v: Vec<(u32, u32)> = if lo > a {
+            trim(a, lo - 1).into_iter().collect()
+        } else {
+            Vec::new()
+        };
+        v.extend(trim(hi + 1, b));
+        options.push(v);
+    }
+    if lo < hi && invisible(lo, lo) {
+        let mut v: Vec<(u32, u32)> = if lo > a {
+            trim(a, lo - 1).into_iter().collect()
+        } else {
+            Vec::new()
+        };
+        v.extend(trim(lo + 1, b));
+        options.push(v);
+    }
+    options.dedup();
+    options
+}
+
+/// The best pair of splits of x and y for a conflict at `frames` (ascending; x must be drawn
+/// before y at each): fewest frames left in conflict, then fewest copies, then the longest
+/// pieces. Always fixes at least the first frame (isolating it in both copies puts them in
+/// the same cell).
+fn fix_conflict(
+    cx: &Context<'_>,
+    order: CellOrder,
+    x: Copy,
+    y: Copy,
+    frames: &[u32],
+) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
+    let (lo, hi) = (frames[0], *frames.last().expect("a conflict has a frame"));
+    let at =
+        |pieces: &[(u32, u32)], f: u32| pieces.iter().copied().find(|&(a, b)| a <= f && f <= b);
+    let fixed = |px: &[(u32, u32)], py: &[(u32, u32)], f: u32| match (at(px, f), at(py, f)) {
+        (Some(p), Some(q)) => p == q || order.key(p.0, p.1) < order.key(q.0, q.1),
+        _ => true,
+    };
+    let xs = split_options(cx, x, lo, hi);
+    let ys = split_options(cx, y, lo, hi);
+    type Score = (usize, usize, std::cmp::Reverse<u32>);
+    let mut best: Option<(Score, usize, usize)> = None;
+    for (a, px) in xs.iter().enumerate() {
+        for (b, py) in ys.iter().enumerate() {
+            if !fixed(px, py, lo) {
+                continue;
+            }
+            let unfixed = frames.iter().filter(|&&f| !fixed(px, py, f)).count();
+            let span: u32 = [at(px, lo), at(py, lo)]
+                .into_iter()
+                .flatten()
+                .map(|(p, q)| q - p)
+                .sum();
+            let score = (unfixed, px.len() + py.len(), std::cmp::Reverse(span));
+            if best.as_ref().is_none_or(|b| score < b.0) {
+                best = Some((score, a, b));
+            }
+        }
+    }
+    let (_, a, b) = best.expect("isolating a frame in both copies always orders them");
+    (xs[a].clone(), ys[b].clone())
+}
+
+/// Cycles in the union-over-frames constraint graphs of the multi-frame cells: one split
+/// `(copy, m)` (pieces `first..=m` and `m+1..=last`) per vertex-disjoint cycle found.
+fn find_cell_cycles(
+    cx: &Context<'_>,
+    seg: Range<u32>,
+    copies: &[Copy],
+    lookup: &CopyLookup,
+) -> Vec<(u32, u32)> {
+    // Tracked cells: multi-frame cells with at least two copies.
+    let mut cells: Vec<(u32, u32, u32)> = copies
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.first < c.last)
+        .map(|(k, c)| (c.first, c.last, k as u32))
+        .collect();
+    cells.sort_unstable();
+    let mut cell_of = vec![NONE; copies.len()];
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    for g in cells.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)) {
+        if g.len() >= 2 {
+            for &(_, _, k) in g {
+                cell_of[k as usize] = members.len() as u32;
+            }
+            members.push(g.iter().map(|x| x.2).collect());
+        }
+    }
+    if members.is_empty() {
+        return Vec::new();
+    }
+    let edges = cell_edges(cx.graphs, seg, copies, lookup, &cell_of);
+    let groups: Vec<&[crate::cells::CellEdge]> = edges.chunk_by(|a, b| a.cell == b.cell).collect();
+    let per_cell: Vec<Vec<(u32, u32)>> = groups
+        .par_iter()
+        .map(|g| {
+            let graph = CellGraph::new(g, &members[g[0].cell as usize]);
+            cycle_splits(&graph, copies)
+        })
+        .collect();
+    per_cell.into_iter().flatten().collect()
+}
+
+/// Vertex-disjoint cycles of one cell graph and the split that breaks each.
+fn cycle_splits(g: &CellGraph, copies: &[Copy]) -> Vec<(u32, u32)> {
+    let n = g.nodes.len();
+    let (off, succ) = csr(n, g.edges.iter().copied());
+    let mut indeg = vec![0u32; n];
+    for &(_, b) in &g.edges {
+        indeg[b as usize] += 1;
+    }
+    let mut stack: Vec<u32> = (0..n as u32).filter(|&v| indeg[v as usize] == 0).collect();
+    let mut done = vec![false; n];
+    while let Some(v) = stack.pop() {
+        done[v as usize] = true;
+        for &w in &succ[off[v as usize] as usize..off[v as usize + 1] as usize] {
+            indeg[w as usize] -= 1;
+            if indeg[w as usize] == 0 {
+                stack.push(w);
+            }
+        }
+    }
+    if done.iter().all(|&d| d) {
+        return Vec::new();
+    }
+    // Incoming edges per vertex (edge ids), to walk back through left-over vertices.
+    let (in_off, in_e) = csr(
+        n,
+        g.edges.iter().enumerate().map(|(e, &(_, b))| (b, e as u32)),
+    );
+    let mut used = vec![false; n];
+    let mut out = Vec::new();
+    let mut on_walk = vec![NONE; n];
+    for start in 0..n {
+        if done[start] || used[start] {
+            continue;
+        }
+        // Walk predecessors until a vertex repeats; record the edge taken into each vertex.
+        let mut walk: Vec<(u32, u32)> = Vec::new(); // (vertex, edge into it from the next)
+        let mut v = start as u32;
+        let cycle_from = loop {
+            if on_walk[v as usize] != NONE {
+                break Some(on_walk[v as usize] as usize);
+            }
+            let pred = in_e[in_off[v as usize] as usize..in_off[v as usize + 1] as usize]
+                .iter()
+                .copied()
+                .find(|&e| {
+                    let a = g.edges[e as usize].0 as usize;
+                    !done[a] && !used[a]
+                });
+            let Some(e) = pred else { break None };
+            on_walk[v as usize] = walk.len() as u32;
+            walk.push((v, e));
+            v = g.edges[e as usize].0;
+        };
+        for &(w, _) in &walk {
+            on_walk[w as usize] = NONE;
+            used[w as usize] = true;
+        }
+        let Some(from) = cycle_from else { continue };
+        // walk[from..] is the cycle, backwards: walk[k].1 enters walk[k].0 from walk[k+1].0.
+        let cyc = &walk[from..];
+        let len = cyc.len();
+        // For the vertex cyc[k]: its incoming edge is cyc[k].1, its outgoing edge is the one
+        // entering cyc[k-1] (cyclically).
+        let mut chosen: Option<(u32, u32)> = None;
+        let mut fallback: Option<(u32, u32)> = None;
+        let mut longest: Option<(u32, u32, u32)> = None;
+        for k in 0..len {
+            let Some(copy) = g.nodes[cyc[k].0 as usize].as_copy() else {
+                continue;
+            };
+            let c = copies[copy as usize];
+            if c.first == c.last {
+                continue;
+            }
+            let s_in = &g.frames[cyc[k].1 as usize];
+            let s_out = &g.frames[cyc[(k + len - 1) % len].1 as usize];
+            let (in_lo, in_hi) = (s_in[0], *s_in.last().expect("an edge has a frame"));
+            let (out_lo, out_hi) = (s_out[0], *s_out.last().expect("an edge has a frame"));
+            let gap = if in_hi < out_lo {
+                Some((in_hi, out_lo))
+            } else if out_hi < in_lo {
+                Some((out_hi, in_lo))
+            } else {
+                None
+            };
+            if let Some((lo, hi)) = gap {
+                chosen = Some((copy, lo + (hi - lo - 1) / 2));
+                break;
+            }
+            if fallback.is_none() {
+                let a = s_in.iter().find(|f| s_out.binary_search(f).is_err());
+                let b = s_out.iter().find(|f| s_in.binary_search(f).is_err());
+                if let (Some(&a), Some(&b)) = (a, b) {
+                    let (lo, hi) = (a.min(b), a.max(b));
+                    fallback = Some((copy, lo + (hi - lo - 1) / 2));
+                }
+            }
+            let span = c.last - c.first;
+            if longest.is_none_or(|l| span > l.2) {
+                longest = Some((copy, c.first + (span - 1) / 2, span));
+            }
+        }
+        let split = chosen.or(fallback).or(longest.map(|l| (l.0, l.1)));
+        if let Some(s) = split {
+            out.push(s);
+        }
+    }
+    out
+}

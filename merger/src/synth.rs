@@ -1,0 +1,328 @@
+//! Synthetic recordings, for tests and benchmarks only (no GPU, no scene file).
+//!
+//! [`recording_from_frames`] turns hand-written per-frame sets and edges into a valid
+//! [`Recording`]; [`turntable`] simulates the recorder on a one-dimensional scene seen by a
+//! camera orbiting it, with opaque and transparent triangles, hidden and never-covered
+//! triangles, interpenetrating (tilted) triangles that make intra-frame cycles, and order
+//! inversions as the camera turns; [`split_frames`] cuts a recording into frame ranges, as
+//! `record --frames a..b` on several machines would.
+
+use trisort_format::{
+    Camera, DeviceInfo, Edge, FrameRecord, FrameState, Geometry, Material, Node, Phase,
+    RecordSettings, Recording, Vertex,
+};
+
+/// One frame of a hand-written recording, in scene ids.
+#[derive(Clone, Debug, Default)]
+pub struct FrameSpec {
+    /// V_f.
+    pub visible: Vec<u32>,
+    /// Triangles covered but hidden (C_f \ V_f).
+    pub hidden: Vec<u32>,
+    /// E_f as `(front, back, weight)`.
+    pub edges: Vec<(u32, u32, u32)>,
+    /// Tie edges (a subset of `edges`, for depth-only bakes).
+    pub ties: Vec<(u32, u32, u32)>,
+}
+
+/// Builds a Phase-2 recording of `scene_triangles` triangles from per-frame specs: G is the
+/// union of the visible sets; hidden triangles and edge endpoints outside G are dropped (the
+/// recorder's phase 2 peels only G). Sets are sorted and deduplicated. Geometry: one
+/// triangle strip over G (triangle k uses vertices k, k+1, k+2), one material, one node.
+pub fn recording_from_frames(scene_triangles: u32, frames: &[FrameSpec]) -> Recording {
+    let mut g: Vec<u32> = frames
+        .iter()
+        .flat_map(|f| f.visible.iter().copied())
+        .collect();
+    g.sort_unstable();
+    g.dedup();
+    let in_g = |t: &u32| g.binary_search(t).is_ok();
+    let edges = |list: &[(u32, u32, u32)]| {
+        let mut e: Vec<Edge> = list
+            .iter()
+            .filter(|(a, b, _)| in_g(a) && in_g(b))
+            .map(|&(from, to, weight)| Edge { from, to, weight })
+            .collect();
+        e.sort_unstable();
+        e.dedup_by_key(|e| (e.from, e.to));
+        e
+    };
+    let records: Vec<FrameRecord> = frames
+        .iter()
+        .enumerate()
+        .map(|(f, s)| {
+            let mut visible = s.visible.clone();
+            visible.sort_unstable();
+            visible.dedup();
+            let edges_f = edges(&s.edges);
+            let mut covered: Vec<u32> = visible
+                .iter()
+                .chain(&s.hidden)
+                .copied()
+                .filter(in_g)
+                .collect();
+            covered.extend(edges_f.iter().flat_map(|e| [e.from, e.to]));
+            covered.sort_unstable();
+            covered.dedup();
+            FrameRecord {
+                frame: f as u32,
+                visible,
+                covered,
+                edges: edges_f,
+                ties: edges(&s.ties),
+                layers: [1, 1],
+                truncated: false,
+            }
+        })
+        .collect();
+    let n = g.len() as u32;
+    let vertices: Vec<Vertex> = (0..n + 2)
+        .map(|k| Vertex {
+            position: [k as f32 * 0.5, (k % 2) as f32, 0.0],
+            normal: [0.0, 0.0, 1.0],
+            uv: [0.0; 2],
+            material: 0,
+            node: 0,
+        })
+        .collect();
+    let geometry = Geometry {
+        vertices,
+        triangles: (0..n).map(|k| [k, k + 1, k + 2]).collect(),
+        materials: vec![Material::default()],
+        textures: vec![],
+        nodes: vec![Node {
+            name: "root".into(),
+            parent: None,
+            rest: identity(),
+        }],
+    };
+    let frame_states = (0..frames.len())
+        .map(|_| FrameState {
+            camera: Camera {
+                view: identity(),
+                yfov: 1.0,
+                znear: 0.1,
+                zfar: None,
+            },
+            poses: vec![],
+        })
+        .collect();
+    let mut id = Vec::new();
+    id.extend_from_slice(&scene_triangles.to_le_bytes());
+    id.extend_from_slice(&(frames.len() as u32).to_le_bytes());
+    Recording {
+        tool_version: trisort_format::TOOL_VERSION.into(),
+        scene_hash: trisort_format::hash_bytes(&id),
+        path_hash: trisort_format::hash_bytes(b"synthetic path"),
+        settings: RecordSettings {
+            width: 1,
+            height: 1,
+            samples: 1,
+            ..RecordSettings::default()
+        },
+        device: DeviceInfo {
+            adapter: "synthetic".into(),
+            driver: String::new(),
+            backend: String::new(),
+        },
+        phase: Phase::Graphs,
+        scene_triangles,
+        frame_states,
+        frames: records,
+        unique_visible: g,
+        geometry,
+    }
+}
+
+fn identity() -> [f64; 16] {
+    let mut m = [0.0; 16];
+    for k in 0..4 {
+        m[k * 5] = 1.0;
+    }
+    m
+}
+
+/// Parameters of [`turntable`].
+#[derive(Clone, Copy, Debug)]
+pub struct Turntable {
+    /// Scene triangles.
+    pub triangles: u32,
+    /// Frames of the path.
+    pub frames: u32,
+    /// Samples across the one-dimensional image.
+    pub samples: u32,
+    /// Total camera turn in degrees over the path.
+    pub degrees: f64,
+    /// Fraction of transparent triangles (opacity 0.5); the rest are opaque.
+    pub transparent: f64,
+    /// Largest depth slope across a triangle (interpenetration makes intra-frame cycles).
+    pub tilt: f64,
+    /// Random seed.
+    pub seed: u64,
+}
+
+impl Default for Turntable {
+    fn default() -> Self {
+        Turntable {
+            triangles: 300,
+            frames: 24,
+            samples: 256,
+            degrees: 90.0,
+            transparent: 0.3,
+            tilt: 0.3,
+            seed: 1,
+        }
+    }
+}
+
+/// A deterministic pseudo-random generator (SplitMix64).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Simulates the recorder on a turntable: triangles are short segments on a disc, the camera
+/// orbits it at distance 3 looking at the centre, and each of `samples` samples across the
+/// image peels the triangles covering it by (depth, id). V_f: triangles reached before the
+/// sample's opacity saturates (0.998); C_f: every triangle of G covering a sample; E_f:
+/// neighbours in the peel of G, weighted by samples. Deterministic in its parameters.
+pub fn turntable(p: &Turntable) -> Recording {
+    struct Tri {
+        radius: f64,
+        angle: f64,
+        half: f64,
+        tilt: f64,
+        opacity: f64,
+    }
+    let mut rng = Rng(p.seed);
+    let tris: Vec<Tri> = (0..p.triangles)
+        .map(|_| Tri {
+            radius: 0.1 + 0.9 * rng.unit().sqrt(),
+            angle: rng.unit() * std::f64::consts::TAU,
+            half: 0.01 + 0.08 * rng.unit(),
+            tilt: p.tilt * (2.0 * rng.unit() - 1.0),
+            opacity: if rng.unit() < p.transparent { 0.5 } else { 1.0 },
+        })
+        .collect();
+    let focal = 2.2;
+    // Per frame and sample: the peel (depth, id) of the covering triangles.
+    let peel = |f: u32| -> Vec<Vec<u32>> {
+        let theta = (p.degrees * f as f64 / p.frames.max(2).saturating_sub(1) as f64).to_radians();
+        let mut per_sample: Vec<Vec<(f64, u32)>> = vec![Vec::new(); p.samples as usize];
+        for (t, tr) in tris.iter().enumerate() {
+            let phi = tr.angle - theta;
+            let x = tr.radius * phi.sin();
+            let z = 3.0 - tr.radius * phi.cos();
+            let u = focal * x / z;
+            let hw = focal * tr.half / z;
+            let s_of = |u: f64| (u + 1.0) / 2.0 * p.samples as f64 - 0.5;
+            let lo = s_of(u - hw).ceil().max(0.0) as i64;
+            let hi = s_of(u + hw).floor().min(p.samples as f64 - 1.0) as i64;
+            for s in lo..=hi {
+                let us = (s as f64 + 0.5) / p.samples as f64 * 2.0 - 1.0;
+                let depth = z + tr.tilt * (us - u) * z / focal;
+                per_sample[s as usize].push((depth, t as u32));
+            }
+        }
+        per_sample
+            .into_iter()
+            .map(|mut v| {
+                v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                v.into_iter().map(|(_, t)| t).collect()
+            })
+            .collect()
+    };
+    let peels: Vec<Vec<Vec<u32>>> = (0..p.frames).map(peel).collect();
+    let visible_of = |samples: &Vec<Vec<u32>>| {
+        let mut vis = Vec::new();
+        for order in samples {
+            let mut transmit = 1.0;
+            for &t in order {
+                if 1.0 - transmit >= 0.998 {
+                    break;
+                }
+                vis.push(t);
+                transmit *= 1.0 - tris[t as usize].opacity;
+            }
+        }
+        vis.sort_unstable();
+        vis.dedup();
+        vis
+    };
+    let visible: Vec<Vec<u32>> = peels.iter().map(visible_of).collect();
+    let mut g: Vec<u32> = visible.iter().flatten().copied().collect();
+    g.sort_unstable();
+    g.dedup();
+    let specs: Vec<FrameSpec> = peels
+        .iter()
+        .zip(&visible)
+        .map(|(samples, vis)| {
+            let mut counts: std::collections::BTreeMap<(u32, u32), u32> = Default::default();
+            let mut covered = Vec::new();
+            for order in samples {
+                let in_g: Vec<u32> = order
+                    .iter()
+                    .copied()
+                    .filter(|t| g.binary_search(t).is_ok())
+                    .collect();
+                covered.extend_from_slice(&in_g);
+                for w in in_g.windows(2) {
+                    *counts.entry((w[0], w[1])).or_default() += 1;
+                }
+            }
+            covered.sort_unstable();
+            covered.dedup();
+            let hidden = covered
+                .into_iter()
+                .filter(|t| vis.binary_search(t).is_err())
+                .collect();
+            FrameSpec {
+                visible: vis.clone(),
+                hidden,
+                edges: counts.into_iter().map(|((a, b), w)| (a, b, w)).collect(),
+                ties: vec![],
+            }
+        })
+        .collect();
+    let mut rec = recording_from_frames(p.triangles, &specs);
+    let mut id = Vec::new();
+    for x in [
+        p.triangles as u64,
+        p.frames as u64,
+        p.samples as u64,
+        p.seed,
+        p.degrees.to_bits(),
+        p.tilt.to_bits(),
+    ] {
+        id.extend_from_slice(&x.to_le_bytes());
+    }
+    rec.scene_hash = trisort_format::hash_bytes(&id);
+    rec
+}
+
+/// Cuts a recording into frame ranges starting at each of `starts` (ascending, first 0), as
+/// separate recordings of the same path would be.
+pub fn split_frames(rec: &Recording, starts: &[u32]) -> Vec<Recording> {
+    let n = rec.frames.len() as u32;
+    starts
+        .iter()
+        .enumerate()
+        .map(|(k, &a)| {
+            let b = starts.get(k + 1).copied().unwrap_or(n);
+            let mut r = rec.clone();
+            r.frames = rec.frames[a as usize..b as usize].to_vec();
+            r
+        })
+        .collect()
+}
