@@ -95,6 +95,25 @@ pub fn load_slice(bytes: &[u8], file: &Path) -> Result<Scene, SceneError> {
         file: file.to_path_buf(),
         problem: format!("invalid JSON: {e}"),
     })?;
+    // gltf-json's validation indexes the POSITION accessor before checking that it exists
+    // (gltf-json 1.4.1, mesh.rs); check it first so a dangling index is an error, not a panic.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    return Err(SceneError::Malformed {
+                        file: file.to_path_buf(),
+                        problem: format!(
+                            "mesh {m} primitive {p}: attribute {semantic:?} names accessor {}, \
+                             the file has {}",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    });
+                }
+            }
+        }
+    }
     let doc = gltf::Document::from_json(root).map_err(|e| SceneError::Malformed {
         file: file.to_path_buf(),
         problem: e.to_string(),
@@ -595,7 +614,7 @@ impl<'d> Importer<'d> {
         }
         if let Some(n) = (0..file_nodes.len()).find(|&n| new_index[n] == u32::MAX) {
             return Err(self.malformed(format!(
-                "{} is part of a cycle in the node hierarchy",
+                "{} cannot be reached from any root: the node hierarchy has a cycle",
                 node_label(&file_nodes[n])
             )));
         }
@@ -851,21 +870,35 @@ impl<'d> Importer<'d> {
 
     /// Loads and decodes an image to RGBA8.
     fn decode_image(&self, image: &gltf::Image) -> Result<Texture, SceneError> {
-        let (bytes, uri): (Cow<[u8]>, Option<&str>) = match image.source() {
-            gltf::image::Source::View { view, .. } => (
-                Cow::Borrowed(
-                    self.view_bytes(&view)
-                        .map_err(|p| self.image_error(image, "", p))?,
-                ),
-                None,
-            ),
-            gltf::image::Source::Uri { uri, .. } => (
+        // Read the JSON directly: `gltf::Image::source` unwraps a missing mimeType or URI.
+        let json = &self.doc.as_json().images[image.index()];
+        let (bytes, uri): (Cow<[u8]>, Option<&str>) = match (&json.buffer_view, &json.uri) {
+            (Some(view), _) => {
+                let view = self.doc.views().nth(view.value()).ok_or_else(|| {
+                    self.image_error(image, "", "dangling buffer view".to_string())
+                })?;
+                (
+                    Cow::Borrowed(
+                        self.view_bytes(&view)
+                            .map_err(|p| self.image_error(image, "", p))?,
+                    ),
+                    None,
+                )
+            }
+            (None, Some(uri)) => (
                 Cow::Owned(
                     read_uri(uri, self.base.as_deref())
                         .map_err(|p| self.image_error(image, uri, p))?,
                 ),
-                Some(uri),
+                Some(uri.as_str()),
             ),
+            (None, None) => {
+                return Err(self.image_error(
+                    image,
+                    "",
+                    "has neither a URI nor a buffer view".to_string(),
+                ))
+            }
         };
         let name = image
             .name()
@@ -1122,19 +1155,31 @@ impl<'d> Importer<'d> {
             let Some(camera) = node.camera().filter(|_| in_scene[n]) else {
                 continue;
             };
-            match camera.projection() {
-                gltf::camera::Projection::Perspective(p) => cameras.push(SceneCamera {
+            // Read the JSON directly: `gltf::Camera::projection` unwraps a missing
+            // perspective object when the type says perspective.
+            let json = &self.doc.as_json().cameras[camera.index()];
+            let perspective = matches!(
+                json.type_,
+                gltf::json::validation::Checked::Valid(gltf::json::camera::Type::Perspective)
+            );
+            match json.perspective.as_ref().filter(|_| perspective) {
+                Some(p) => cameras.push(SceneCamera {
                     name: camera.name().unwrap_or("").to_string(),
                     node: new as u32,
-                    yfov: f64::from(p.yfov()),
-                    znear: f64::from(p.znear()),
-                    zfar: p.zfar().map(f64::from),
-                    aspect: p.aspect_ratio().map(f64::from),
+                    yfov: f64::from(p.yfov),
+                    znear: f64::from(p.znear),
+                    zfar: p.zfar.map(f64::from),
+                    aspect: p.aspect_ratio.map(f64::from),
                 }),
-                gltf::camera::Projection::Orthographic(_) => self.notes.push(format!(
-                    "skipped orthographic {} on {}",
+                None => self.notes.push(format!(
+                    "skipped {} on {}: {}",
                     label("camera", camera.index(), camera.name()),
-                    node_label(node)
+                    node_label(node),
+                    if perspective {
+                        "no perspective parameters"
+                    } else {
+                        "orthographic cameras are not supported"
+                    }
                 )),
             }
         }
