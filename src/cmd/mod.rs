@@ -1,0 +1,217 @@
+//! The subcommands (DESIGN.md § CLI contract).
+
+mod inspect;
+mod record;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{bail, Result};
+use clap::{Args, Parser, Subcommand};
+
+use crate::common::{parse_range, parse_size, FrameRange};
+
+/// trisort: bake fixed camera paths into one depth-sorted index buffer with a sliding window
+/// per frame, and play, verify and measure the result.
+#[derive(Parser, Debug)]
+#[command(name = "trisort", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Summarise a scene (.glb/.gltf), a recording or a baked file.
+    Inspect(inspect::InspectArgs),
+    /// Record a path over a scene: per-frame visible sets and occlusion graphs (GPU).
+    Record(record::RecordArgs),
+    /// Merge recordings into a baked file (sorted index buffer + sliding windows).
+    Merge(MergeArgs),
+    /// Record and merge in one go.
+    Bake(BakeArgs),
+    /// Play a baked file headless to PNG frames (or in a window).
+    Play(PlayArgs),
+    /// Check a baked file: graph rules against its recording, images against the exact reference.
+    Verify(VerifyArgs),
+    /// Measure frame times and accuracy of the merged player against its rivals.
+    Bench(BenchArgs),
+    /// Bake and play the built-in procedural car and print its figures.
+    Demo(DemoArgs),
+}
+
+/// Recording options shared by `record` and `bake`.
+#[derive(Args, Debug, Clone)]
+pub struct RecordOpts {
+    /// Recording size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// MSAA samples (1 or 4).
+    #[arg(long, default_value_t = 4)]
+    pub samples: u32,
+    /// Accumulated opacity at which a sample counts as saturated.
+    #[arg(long, default_value_t = 0.998)]
+    pub saturation: f32,
+    /// Opacity at which transmissive glass is recorded.
+    #[arg(long, default_value_t = 0.0)]
+    pub glass_opacity: f32,
+    /// Safety bound on peel layers per frame (a frame hitting it is marked truncated).
+    #[arg(long, default_value_t = 256)]
+    pub max_layers: u32,
+    /// Frames to record, half-open `a..b` (default: all).
+    #[arg(long, value_parser = parse_range)]
+    pub frames: Option<FrameRange>,
+    /// Sampling rate for `--path gltf` and generated paths.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+}
+
+impl RecordOpts {
+    /// The settings stored in the recording.
+    pub fn settings(&self) -> trisort_format::RecordSettings {
+        trisort_format::RecordSettings {
+            width: self.size.0,
+            height: self.size.1,
+            samples: self.samples,
+            saturation: self.saturation,
+            glass_opacity: self.glass_opacity,
+            max_layers: self.max_layers,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+struct MergeArgs {
+    /// Recordings (frame ranges of one scene and path).
+    #[arg(required = true)]
+    recordings: Vec<PathBuf>,
+    /// Output baked file.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Print the figures as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args, Debug)]
+struct BakeArgs {
+    /// Scene (.glb/.gltf, or `demo[:TRIANGLES]`).
+    scene: String,
+    /// Path: TOML file, `gltf`, `orbit:…`, `dolly:…` or `demo`.
+    #[arg(long)]
+    path: String,
+    /// Output baked file.
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    record: RecordOpts,
+    /// Print the figures as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args, Debug)]
+struct PlayArgs {
+    /// Baked file.
+    baked: PathBuf,
+    /// Frames to play, `a..b`.
+    #[arg(long, value_parser = parse_range)]
+    frames: Option<FrameRange>,
+    /// Where to write PNG frames.
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
+    /// Playback size (default: the recorded size).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// MSAA samples (default: the recorded count).
+    #[arg(long)]
+    samples: Option<u32>,
+    /// blend, depth or saturate.
+    #[arg(long, default_value = "blend")]
+    mode: String,
+    /// Glass opacity (default: the recorded one).
+    #[arg(long)]
+    glass_opacity: Option<f32>,
+    /// Open a window.
+    #[arg(long)]
+    window: bool,
+    /// Print per-frame figures as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args, Debug)]
+struct VerifyArgs {
+    /// Baked file.
+    baked: PathBuf,
+    /// Recording(s) to check the graph rules against.
+    #[arg(long, num_args = 1..)]
+    recording: Vec<PathBuf>,
+    /// Scene to check the images against.
+    #[arg(long)]
+    scene: Option<String>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// Scene.
+    scene: String,
+    /// Path.
+    #[arg(long)]
+    path: String,
+}
+
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Where to write frames and files.
+    #[arg(long, default_value = "demo-out")]
+    pub out_dir: PathBuf,
+    /// Triangles of the procedural car (about 10 000 to 5 000 000).
+    #[arg(long)]
+    pub triangles: Option<u32>,
+    /// Also write the car as glTF to this file.
+    #[arg(long)]
+    pub export_scene: Option<PathBuf>,
+}
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Inspect(a) => inspect::run(a),
+        Command::Record(a) => record::run(a),
+        Command::Merge(_) => not_built("merge", 4),
+        Command::Bake(_) => not_built("bake", 5),
+        Command::Play(_) => not_built("play", 5),
+        Command::Verify(_) => not_built("verify", 6),
+        Command::Bench(_) => not_built("bench", 7),
+        Command::Demo(a) => demo(a),
+    }
+}
+
+fn not_built(name: &str, issue: u32) -> Result<ExitCode> {
+    bail!("`trisort {name}` is not built yet (issue {issue})")
+}
+
+fn demo(a: DemoArgs) -> Result<ExitCode> {
+    let triangles = a
+        .triangles
+        .unwrap_or(trisort_scene::demo_car::DEFAULT_TRIANGLES);
+    let scene = trisort_scene::demo_car::demo_car(triangles);
+    let path = trisort_paths::demo_default(&scene);
+    std::fs::create_dir_all(&a.out_dir)?;
+    if let Some(p) = &a.export_scene {
+        // EXPORT_PENDING trisort_scene::export::export_glb(&scene, p)?;
+        println!("wrote {}", p.display());
+    }
+    println!(
+        "demo car: {} triangles, {} nodes, {} materials; path: {} frames",
+        scene.stats.triangles,
+        scene.geometry.nodes.len(),
+        scene.geometry.materials.len(),
+        path.frames.len()
+    );
+    bail!("`trisort demo` can only export the scene until the player exists (issue 5)")
+}

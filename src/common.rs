@@ -1,0 +1,125 @@
+//! Helpers shared by the subcommands: loading scenes and paths, parsing sizes and ranges,
+//! progress bars and JSON output.
+
+use std::ops::Range;
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use trisort_scene::Scene;
+
+/// Loads a scene: a `.glb`/`.gltf` file, or `demo` / `demo:TRIANGLES` for the built-in car.
+pub fn load_scene(spec: &str) -> Result<Scene> {
+    if let Some(rest) = spec.strip_prefix("demo") {
+        let triangles = match rest.strip_prefix(':') {
+            Some(n) => n
+                .parse()
+                .with_context(|| format!("scene {spec}: expected demo:TRIANGLES"))?,
+            None if rest.is_empty() => trisort_scene::demo_car::DEFAULT_TRIANGLES,
+            None => return load_file(spec),
+        };
+        return Ok(trisort_scene::demo_car::demo_car(triangles));
+    }
+    load_file(spec)
+}
+
+fn load_file(spec: &str) -> Result<Scene> {
+    let scene = trisort_scene::load(Path::new(spec))?;
+    for note in &scene.notes {
+        eprintln!("trisort: note: {note}");
+    }
+    Ok(scene)
+}
+
+/// Loads a path over a scene (`demo` gives the demo car's default path).
+pub fn load_path(spec: &str, scene: &Scene, fps: f64) -> Result<trisort_paths::Timeline> {
+    if spec == "demo" {
+        return Ok(trisort_paths::demo_default(scene));
+    }
+    Ok(trisort_paths::load(
+        spec,
+        scene,
+        &trisort_paths::PathOptions { fps },
+    )?)
+}
+
+/// Parses `WIDTHxHEIGHT` or a single number for a square.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let parse = |x: &str| {
+        x.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("bad size {s:?}: expected WIDTHxHEIGHT"))
+    };
+    let (w, h) = match s.split_once(['x', 'X']) {
+        Some((w, h)) => (parse(w)?, parse(h)?),
+        None => {
+            let n = parse(s)?;
+            (n, n)
+        }
+    };
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("size {s}: each side must be 1..=16384"));
+    }
+    Ok((w, h))
+}
+
+/// Parses a half-open frame range `a..b` (also `a..` and `..b`, and a single frame `a`).
+pub fn parse_range(s: &str) -> Result<FrameRange, String> {
+    let num = |x: &str| -> Result<Option<u32>, String> {
+        if x.is_empty() {
+            Ok(None)
+        } else {
+            x.parse()
+                .map(Some)
+                .map_err(|_| format!("bad frame range {s:?}: expected a..b"))
+        }
+    };
+    let (a, b) = match s.split_once("..") {
+        Some((a, b)) => (num(a)?, num(b)?),
+        None => {
+            let a = num(s)?.ok_or_else(|| format!("bad frame range {s:?}"))?;
+            (Some(a), Some(a + 1))
+        }
+    };
+    Ok(FrameRange { start: a, end: b })
+}
+
+/// A frame range whose open ends are resolved against the path length.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameRange {
+    start: Option<u32>,
+    end: Option<u32>,
+}
+
+impl FrameRange {
+    /// The concrete range for a path of `n` frames; an error if it is empty or past the end.
+    pub fn resolve(&self, n: u32) -> Result<Range<u32>> {
+        let r = self.start.unwrap_or(0)..self.end.unwrap_or(n);
+        if r.start >= r.end || r.end > n {
+            bail!(
+                "frame range {}..{} is empty or outside the path's frames 0..{n}",
+                r.start,
+                r.end
+            );
+        }
+        Ok(r)
+    }
+}
+
+/// A progress bar on stderr (hidden when stderr is not a terminal).
+pub fn progress_bar(total: u64, what: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(total);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{prefix:>10} [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    bar.set_prefix(what.to_string());
+    bar
+}
+
+/// Prints a JSON value to stdout.
+pub fn print_json(v: &serde_json::Value) {
+    println!("{}", serde_json::to_string_pretty(v).expect("json"));
+}

@@ -1,0 +1,64 @@
+//! Harness for tests that run the real `trisort` binary: a temp directory per test and, on
+//! failure, the command, its directory and its stderr.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The binary under test.
+pub fn bin() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_trisort"))
+}
+
+/// A command for the binary with the environment tests need.
+pub fn trisort(dir: &Path) -> Command {
+    let mut c = Command::new(bin());
+    c.current_dir(dir);
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        c.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    c
+}
+
+/// Runs and returns the output, panicking with the command, directory and stderr if the exit
+/// status is not `expect_success`.
+pub fn run(dir: &Path, args: &[&str], expect_success: bool) -> Output {
+    let out = trisort(dir).args(args).output().expect("spawn trisort");
+    if out.status.success() != expect_success {
+        panic!(
+            "trisort {} (in {}) exited with {:?}, expected {}\n--- stdout\n{}\n--- stderr\n{}",
+            args.join(" "),
+            dir.display(),
+            out.status.code(),
+            if expect_success { "success" } else { "failure" },
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    out
+}
+
+/// Runs with `--json` appended and parses stdout.
+pub fn run_json(dir: &Path, args: &[&str]) -> serde_json::Value {
+    let mut a = args.to_vec();
+    a.push("--json");
+    let out = run(dir, &a, true);
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "bad JSON from trisort {}: {e}\n{}",
+            a.join(" "),
+            String::from_utf8_lossy(&out.stdout)
+        )
+    })
+}
+
+/// A shared scene file, or `None` to skip (unless TRISORT_REQUIRE_SCENES=1).
+pub fn scene(name: &str) -> Option<String> {
+    trisort_scene::test_scene(&format!("{name}/{name}.glb")).map(|p| p.display().to_string())
+}
+
+/// Whether GPU tests can run here; panics when a GPU is required (CI) but missing.
+pub fn gpu_available() -> bool {
+    trisort_shaders::gpu::Gpu::for_tests().is_some()
+}
