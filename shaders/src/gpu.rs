@@ -42,13 +42,33 @@ pub fn wanted_features() -> wgpu::Features {
         | wgpu::Features::PIPELINE_STATISTICS_QUERY
 }
 
+/// An adapter as a trisort file records it: name, driver (name and version) and backend.
+pub fn device_info(info: &wgpu::AdapterInfo) -> trisort_format::DeviceInfo {
+    trisort_format::DeviceInfo {
+        adapter: info.name.clone(),
+        driver: format!("{} {}", info.driver, info.driver_info)
+            .trim()
+            .to_string(),
+        backend: format!("{:?}", info.backend),
+    }
+}
+
 impl Gpu {
     /// Opens the default adapter headless (no surface) with the adapter's own limits and the
     /// [`wanted_features`] it supports. `WGPU_BACKEND` and `WGPU_ADAPTER_NAME` select as in
     /// wgpu.
     pub fn new() -> Result<Gpu, GpuError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Gpu::with_flags(wgpu::InstanceFlags::from_build_config().with_env())
+    }
+
+    /// Like [`Gpu::new`], with the instance created with `flags` instead of wgpu's defaults
+    /// (`WGPU_BACKEND` and `WGPU_ADAPTER_NAME` still select). Use it to switch wgpu's
+    /// indirect-call validation ([`wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL`], on by
+    /// default even in release builds) on or off: the flag is read when the device is created.
+    pub fn with_flags(flags: wgpu::InstanceFlags) -> Result<Gpu, GpuError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.flags = flags;
+        let instance = wgpu::Instance::new(desc);
         let adapter =
             pollster::block_on(
                 instance.request_adapter(&wgpu::RequestAdapterOptions {
@@ -101,6 +121,11 @@ impl Gpu {
             "{} ({:?}, {} {})",
             self.info.name, self.info.backend, self.info.driver, self.info.driver_info
         )
+    }
+
+    /// The adapter as a trisort file records it (see [`device_info`]).
+    pub fn device_info(&self) -> trisort_format::DeviceInfo {
+        device_info(&self.info)
     }
 
     /// Reads back a buffer region synchronously (copies into a mappable staging buffer).

@@ -1,0 +1,197 @@
+//! How a baked file is played: mode, target formats, size, glass opacity, draw path; and the
+//! warnings for playing it away from its recorded sample pattern.
+
+use std::fmt;
+use std::str::FromStr;
+
+use trisort_format::{Baked, DeviceInfo};
+
+/// How the sorted triangles are composited (see the crate documentation for the equations).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Mode {
+    /// Back to front, *over*, no depth test.
+    #[default]
+    Blend,
+    /// Front to back with the depth test (`Less`, depth writes) and *over*.
+    Depth,
+    /// Front to back, *under* on a target cleared to alpha 0, no depth test.
+    Saturate,
+}
+
+impl Mode {
+    /// Every mode.
+    pub const ALL: [Mode; 3] = [Mode::Blend, Mode::Depth, Mode::Saturate];
+
+    /// The CLI name (`blend`, `depth`, `saturate`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Blend => "blend",
+            Mode::Depth => "depth",
+            Mode::Saturate => "saturate",
+        }
+    }
+
+    /// Whether the mode plays the stored order reversed (back to front).
+    pub fn back_to_front(self) -> bool {
+        self == Mode::Blend
+    }
+}
+
+impl fmt::Display for Mode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An unknown mode name.
+#[derive(Debug, thiserror::Error)]
+#[error("unknown mode `{0}` (expected blend, depth or saturate)")]
+pub struct ParseModeError(pub String);
+
+impl FromStr for Mode {
+    type Err = ParseModeError;
+    fn from_str(s: &str) -> Result<Mode, ParseModeError> {
+        Mode::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| ParseModeError(s.to_string()))
+    }
+}
+
+/// How draws are issued.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DrawPath {
+    /// One `multi_draw_indexed_indirect` per frame (needs `DownlevelFlags::INDIRECT_EXECUTION`).
+    #[default]
+    MultiDrawIndirect,
+    /// The same ranges one `draw_indexed` at a time, read from the CPU copy of the commands.
+    Direct,
+}
+
+impl DrawPath {
+    /// The multi-draw where the adapter executes indirect draws, the direct fallback elsewhere.
+    pub fn for_adapter(adapter: &wgpu::Adapter) -> DrawPath {
+        let flags = adapter.get_downlevel_capabilities().flags;
+        if flags.contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION) {
+            DrawPath::MultiDrawIndirect
+        } else {
+            DrawPath::Direct
+        }
+    }
+}
+
+/// Everything [`crate::Player::new`] needs besides the file: the caller's target and how to
+/// play.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlayerConfig {
+    /// Format of the colour attachment the player draws into.
+    pub color_format: wgpu::TextureFormat,
+    /// Format of the pass's depth attachment, if it has one. Required by [`Mode::Depth`]; in
+    /// the other modes the pipeline neither tests nor writes depth.
+    pub depth_format: Option<wgpu::TextureFormat>,
+    /// MSAA sample count of the attachments.
+    pub sample_count: u32,
+    /// Target size in pixels (width, height): sets the projection's aspect ratio.
+    pub size: (u32, u32),
+    /// Compositing mode.
+    pub mode: Mode,
+    /// Opacity of transmissive glass; `None` plays the recorded opacity.
+    pub glass_opacity: Option<f32>,
+    /// How draws are issued ([`DrawPath::for_adapter`] picks the right one).
+    pub draw_path: DrawPath,
+    /// The device it is played on, as a file records it
+    /// (`trisort_shaders::gpu::device_info`), to warn when it is not the recording device.
+    /// `None` skips that check.
+    pub device: Option<DeviceInfo>,
+}
+
+impl PlayerConfig {
+    /// Plays `baked` as recorded (size, sample count, glass opacity) in `blend` mode into a
+    /// `color_format` target without depth, with one multi-draw per frame.
+    pub fn recorded(baked: &Baked, color_format: wgpu::TextureFormat) -> PlayerConfig {
+        PlayerConfig {
+            color_format,
+            depth_format: None,
+            sample_count: baked.settings.samples.max(1),
+            size: (baked.settings.width, baked.settings.height),
+            mode: Mode::Blend,
+            glass_opacity: None,
+            draw_path: DrawPath::MultiDrawIndirect,
+            device: None,
+        }
+    }
+
+    /// [`PlayerConfig::recorded`] with the draw path and device taken from `adapter`.
+    pub fn for_adapter(
+        baked: &Baked,
+        adapter: &wgpu::Adapter,
+        color_format: wgpu::TextureFormat,
+    ) -> PlayerConfig {
+        PlayerConfig {
+            draw_path: DrawPath::for_adapter(adapter),
+            device: Some(trisort_shaders::gpu::device_info(&adapter.get_info())),
+            ..PlayerConfig::recorded(baked, color_format)
+        }
+    }
+
+    /// The glass opacity that will be played.
+    pub fn glass_opacity_for(&self, baked: &Baked) -> f32 {
+        self.glass_opacity.unwrap_or(baked.settings.glass_opacity)
+    }
+}
+
+/// The warnings for playing `baked` with `config`: another size, sample count or device than
+/// recorded (visibility and order are exact only at the recorded sample pattern), glass more
+/// transparent than recorded (surfaces hidden behind it at recording time were left out: holes),
+/// or a depth-only bake played without the depth test.
+pub fn playback_warnings(baked: &Baked, config: &PlayerConfig) -> Vec<String> {
+    let rec = &baked.settings;
+    let mut out = Vec::new();
+    if config.size != (rec.width, rec.height) {
+        out.push(format!(
+            "played at {}x{}, recorded at {}x{}: the sorted order is exact only at the recorded size",
+            config.size.0, config.size.1, rec.width, rec.height
+        ));
+    }
+    if config.sample_count != rec.samples {
+        out.push(format!(
+            "played with {} sample(s) per pixel, recorded with {}: the sorted order is exact only at the recorded sample pattern",
+            config.sample_count, rec.samples
+        ));
+    }
+    if let Some(dev) = &config.device {
+        if dev.adapter != baked.device.adapter
+            || dev.backend != baked.device.backend
+            || dev.driver != baked.device.driver
+        {
+            out.push(format!(
+                "played on {} ({}, {}), recorded on {} ({}, {}): rasterization may differ slightly",
+                dev.adapter,
+                dev.backend,
+                dev.driver,
+                baked.device.adapter,
+                baked.device.backend,
+                baked.device.driver
+            ));
+        }
+    }
+    let glass = config.glass_opacity_for(baked);
+    let has_glass = baked
+        .geometry
+        .materials
+        .iter()
+        .any(|m| m.transmission > 0.0);
+    if has_glass && glass < rec.glass_opacity {
+        out.push(format!(
+            "glass opacity {glass} is below the recorded {}: surfaces that the glass hid when recording were left out of the file and can show as holes",
+            rec.glass_opacity
+        ));
+    }
+    if baked.merge.depth_only && config.mode != Mode::Depth {
+        out.push(format!(
+            "a depth-only bake is ordered only where depths tie; played in {} mode without the depth test it is not sorted",
+            config.mode
+        ));
+    }
+    out
+}

@@ -1,0 +1,44 @@
+//! The player's error type.
+
+use std::path::PathBuf;
+
+/// Errors loading or playing a baked file.
+#[derive(Debug, thiserror::Error)]
+pub enum PlayerError {
+    /// The file could not be read or decoded (the message names the file).
+    #[error(transparent)]
+    Format(#[from] trisort_format::FormatError),
+    /// The file decoded but its contents are inconsistent.
+    #[error("{}: inconsistent baked file: {reason}", path.as_ref().map_or("<memory>".into(), |p| p.display().to_string()))]
+    Structure {
+        /// The file, when it came from one.
+        path: Option<PathBuf>,
+        /// The first problem found.
+        reason: String,
+    },
+    /// A frame index beyond the file's frames.
+    #[error("frame {frame} does not exist (the file has {frames} frames)")]
+    FrameOutOfRange {
+        /// The frame asked for.
+        frame: u32,
+        /// Frames in the file.
+        frames: u32,
+    },
+    /// `depth` mode without a depth attachment format.
+    #[error("depth mode needs a depth attachment: set PlayerConfig::depth_format")]
+    DepthFormatMissing,
+    /// The adapter cannot render this format at this sample count.
+    #[error("{format:?} does not support {samples}x multisampling on this adapter")]
+    SampleCount {
+        /// The format.
+        format: wgpu::TextureFormat,
+        /// The sample count asked for.
+        samples: u32,
+    },
+    /// wgpu refused to create a resource or run a command.
+    #[error("wgpu: {0}")]
+    Wgpu(String),
+    /// The device was lost or a readback failed.
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+}

@@ -1,0 +1,472 @@
+//! Headless rendering for the CLI (`trisort play`) and the tests: frames drawn by a [`Player`]
+//! into an `Rgba16Float` target (MSAA resolved to one sample), read back and quantized once to
+//! 8-bit sRGB, the way the exact reference renders (DESIGN § Frame accuracy).
+
+use std::sync::mpsc;
+
+use trisort_format::Baked;
+use trisort_shaders::gpu::Gpu;
+
+use crate::config::{DrawPath, Mode, PlayerConfig};
+use crate::error::PlayerError;
+use crate::player::{block_on_ready, Player};
+
+/// The background every headless frame is drawn over: a dark grey, linear RGB.
+pub const BACKGROUND: [f32; 3] = [0.03, 0.03, 0.03];
+
+/// Format of the headless colour target.
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Format of the headless depth target (`depth` mode only).
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// One rendered frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderedFrame {
+    /// Frame index.
+    pub frame: u32,
+    /// `width × height` pixels, RGBA8, sRGB-encoded, rows top to bottom, alpha 255.
+    pub rgba8: Vec<u8>,
+    /// GPU time of the frame's render pass in milliseconds, where the device has
+    /// `Features::TIMESTAMP_QUERY`.
+    pub gpu_ms: Option<f64>,
+}
+
+/// How headless frames are rendered.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeadlessConfig {
+    /// Image size (width, height).
+    pub size: (u32, u32),
+    /// MSAA samples.
+    pub samples: u32,
+    /// Compositing mode.
+    pub mode: Mode,
+    /// Glass opacity; `None` plays the recorded one.
+    pub glass_opacity: Option<f32>,
+    /// Draw path; `None` picks it from the adapter ([`DrawPath::for_adapter`]).
+    pub draw_path: Option<DrawPath>,
+    /// Use 32-bit indices even where 16 bits fit.
+    pub force_u32: bool,
+}
+
+impl HeadlessConfig {
+    /// The recorded size and sample count, `blend` mode, recorded glass opacity.
+    pub fn recorded(baked: &Baked) -> HeadlessConfig {
+        HeadlessConfig {
+            size: (baked.settings.width, baked.settings.height),
+            samples: baked.settings.samples.max(1),
+            mode: Mode::Blend,
+            glass_opacity: None,
+            draw_path: None,
+            force_u32: false,
+        }
+    }
+}
+
+/// Renders `frames` of `baked` headless at `size` with `samples` MSAA samples in `mode`
+/// (`glass_opacity` `None`: as recorded). See [`HeadlessRenderer`].
+pub fn render_frames(
+    gpu: &Gpu,
+    baked: &Baked,
+    frames: &[u32],
+    size: (u32, u32),
+    samples: u32,
+    mode: Mode,
+    glass_opacity: Option<f32>,
+) -> Result<Vec<RenderedFrame>, PlayerError> {
+    let config = HeadlessConfig {
+        size,
+        samples,
+        mode,
+        glass_opacity,
+        draw_path: None,
+        force_u32: false,
+    };
+    let renderer = HeadlessRenderer::new(gpu, baked, &config)?;
+    frames.iter().map(|&f| renderer.render(f)).collect()
+}
+
+struct Timer {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    period_ns: f64,
+}
+
+/// A [`Player`] with its own offscreen targets: renders one frame per call, each with a single
+/// command encoder (render pass, MSAA resolve, timestamp resolve, copy to a staging buffer).
+pub struct HeadlessRenderer<'g> {
+    gpu: &'g Gpu,
+    player: Player,
+    mode: Mode,
+    size: (u32, u32),
+    msaa_view: Option<wgpu::TextureView>,
+    target: wgpu::Texture,
+    target_view: wgpu::TextureView,
+    depth_view: Option<wgpu::TextureView>,
+    row_bytes: u32,
+    staging: wgpu::Buffer,
+    timer: Option<Timer>,
+}
+
+impl<'g> HeadlessRenderer<'g> {
+    /// Creates the player and the targets. Errors where the adapter cannot multisample the
+    /// targets at `config.samples`, or as [`Player::new`].
+    pub fn new(
+        gpu: &'g Gpu,
+        baked: &Baked,
+        config: &HeadlessConfig,
+    ) -> Result<HeadlessRenderer<'g>, PlayerError> {
+        let (w, h) = (config.size.0.max(1), config.size.1.max(1));
+        let samples = config.samples.max(1);
+        let mut formats = vec![COLOR_FORMAT];
+        if config.mode == Mode::Depth {
+            formats.push(DEPTH_FORMAT);
+        }
+        for format in formats {
+            let flags = gpu.adapter.get_texture_format_features(format).flags;
+            if !flags.sample_count_supported(samples) {
+                return Err(PlayerError::SampleCount { format, samples });
+            }
+        }
+        let player_config = PlayerConfig {
+            color_format: COLOR_FORMAT,
+            depth_format: (config.mode == Mode::Depth).then_some(DEPTH_FORMAT),
+            sample_count: samples,
+            size: (w, h),
+            mode: config.mode,
+            glass_opacity: config.glass_opacity,
+            draw_path: config
+                .draw_path
+                .unwrap_or_else(|| DrawPath::for_adapter(&gpu.adapter)),
+            device: Some(gpu.device_info()),
+        };
+        let player = if config.force_u32 {
+            Player::new_u32(&gpu.device, &gpu.queue, baked, player_config)?
+        } else {
+            Player::new(&gpu.device, &gpu.queue, baked, player_config)?
+        };
+
+        let device = &gpu.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let extent = wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        };
+        let texture = |label, format, sample_count, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: extent,
+                mip_level_count: 1,
+                sample_count,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let target = texture(
+            "trisort frame",
+            COLOR_FORMAT,
+            1,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let target_view = target.create_view(&Default::default());
+        let msaa_view = (samples > 1).then(|| {
+            texture(
+                "trisort frame (MSAA)",
+                COLOR_FORMAT,
+                samples,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            )
+            .create_view(&Default::default())
+        });
+        let depth_view = (config.mode == Mode::Depth).then(|| {
+            texture(
+                "trisort depth",
+                DEPTH_FORMAT,
+                samples,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            )
+            .create_view(&Default::default())
+        });
+        let row_bytes = (w * 8).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("trisort frame readback"),
+            size: row_bytes as u64 * h as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let timer = device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| Timer {
+                set: device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("trisort frame time"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2,
+                }),
+                resolve: device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("trisort timestamps"),
+                    size: 16,
+                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                }),
+                staging: device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("trisort timestamps readback"),
+                    size: 16,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+                period_ns: gpu.queue.get_timestamp_period() as f64,
+            });
+        if let Some(Some(e)) = block_on_ready(scope.pop()) {
+            return Err(PlayerError::Wgpu(e.to_string()));
+        }
+        Ok(HeadlessRenderer {
+            gpu,
+            player,
+            mode: config.mode,
+            size: (w, h),
+            msaa_view,
+            target,
+            target_view,
+            depth_view,
+            row_bytes,
+            staging,
+            timer,
+        })
+    }
+
+    /// The player.
+    pub fn player(&self) -> &Player {
+        &self.player
+    }
+
+    /// Renders frame `frame` and reads it back as 8-bit sRGB.
+    pub fn render(&self, frame: u32) -> Result<RenderedFrame, PlayerError> {
+        let device = &self.gpu.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let clear = match self.mode {
+            // The background is composited under the accumulated colour after the pass.
+            Mode::Saturate => wgpu::Color::TRANSPARENT,
+            Mode::Blend | Mode::Depth => wgpu::Color {
+                r: BACKGROUND[0] as f64,
+                g: BACKGROUND[1] as f64,
+                b: BACKGROUND[2] as f64,
+                a: 1.0,
+            },
+        };
+        let (view, resolve_target, store) = match &self.msaa_view {
+            Some(msaa) => (msaa, Some(&self.target_view), wgpu::StoreOp::Discard),
+            None => (&self.target_view, None, wgpu::StoreOp::Store),
+        };
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("trisort frame"),
+        });
+        let drawn = {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("trisort frame"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(clear),
+                        store,
+                    },
+                })],
+                depth_stencil_attachment: self.depth_view.as_ref().map(|view| {
+                    wgpu::RenderPassDepthStencilAttachment {
+                        view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Discard,
+                        }),
+                        stencil_ops: None,
+                    }
+                }),
+                timestamp_writes: self
+                    .timer
+                    .as_ref()
+                    .map(|t| wgpu::RenderPassTimestampWrites {
+                        query_set: &t.set,
+                        beginning_of_pass_write_index: Some(0),
+                        end_of_pass_write_index: Some(1),
+                    }),
+                ..Default::default()
+            });
+            self.player.draw(&mut pass, frame)
+        };
+        if let Err(e) = drawn {
+            drop(enc);
+            let _ = block_on_ready(scope.pop());
+            return Err(e);
+        }
+        if let Some(t) = &self.timer {
+            enc.resolve_query_set(&t.set, 0..2, &t.resolve, 0);
+            enc.copy_buffer_to_buffer(&t.resolve, 0, &t.staging, 0, 16);
+        }
+        let (w, h) = self.size;
+        enc.copy_texture_to_buffer(
+            self.target.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.row_bytes),
+                    rows_per_image: Some(h),
+                },
+            },
+            self.target.size(),
+        );
+        self.gpu.queue.submit([enc.finish()]);
+        if let Some(Some(e)) = block_on_ready(scope.pop()) {
+            return Err(PlayerError::Wgpu(e.to_string()));
+        }
+
+        let mut buffers = vec![&self.staging];
+        if let Some(t) = &self.timer {
+            buffers.push(&t.staging);
+        }
+        let bytes = map_read_all(device, &buffers)?;
+        let mut halves = Vec::with_capacity((w * h * 4) as usize);
+        for y in 0..h as usize {
+            let row = &bytes[0][y * self.row_bytes as usize..][..(w * 8) as usize];
+            halves.extend(
+                row.chunks_exact(2)
+                    .map(|b| u16::from_le_bytes([b[0], b[1]])),
+            );
+        }
+        let under = (self.mode == Mode::Saturate).then_some(BACKGROUND);
+        let rgba8 = quantize_rgba16f(&halves, under);
+        let gpu_ms = self.timer.as_ref().and_then(|t| {
+            let ts: &[u64] = bytemuck::cast_slice(&bytes[1]);
+            (ts[1] >= ts[0]).then(|| (ts[1] - ts[0]) as f64 * t.period_ns / 1e6)
+        });
+        Ok(RenderedFrame {
+            frame,
+            rgba8,
+            gpu_ms,
+        })
+    }
+}
+
+/// Maps `MAP_READ` buffers after the queue is done with them and returns their bytes.
+fn map_read_all(
+    device: &wgpu::Device,
+    buffers: &[&wgpu::Buffer],
+) -> Result<Vec<Vec<u8>>, PlayerError> {
+    let (tx, rx) = mpsc::channel();
+    for (k, b) in buffers.iter().enumerate() {
+        let tx = tx.clone();
+        b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send((k, r));
+        });
+    }
+    drop(tx);
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| PlayerError::Readback(e.to_string()))?;
+    for (_, r) in rx.iter() {
+        r.map_err(|e| PlayerError::Readback(e.to_string()))?;
+    }
+    let mut out = Vec::with_capacity(buffers.len());
+    for b in buffers {
+        let bytes = b
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| PlayerError::Readback(e.to_string()))?
+            .to_vec();
+        b.unmap();
+        out.push(bytes);
+    }
+    Ok(out)
+}
+
+/// An IEEE 754 half (binary16) as f32.
+pub fn f16_to_f32(h: u16) -> f32 {
+    let negative = h & 0x8000 != 0;
+    let exp = ((h >> 10) & 0x1f) as u32;
+    let man = (h & 0x3ff) as u32;
+    let magnitude = match exp {
+        0 => man as f32 * (1.0 / 16_777_216.0), // subnormal: man × 2⁻²⁴
+        31 => f32::from_bits(0x7f80_0000 | (man << 13)),
+        _ => f32::from_bits(((exp + 112) << 23) | (man << 13)),
+    };
+    if negative {
+        -magnitude
+    } else {
+        magnitude
+    }
+}
+
+/// Linear to sRGB transfer function (IEC 61966-2-1) on [0, 1].
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Converts linear `Rgba16Float` texels (4 halves each) to 8-bit sRGB RGBA with alpha 255,
+/// quantizing once: the one conversion the player and the exact reference share.
+///
+/// With `under = None` the texels are final colours (`blend`, `depth`: already composited over
+/// an opaque background). With `Some(background)` they hold premultiplied colour and coverage
+/// alpha (`saturate`'s accumulation) and the background goes under them first:
+/// `rgb + (1 − a)·background`.
+pub fn quantize_rgba16f(halves: &[u16], under: Option<[f32; 3]>) -> Vec<u8> {
+    debug_assert!(halves.len().is_multiple_of(4));
+    let mut out = Vec::with_capacity(halves.len());
+    for px in halves.chunks_exact(4) {
+        let a = f16_to_f32(px[3]).clamp(0.0, 1.0);
+        for (c, &h) in px[..3].iter().enumerate() {
+            let mut v = f16_to_f32(h);
+            if let Some(bg) = under {
+                v += (1.0 - a) * bg[c];
+            }
+            out.push((linear_to_srgb(v) * 255.0).round() as u8);
+        }
+        out.push(255);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn halves_decode() {
+        assert_eq!(f16_to_f32(0x0000), 0.0);
+        assert_eq!(f16_to_f32(0x3c00), 1.0);
+        assert_eq!(f16_to_f32(0xc000), -2.0);
+        assert_eq!(f16_to_f32(0x3800), 0.5);
+        assert_eq!(f16_to_f32(0x7bff), 65504.0);
+        assert_eq!(f16_to_f32(0x0001), 2f32.powi(-24));
+        assert_eq!(f16_to_f32(0x7c00), f32::INFINITY);
+        assert!(f16_to_f32(0x7e00).is_nan());
+    }
+
+    #[test]
+    fn quantize_once_with_and_without_background() {
+        // 1.0 and 0.5 linear; alpha 1.
+        let px = [0x3c00, 0x3800, 0x0000, 0x3c00];
+        assert_eq!(quantize_rgba16f(&px, None), vec![255, 188, 0, 255]);
+        // Premultiplied nothing (alpha 0) over a background of 0.5 gives the background.
+        let empty = [0, 0, 0, 0];
+        assert_eq!(
+            quantize_rgba16f(&empty, Some([0.5, 0.5, 1.0])),
+            vec![188, 188, 255, 255]
+        );
+        // Alpha 1 hides the background entirely.
+        assert_eq!(
+            quantize_rgba16f(&px, Some([1.0; 3])),
+            vec![255, 188, 0, 255]
+        );
+    }
+}

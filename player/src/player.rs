@@ -1,0 +1,355 @@
+//! [`Player`]: uploads a baked file once and draws a frame with one multi-draw-indirect call.
+
+use std::path::Path;
+
+use trisort_format::{Baked, DrawIndexedIndirectArgs, FileKind, FrameWindow};
+use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use wgpu::util::DeviceExt;
+
+use crate::commands::{frame_commands, index_buffer, Order};
+use crate::config::{playback_warnings, DrawPath, Mode, PlayerConfig};
+use crate::draw_calls::DrawCalls;
+use crate::error::PlayerError;
+
+/// Size in bytes of one `DrawIndexedIndirectArgs`.
+const ARGS_SIZE: u64 = std::mem::size_of::<DrawIndexedIndirectArgs>() as u64;
+
+/// Reads a baked file and checks its structure, so that every draw lies inside its index
+/// buffer. Errors name the file.
+pub fn open_baked(path: &Path) -> Result<Baked, PlayerError> {
+    let baked: Baked = trisort_format::read_file(FileKind::Baked, path)?;
+    baked
+        .check_structure()
+        .map_err(|reason| PlayerError::Structure {
+            path: Some(path.to_path_buf()),
+            reason,
+        })?;
+    Ok(baked)
+}
+
+/// A baked file on the GPU, ready to draw any of its frames into a caller's render pass.
+///
+/// Everything is uploaded once by [`Player::new`]: the scene (vertices, materials, textures,
+/// per-frame uniforms and node matrices, see [`SceneGpu`]), the index buffer in the mode's
+/// order, and every frame's `DrawIndexedIndirectArgs` back to back in one indirect buffer.
+pub struct Player {
+    scene: SceneGpu,
+    pipeline: wgpu::RenderPipeline,
+    index_buffer: wgpu::Buffer,
+    index_format: wgpu::IndexFormat,
+    index_count: u32,
+    indirect: wgpu::Buffer,
+    commands: Vec<DrawIndexedIndirectArgs>,
+    windows: Vec<FrameWindow>,
+    config: PlayerConfig,
+    warnings: Vec<String>,
+}
+
+impl Player {
+    /// Uploads `baked` for playing with `config`.
+    ///
+    /// Checks the file's structure first (every draw inside the index buffer, every window
+    /// inside the draw list), so the indirect commands are valid whether or not wgpu validates
+    /// indirect calls. Errors on an inconsistent file, on `depth` mode without a depth format,
+    /// and on anything wgpu refuses (caught in an error scope). [`Player::warnings`] lists what
+    /// makes this playback inexact.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        baked: &Baked,
+        config: PlayerConfig,
+    ) -> Result<Player, PlayerError> {
+        Player::build(device, queue, baked, config, false)
+    }
+
+    /// [`Player::new`] with 32-bit indices even where 16 bits would do (to compare both paths).
+    pub fn new_u32(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        baked: &Baked,
+        config: PlayerConfig,
+    ) -> Result<Player, PlayerError> {
+        Player::build(device, queue, baked, config, true)
+    }
+
+    fn build(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        baked: &Baked,
+        config: PlayerConfig,
+        force_u32: bool,
+    ) -> Result<Player, PlayerError> {
+        baked
+            .check_structure()
+            .map_err(|reason| PlayerError::Structure { path: None, reason })?;
+        if config.mode == Mode::Depth && config.depth_format.is_none() {
+            return Err(PlayerError::DepthFormatMissing);
+        }
+        let warnings = playback_warnings(baked, &config);
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+
+        let view = View {
+            width: config.size.0.max(1),
+            height: config.size.1.max(1),
+            samples: config.sample_count,
+            glass_opacity: config.glass_opacity_for(baked),
+        };
+        let scene = SceneGpu::new(device, queue, &baked.geometry, &baked.frame_states, view);
+        let order = if config.mode.back_to_front() {
+            Order::BackToFront
+        } else {
+            Order::FrontToBack
+        };
+        let indices = index_buffer(baked, order, force_u32);
+        let index_count = indices.len() as u32;
+        let index_bytes: &[u8] = if indices.is_empty() {
+            &[0u8; 4]
+        } else {
+            indices.bytes()
+        };
+        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("trisort sorted indices"),
+            contents: index_bytes,
+            // COPY_SRC: so tests and tools can read back what is drawn.
+            usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_SRC,
+        });
+        let (commands, windows) = frame_commands(baked, order);
+        let zero = [DrawIndexedIndirectArgs::default()];
+        let command_bytes: &[u8] = if commands.is_empty() {
+            bytemuck::cast_slice(&zero)
+        } else {
+            bytemuck::cast_slice(&commands)
+        };
+        let indirect = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("trisort frame windows"),
+            contents: command_bytes,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
+        });
+        let pipeline = create_pipeline(device, &scene.layout, &config);
+
+        if let Some(Some(e)) = block_on_ready(scope.pop()) {
+            return Err(PlayerError::Wgpu(e.to_string()));
+        }
+        Ok(Player {
+            scene,
+            pipeline,
+            index_format: indices.format(),
+            index_buffer,
+            index_count,
+            indirect,
+            commands,
+            windows,
+            config,
+            warnings,
+        })
+    }
+
+    /// Draws frame `frame` into `pass`: binds the pipeline, the frame's uniforms and node
+    /// matrices (dynamic offsets), the vertex and index buffers, and issues exactly one
+    /// `multi_draw_indexed_indirect` over the frame's window, or, on the
+    /// [`DrawPath::Direct`] path, one `draw_indexed` per range of the window.
+    ///
+    /// The pass's attachments must match the [`PlayerConfig`] (formats, sample count); in
+    /// `saturate` mode its colour must have been cleared to alpha 0.
+    pub fn draw(&self, pass: &mut impl DrawCalls, frame: u32) -> Result<(), PlayerError> {
+        let Some(&window) = self.windows.get(frame as usize) else {
+            return Err(PlayerError::FrameOutOfRange {
+                frame,
+                frames: self.windows.len() as u32,
+            });
+        };
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+        pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
+        pass.set_index_buffer(self.index_buffer.slice(..), self.index_format);
+        match self.config.draw_path {
+            DrawPath::MultiDrawIndirect => pass.multi_draw_indexed_indirect(
+                &self.indirect,
+                window.first as u64 * ARGS_SIZE,
+                window.count,
+            ),
+            DrawPath::Direct => {
+                for d in self.frame_commands(frame) {
+                    pass.draw_indexed(
+                        d.first_index..d.first_index + d.index_count,
+                        d.base_vertex,
+                        d.first_instance..d.first_instance + d.instance_count,
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of frames.
+    pub fn frame_count(&self) -> u32 {
+        self.windows.len() as u32
+    }
+
+    /// Frame `frame`'s draws in the order they are played (a CPU copy of its part of
+    /// [`Player::indirect_buffer`]).
+    pub fn frame_commands(&self, frame: u32) -> &[DrawIndexedIndirectArgs] {
+        let w = self.windows[frame as usize];
+        &self.commands[w.first as usize..(w.first + w.count) as usize]
+    }
+
+    /// Triangles drawn in frame `frame`.
+    pub fn frame_triangles(&self, frame: u32) -> u64 {
+        self.frame_commands(frame)
+            .iter()
+            .map(|d| d.index_count as u64 / 3)
+            .sum()
+    }
+
+    /// Byte offset of frame `frame`'s first command in [`Player::indirect_buffer`].
+    pub fn frame_offset(&self, frame: u32) -> u64 {
+        self.windows[frame as usize].first as u64 * ARGS_SIZE
+    }
+
+    /// The indirect buffer: every frame's commands back to back.
+    pub fn indirect_buffer(&self) -> &wgpu::Buffer {
+        &self.indirect
+    }
+
+    /// The index buffer in the mode's order.
+    pub fn index_buffer(&self) -> &wgpu::Buffer {
+        &self.index_buffer
+    }
+
+    /// Index format of the index buffer (u16 where every vertex index fits).
+    pub fn index_format(&self) -> wgpu::IndexFormat {
+        self.index_format
+    }
+
+    /// Number of indices in the index buffer (3 per copy).
+    pub fn index_count(&self) -> u32 {
+        self.index_count
+    }
+
+    /// The configuration it was created with.
+    pub fn config(&self) -> &PlayerConfig {
+        &self.config
+    }
+
+    /// What makes this playback inexact (see [`playback_warnings`]); empty at the recorded
+    /// sample pattern on the recording device.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+}
+
+/// The blend state of a mode (see the crate documentation for the equations).
+pub(crate) fn blend_state(mode: Mode) -> wgpu::BlendState {
+    use wgpu::{BlendComponent, BlendFactor, BlendOperation};
+    match mode {
+        // Straight alpha, over: colour s.a·s + (1 − s.a)·d, alpha s.a + (1 − s.a)·d.a.
+        Mode::Blend | Mode::Depth => wgpu::BlendState {
+            color: BlendComponent {
+                src_factor: BlendFactor::SrcAlpha,
+                dst_factor: BlendFactor::OneMinusSrcAlpha,
+                operation: BlendOperation::Add,
+            },
+            alpha: BlendComponent {
+                src_factor: BlendFactor::One,
+                dst_factor: BlendFactor::OneMinusSrcAlpha,
+                operation: BlendOperation::Add,
+            },
+        },
+        // Premultiplied source, under: (1 − d.a)·s + d for colour and alpha alike.
+        Mode::Saturate => {
+            let under = BlendComponent {
+                src_factor: BlendFactor::OneMinusDstAlpha,
+                dst_factor: BlendFactor::One,
+                operation: BlendOperation::Add,
+            };
+            wgpu::BlendState {
+                color: under,
+                alpha: under,
+            }
+        }
+    }
+}
+
+fn create_pipeline(
+    device: &wgpu::Device,
+    scene_layout: &wgpu::BindGroupLayout,
+    config: &PlayerConfig,
+) -> wgpu::RenderPipeline {
+    let source = trisort_shaders::compose(&[], trisort_shaders::PLAYER);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("trisort player"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("trisort player"),
+        bind_group_layouts: &[Some(scene_layout)],
+        immediate_size: 0,
+    });
+    let depth_stencil = config.depth_format.map(|format| {
+        let depth = config.mode == Mode::Depth;
+        wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(depth),
+            depth_compare: Some(if depth {
+                wgpu::CompareFunction::Less
+            } else {
+                wgpu::CompareFunction::Always
+            }),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }
+    });
+    let fragment_entry = match config.mode {
+        Mode::Blend | Mode::Depth => "fs_player_straight",
+        Mode::Saturate => "fs_player_premultiplied",
+    };
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("trisort player"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_player"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertex_layout())],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            front_face: wgpu::FrontFace::Ccw,
+            // One pipeline for every material: single-sided ones discard on `front_facing`.
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil,
+        multisample: wgpu::MultisampleState {
+            count: config.sample_count,
+            mask: !0,
+            alpha_to_coverage_enabled: false,
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some(fragment_entry),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: config.color_format,
+                blend: Some(blend_state(config.mode)),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// Polls a future that native wgpu resolves immediately (error-scope pops). A future still
+/// pending after a bounded number of polls is taken to carry no error.
+pub(crate) fn block_on_ready<F: std::future::Future>(fut: F) -> Option<F::Output> {
+    let mut fut = std::pin::pin!(fut);
+    let mut cx = std::task::Context::from_waker(std::task::Waker::noop());
+    for _ in 0..1000 {
+        if let std::task::Poll::Ready(v) = fut.as_mut().poll(&mut cx) {
+            return Some(v);
+        }
+        std::thread::yield_now();
+    }
+    None
+}

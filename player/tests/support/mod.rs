@@ -1,0 +1,209 @@
+//! Baked files built by hand for the player's tests: a few quads at different depths and
+//! colours, three frames with different windows.
+#![allow(dead_code)]
+
+use glam::{DMat4, DVec3};
+use trisort_format::{
+    AlphaMode, Baked, Camera, DeviceInfo, DrawIndexedIndirectArgs, FrameState, FrameWindow,
+    Geometry, Material, Node, RecordSettings, Vertex,
+};
+
+/// Recorded image size (square).
+pub const SIZE: u32 = 32;
+
+/// Camera distance from the origin along +Z.
+pub const EYE_Z: f64 = 5.0;
+
+/// Linear base colours of the quads: red and green half transparent, blue opaque.
+pub const RED: [f32; 4] = [1.0, 0.0, 0.0, 0.5];
+/// Green, half transparent, behind red.
+pub const GREEN: [f32; 4] = [0.0, 1.0, 0.0, 0.5];
+/// Blue, opaque, behind everything, covering the whole view.
+pub const BLUE: [f32; 4] = [0.0, 0.0, 1.0, 1.0];
+
+/// A quad in the plane z, from (x0, y0) to (x1, y1), front face towards +Z (the camera).
+fn quad(g: &mut Geometry, x0: f32, y0: f32, x1: f32, y1: f32, z: f32, material: u32) {
+    let base = g.vertices.len() as u32;
+    for (x, y) in [(x0, y0), (x1, y0), (x1, y1), (x0, y1)] {
+        g.vertices.push(Vertex {
+            position: [x, y, z],
+            normal: [0.0, 0.0, 1.0],
+            uv: [0.0; 2],
+            material,
+            node: 0,
+        });
+    }
+    g.triangles.push([base, base + 1, base + 2]);
+    g.triangles.push([base, base + 2, base + 3]);
+}
+
+fn material(base_color: [f32; 4], alpha_mode: AlphaMode) -> Material {
+    Material {
+        base_color,
+        alpha_mode,
+        ..Default::default()
+    }
+}
+
+/// Indirect args over `count` indices from `first`.
+pub fn args(first_index: u32, index_count: u32) -> DrawIndexedIndirectArgs {
+    DrawIndexedIndirectArgs {
+        index_count,
+        instance_count: 1,
+        first_index,
+        base_vertex: 0,
+        first_instance: 0,
+    }
+}
+
+/// The camera: at (0, 0, 5) looking at the origin; y ∈ [−1, 1] at z = 0 fills the view.
+pub fn frame_state() -> FrameState {
+    FrameState {
+        camera: Camera {
+            view: DMat4::look_at_rh(DVec3::new(0.0, 0.0, EYE_Z), DVec3::ZERO, DVec3::Y)
+                .to_cols_array(),
+            yfov: 2.0 * (1.0 / EYE_Z).atan(),
+            znear: 0.1,
+            zfar: Some(20.0),
+        },
+        poses: vec![],
+    }
+}
+
+/// Three quads, G-local triangles:
+/// - 0, 1: Q0, red (α 0.5), z = 0.5 (front), x, y ∈ [−0.8, 0.3];
+/// - 2, 3: Q1, green (α 0.5), z = 0, x, y ∈ [−0.3, 0.8];
+/// - 4, 5: Q2, blue (opaque), z = −0.5, covering the view.
+///
+/// Copies (front to back): [0 1 2 3 | 4 5 | 2 3]. Draws: A = Q0 Q1 (indices 0..12),
+/// B = Q2 (12..18), D = the first copy of Q0 (0..6), C = the second copy of Q1 (18..24);
+/// the draw list is [A, B, D, C]. Frames: 0 = [A] (red over green), 1 = [A, B] (red over
+/// green over blue), 2 = [D, C] (red over green from two ranges).
+pub fn quads() -> Baked {
+    let mut g = Geometry {
+        materials: vec![
+            material(RED, AlphaMode::Blend),
+            material(GREEN, AlphaMode::Blend),
+            material(BLUE, AlphaMode::Opaque),
+        ],
+        nodes: vec![Node {
+            name: "root".into(),
+            parent: None,
+            rest: DMat4::IDENTITY.to_cols_array(),
+        }],
+        ..Default::default()
+    };
+    quad(&mut g, -0.8, -0.8, 0.3, 0.3, 0.5, 0);
+    quad(&mut g, -0.3, -0.3, 0.8, 0.8, 0.0, 1);
+    quad(&mut g, -3.0, -3.0, 3.0, 3.0, -0.5, 2);
+    let frames = 3;
+    Baked {
+        tool_version: trisort_format::TOOL_VERSION.into(),
+        scene_hash: [1; 32],
+        path_hash: [2; 32],
+        recording_hashes: vec![[3; 32]],
+        settings: RecordSettings {
+            width: SIZE,
+            height: SIZE,
+            samples: 1,
+            ..Default::default()
+        },
+        device: DeviceInfo {
+            adapter: "hand-made".into(),
+            driver: "none".into(),
+            backend: "Vulkan".into(),
+        },
+        merge: Default::default(),
+        stats: Default::default(),
+        scene_ids: (0..g.triangles.len() as u32).map(|t| t * 10).collect(),
+        geometry: g,
+        copies: vec![0, 1, 2, 3, 4, 5, 2, 3],
+        draws: vec![args(0, 12), args(12, 6), args(0, 6), args(18, 6)],
+        frames: vec![
+            FrameWindow { first: 0, count: 1 },
+            FrameWindow { first: 0, count: 2 },
+            FrameWindow { first: 2, count: 2 },
+        ],
+        frame_states: vec![frame_state(); frames],
+        removed_edges: vec![vec![]; frames],
+    }
+}
+
+/// [`quads`] with unused vertices appended so that the indices no longer fit 16 bits.
+pub fn quads_u32() -> Baked {
+    let mut b = quads();
+    let v = b.geometry.vertices[0];
+    b.geometry.vertices.resize(70_000, v);
+    assert!(!b.fits_u16());
+    b
+}
+
+/// The triangles a list of draws covers, as G-local ids in draw order, for a front-to-back
+/// copy list.
+pub fn drawn_copies(baked: &Baked, draws: &[DrawIndexedIndirectArgs]) -> Vec<u32> {
+    draws
+        .iter()
+        .flat_map(|d| d.first_index / 3..(d.first_index + d.index_count) / 3)
+        .map(|k| baked.copies[k as usize])
+        .collect()
+}
+
+/// The lit colour of a flat quad facing the camera (the shared `shade` with a view-space
+/// normal of +Z and no emission), straight alpha.
+pub fn lit(base: [f32; 4]) -> [f64; 4] {
+    let l = trisort_shaders::scene_gpu::LIGHT;
+    let len = ((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]) as f64).sqrt();
+    let diffuse = (l[2] as f64 / len).max(0.0);
+    let k = l[3] as f64 + (1.0 - l[3] as f64) * diffuse;
+    [
+        base[0] as f64 * k,
+        base[1] as f64 * k,
+        base[2] as f64 * k,
+        base[3] as f64,
+    ]
+}
+
+/// `src` over `dst` (straight alpha source, opaque destination).
+pub fn over(src: [f64; 4], dst: [f64; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|c| src[3] * src[c] + (1.0 - src[3]) * dst[c])
+}
+
+/// 8-bit sRGB of a linear colour.
+pub fn srgb8(c: [f64; 3]) -> [u8; 3] {
+    c.map(|v| {
+        let v = v.clamp(0.0, 1.0);
+        let s = if v <= 0.0031308 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        (s * 255.0).round() as u8
+    })
+}
+
+/// The pixel at (x, y) of an RGBA8 image `SIZE` wide.
+pub fn pixel(rgba8: &[u8], x: u32, y: u32) -> [u8; 3] {
+    let i = ((y * SIZE + x) * 4) as usize;
+    [rgba8[i], rgba8[i + 1], rgba8[i + 2]]
+}
+
+/// Largest per-channel difference of two images.
+pub fn max_diff(a: &[u8], b: &[u8]) -> u8 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| x.abs_diff(*y))
+        .max()
+        .unwrap_or(0)
+}
+
+/// Asserts that two colours differ by at most `tol` per channel.
+pub fn assert_close(got: [u8; 3], want: [u8; 3], tol: u8, what: &str) {
+    let d = got
+        .iter()
+        .zip(want)
+        .map(|(a, b)| a.abs_diff(b))
+        .max()
+        .unwrap();
+    assert!(d <= tol, "{what}: got {got:?}, expected {want:?} (±{tol})");
+}

@@ -1,0 +1,50 @@
+// The player's entry points (composed after COMMON): the baked index buffer through the one
+// vertex transform and the one surface function. One pipeline for every material; the mode only
+// changes the fragment output (straight or premultiplied alpha) and the pipeline's blend and
+// depth state.
+
+struct PlayerVarying {
+    @invariant @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(flat) material: u32,
+    // Alpha from textures is evaluated at the pixel centre, as the recorder does.
+    @location(1) @interpolate(perspective, center) uv: vec2<f32>,
+    @location(2) normal: vec3<f32>,
+}
+
+@vertex
+fn vs_player(v: VertexIn) -> PlayerVarying {
+    var out: PlayerVarying;
+    out.position = transform_position(v.position, v.node);
+    out.material = v.material;
+    out.uv = v.uv;
+    out.normal = transform_normal(v.normal, v.node);
+    return out;
+}
+
+// Lit colour with straight alpha in [0, 1]; discards culled back faces and MASK cut-outs.
+fn player_colour(v: PlayerVarying, front_facing: bool) -> vec4<f32> {
+    if (culled(v.material, front_facing)) {
+        discard;
+    }
+    let base = surface_base(v.material, v.uv);
+    if (base.a < 0.0) {
+        discard;
+    }
+    let c = shade(v.material, base, v.normal, front_facing);
+    return vec4<f32>(c.rgb, clamp(c.a, 0.0, 1.0));
+}
+
+// `blend` and `depth`: straight alpha; the blend state composites over (src-alpha,
+// one-minus-src-alpha).
+@fragment
+fn fs_player_straight(v: PlayerVarying, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    return player_colour(v, front_facing);
+}
+
+// `saturate`: premultiplied alpha; the blend state composites under what is already drawn
+// (one-minus-dst-alpha, one).
+@fragment
+fn fs_player_premultiplied(v: PlayerVarying, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    let c = player_colour(v, front_facing);
+    return vec4<f32>(c.rgb * c.a, c.a);
+}
