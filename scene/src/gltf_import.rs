@@ -656,7 +656,8 @@ impl<'d> Importer<'d> {
             nodes,
             ..Geometry::default()
         };
-        let mut primitive_cache: HashMap<(usize, usize), PrimitiveData> = HashMap::new();
+        // Each primitive is read once (`None`: skipped, noted once) and instanced per node.
+        let mut primitive_cache: HashMap<(usize, usize), Option<PrimitiveData>> = HashMap::new();
         let mut skipped: BTreeMap<&'static str, Vec<String>> = BTreeMap::new();
         let mut zero_area_triangles = 0u64;
         for &n in &order {
@@ -688,6 +689,7 @@ impl<'d> Importer<'d> {
                             mesh_label(&mesh),
                             prim.index()
                         ));
+                        slot.insert(None);
                         continue;
                     }
                     let material = match prim.material().index() {
@@ -701,11 +703,14 @@ impl<'d> Importer<'d> {
                             (materials.len() - 1) as u32
                         }),
                     };
-                    let data = self.primitive(&mesh, &prim, material, uv_set[material as usize])?;
-                    let Some(data) = data else { continue };
-                    slot.insert(data);
+                    slot.insert(self.primitive(
+                        &mesh,
+                        &prim,
+                        material,
+                        uv_set[material as usize],
+                    )?);
                 }
-                let Some(data) = primitive_cache.get(&key) else {
+                let Some(Some(data)) = primitive_cache.get(&key) else {
                     continue;
                 };
                 zero_area_triangles += data.zero_area;
@@ -1055,9 +1060,25 @@ impl<'d> Importer<'d> {
         let mut morph_channels = 0;
         for anim in self.doc.animations() {
             let mut channels = Vec::new();
-            for ch in anim.channels() {
-                let target = ch.target();
-                let (property, shape) = match target.property() {
+            // Channel targets are not checked by gltf-json's validation (1.4.1) and
+            // `gltf::animation::Target` unwraps them: check them on the JSON first.
+            let json = &self.doc.as_json().animations[anim.index()];
+            for (ch, json_ch) in anim.channels().zip(&json.channels) {
+                let name = label("animation", anim.index(), anim.name());
+                let target_node = json_ch.target.node.value();
+                if target_node >= new_index.len() {
+                    return Err(self.malformed(format!(
+                        "{name} channel {} targets node {target_node}, which does not exist",
+                        ch.index()
+                    )));
+                }
+                let gltf::json::validation::Checked::Valid(path) = json_ch.target.path else {
+                    return Err(self.malformed(format!(
+                        "{name} channel {} has an unknown target path",
+                        ch.index()
+                    )));
+                };
+                let (property, shape) = match path {
                     gltf::animation::Property::Translation => {
                         (Property::Translation, Dimensions::Vec3)
                     }
@@ -1122,7 +1143,7 @@ impl<'d> Importer<'d> {
                     return Err(bad(&output, "output", "non-finite key value".into()));
                 }
                 channels.push(Channel {
-                    node: new_index[target.node().index()],
+                    node: new_index[target_node],
                     property,
                     interpolation,
                     times,

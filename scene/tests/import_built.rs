@@ -772,3 +772,148 @@ fn broken_structure_is_an_error() {
         eprintln!("{name}: {err}");
     }
 }
+
+/// A document that uses every feature the importer reads, for mutation tests.
+fn rich_document(b: &mut Builder) -> Value {
+    let (p, i) = tetrahedron();
+    let pos = b.vec3(&p);
+    let idx = b.indices(&i);
+    let normals = b.vec3(&p);
+    let uv = b.floats(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0], "VEC2", 4);
+    let strip = b.indices(&[0, 1, 2, 3]);
+    let sparse_idx = b.view(&1u8.to_le_bytes());
+    let sparse_val = b.view(&[0.5f32, 0.5, 0.5].map(f32::to_le_bytes).concat());
+    b.accessors[pos]["sparse"] = json!({
+        "count": 1,
+        "indices": {"bufferView": sparse_idx, "componentType": 5121},
+        "values": {"bufferView": sparse_val}
+    });
+    let times = b.floats(&[0.0, 1.0], "SCALAR", 2);
+    let rot = b.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0], "VEC4", 2);
+    let png = b.view(&tiny_png());
+    json!({
+        "scene": 0,
+        "scenes": [{"nodes": [0, 2]}],
+        "nodes": [
+            {"name": "root", "children": [1], "scale": [-1.0, 1.0, 1.0]},
+            {"name": "part", "mesh": 0, "translation": [0.0, 1.0, 0.0]},
+            {"name": "eye", "camera": 0, "rotation": [0.0, 0.0, 0.0, 1.0]}
+        ],
+        "meshes": [{"name": "m", "primitives": [
+            {"attributes": {"POSITION": pos, "NORMAL": normals, "TEXCOORD_0": uv},
+             "indices": idx, "material": 0},
+            {"attributes": {"POSITION": pos}, "indices": strip, "mode": 5}
+        ]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+                       "alphaMode": "MASK"}],
+        "textures": [{"source": 0}],
+        "images": [{"bufferView": png, "mimeType": "image/png"}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}],
+        "animations": [{"samplers": [{"input": times, "output": rot}],
+                        "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}}]}]
+    })
+}
+
+/// Every number of the JSON (document, views and accessors), replaced in turn by values that
+/// break indices, counts, offsets and strides: the import returns, with or without an error.
+#[test]
+fn every_json_number_mutated_never_panics() {
+    let mut b = Builder::default();
+    let doc = rich_document(&mut b);
+    let mut whole = serde_json::from_str::<Value>(&b.gltf(doc)).unwrap();
+    let scene = load_slice(whole.to_string().as_bytes(), Path::new("rich.gltf")).unwrap();
+    assert_eq!(scene.stats.triangles, 6);
+    assert_eq!(scene.animations.len(), 1);
+    assert_eq!(scene.cameras.len(), 1);
+    fn numbers(v: &Value, path: &mut Vec<String>, out: &mut Vec<Vec<String>>) {
+        match v {
+            Value::Number(_) => out.push(path.clone()),
+            Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    path.push(i.to_string());
+                    numbers(x, path, out);
+                    path.pop();
+                }
+            }
+            Value::Object(o) => {
+                for (k, x) in o {
+                    path.push(k.clone());
+                    numbers(x, path, out);
+                    path.pop();
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut paths = Vec::new();
+    numbers(&whole, &mut Vec::new(), &mut paths);
+    assert!(paths.len() > 60, "{} numbers", paths.len());
+    let mut rejected = 0;
+    for path in &paths {
+        let pointer = format!("/{}", path.join("/"));
+        let original = whole.pointer(&pointer).unwrap().clone();
+        for value in [
+            json!(0),
+            json!(1),
+            json!(3),
+            json!(13),
+            json!(1000),
+            json!(4294967295u64),
+            json!(-1),
+            json!(0.5),
+        ] {
+            *whole.pointer_mut(&pointer).unwrap() = value;
+            if load_slice(whole.to_string().as_bytes(), Path::new("m.gltf")).is_err() {
+                rejected += 1;
+            }
+        }
+        *whole.pointer_mut(&pointer).unwrap() = original;
+    }
+    assert!(
+        rejected > paths.len(),
+        "only {rejected} mutations were rejected"
+    );
+}
+
+/// Every member of every JSON object removed in turn, or replaced by a value of another type.
+#[test]
+fn every_json_member_removed_or_retyped_never_panics() {
+    let mut b = Builder::default();
+    let doc = rich_document(&mut b);
+    let whole = serde_json::from_str::<Value>(&b.gltf(doc)).unwrap();
+    fn members(v: &Value, path: &str, out: &mut Vec<(String, String)>) {
+        match v {
+            Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    members(x, &format!("{path}/{i}"), out);
+                }
+            }
+            Value::Object(o) => {
+                for (k, x) in o {
+                    out.push((path.to_string(), k.clone()));
+                    members(x, &format!("{path}/{k}"), out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut list = Vec::new();
+    members(&whole, "", &mut list);
+    assert!(list.len() > 50, "{} members", list.len());
+    let mut rejected = 0;
+    for (parent, key) in &list {
+        let replacements = [json!(null), json!("x"), json!([]), json!({}), json!(true)];
+        for edit in 0..=replacements.len() {
+            let mut doc = whole.clone();
+            let object = doc.pointer_mut(parent).unwrap().as_object_mut().unwrap();
+            match replacements.get(edit) {
+                Some(value) => object.insert(key.clone(), value.clone()),
+                None => object.remove(key),
+            };
+            if load_slice(doc.to_string().as_bytes(), Path::new("m.gltf")).is_err() {
+                rejected += 1;
+            }
+        }
+    }
+    assert!(rejected > list.len(), "only {rejected} edits were rejected");
+}
