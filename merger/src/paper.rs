@@ -194,11 +194,8 @@ fn remove_overlaps(cx: &Context<'_>, mut raw: Vec<Copy>) -> Vec<Copy> {
                     .collect();
             }
             for (a, b) in pieces {
-                let vis = &cx.visible_frames[t as usize];
-                let lo = vis.partition_point(|&f| f < a);
-                let hi = vis.partition_point(|&f| f <= b);
-                if lo < hi {
-                    taken.push((vis[lo], vis[hi - 1]));
+                if let Some(piece) = cx.trim(t, a, b) {
+                    taken.push(piece);
                 }
             }
         }

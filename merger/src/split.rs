@@ -54,17 +54,34 @@ impl Context<'_> {
         }
     }
 
-    /// The piece `[p, q]` of triangle `t` trimmed to its visible frames, if any.
-    fn trim(&self, t: u32, p: u32, q: u32) -> Option<(u32, u32)> {
+    /// The piece `[p, q]` of triangle `t` trimmed to its visible frames, then extended
+    /// inside `[p, q]` through the frames next to them where `t` has no fragment; `None` if
+    /// `t` is not visible in `[p, q]`.
+    ///
+    /// The extension is free: at those frames `t` has no fragment, so drawing it changes no
+    /// pixel and it has no edge (no order constraint), but a longer copy can share a cell
+    /// with more copies (the paper's ignore lists, §4.1).
+    pub(crate) fn trim(&self, t: u32, p: u32, q: u32) -> Option<(u32, u32)> {
         let vis = &self.visible_frames[t as usize];
         let a = vis.partition_point(|&f| f < p);
         let b = vis.partition_point(|&f| f <= q);
-        (a < b).then(|| (vis[a], vis[b - 1]))
+        if a >= b {
+            return None;
+        }
+        let (mut lo, mut hi) = (vis[a], vis[b - 1]);
+        while lo > p && !self.graphs[lo as usize - 1].is_covered(t) {
+            lo -= 1;
+        }
+        while hi < q && !self.graphs[hi as usize + 1].is_covered(t) {
+            hi += 1;
+        }
+        Some((lo, hi))
     }
 }
 
 /// Seeds: per triangle, maximal runs of its visible frames inside `seg` whose gaps are
-/// bridgeable. Sorted by (triangle, first frame).
+/// bridgeable, each extended through the neighbouring frames where the triangle has no
+/// fragment (see `Context::trim`). Sorted by (triangle, first frame).
 pub(crate) fn seed_intervals(cx: &Context<'_>, seg: Range<u32>) -> Vec<Copy> {
     let per_tri: Vec<Vec<Copy>> = (0..cx.visible_frames.len() as u32)
         .into_par_iter()
@@ -94,6 +111,28 @@ pub(crate) fn seed_intervals(cx: &Context<'_>, seg: Range<u32>) -> Vec<Copy> {
                     first: a,
                     last: b,
                 });
+            }
+            // Extend each run up to its neighbours: a gap between two runs holds a frame
+            // where t is covered, so the extensions never meet.
+            let bounds: Vec<(u32, u32)> = (0..out.len())
+                .map(|k| {
+                    let p = if k == 0 {
+                        seg.start
+                    } else {
+                        out[k - 1].last + 1
+                    };
+                    let q = if k + 1 == out.len() {
+                        seg.end - 1
+                    } else {
+                        out[k + 1].first - 1
+                    };
+                    (p, q)
+                })
+                .collect();
+            for (c, (p, q)) in out.iter_mut().zip(bounds) {
+                let (a, b) = cx.trim(t, p, q).expect("a run has a visible frame");
+                c.first = a;
+                c.last = b;
             }
             out
         })

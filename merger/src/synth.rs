@@ -145,18 +145,18 @@ fn identity() -> [f64; 16] {
 /// Parameters of [`turntable`].
 #[derive(Clone, Copy, Debug)]
 pub struct Turntable {
-    /// Scene triangles.
-    pub triangles: u32,
+    /// Objects on the turntable (closed polygons).
+    pub objects: u32,
+    /// Sides (triangles) per object.
+    pub sides: u32,
     /// Frames of the path.
     pub frames: u32,
     /// Samples across the one-dimensional image.
     pub samples: u32,
     /// Total camera turn in degrees over the path.
     pub degrees: f64,
-    /// Fraction of transparent triangles (opacity 0.5); the rest are opaque.
+    /// Fraction of transparent objects (opacity 0.5); the rest are opaque.
     pub transparent: f64,
-    /// Largest depth slope across a triangle (interpenetration makes intra-frame cycles).
-    pub tilt: f64,
     /// Random seed.
     pub seed: u64,
 }
@@ -164,12 +164,12 @@ pub struct Turntable {
 impl Default for Turntable {
     fn default() -> Self {
         Turntable {
-            triangles: 300,
+            objects: 12,
+            sides: 24,
             frames: 24,
             samples: 256,
             degrees: 90.0,
             transparent: 0.3,
-            tilt: 0.3,
             seed: 1,
         }
     }
@@ -192,47 +192,78 @@ impl Rng {
     }
 }
 
-/// Simulates the recorder on a turntable: triangles are short segments on a disc, the camera
-/// orbits it at distance 3 looking at the centre, and each of `samples` samples across the
-/// image peels the triangles covering it by (depth, id). V_f: triangles reached before the
-/// sample's opacity saturates (0.998); C_f: every triangle of G covering a sample; E_f:
-/// neighbours in the peel of G, weighted by samples. Deterministic in its parameters.
+/// Simulates the recorder on a turntable seen in one dimension: `objects` closed polygons of
+/// `sides` double-sided segments ("triangles", ids object-major) stand at random places on a
+/// disc (they may overlap and interpenetrate, which makes intra-frame cycles); the camera
+/// orbits the disc at distance 3 looking at its centre; each of `samples` rays peels the
+/// segments it hits by (depth, id). V_f: segments reached before the ray's opacity saturates
+/// (0.998); C_f: every segment of G the ray hits; E_f: neighbours in the peel of G, weighted
+/// by rays. Depth complexity is that of a few objects (2 per object), as in real scenes.
+/// Deterministic in its parameters.
 pub fn turntable(p: &Turntable) -> Recording {
-    struct Tri {
+    struct Object {
+        x: f64,
+        z: f64,
         radius: f64,
-        angle: f64,
-        half: f64,
-        tilt: f64,
+        phase: f64,
         opacity: f64,
     }
     let mut rng = Rng(p.seed);
-    let tris: Vec<Tri> = (0..p.triangles)
-        .map(|_| Tri {
-            radius: 0.1 + 0.9 * rng.unit().sqrt(),
-            angle: rng.unit() * std::f64::consts::TAU,
-            half: 0.01 + 0.08 * rng.unit(),
-            tilt: p.tilt * (2.0 * rng.unit() - 1.0),
-            opacity: if rng.unit() < p.transparent { 0.5 } else { 1.0 },
+    let objects: Vec<Object> = (0..p.objects)
+        .map(|_| {
+            let r = 0.9 * rng.unit().sqrt();
+            let a = rng.unit() * std::f64::consts::TAU;
+            Object {
+                x: r * a.cos(),
+                z: r * a.sin(),
+                radius: 0.08 + 0.2 * rng.unit(),
+                phase: rng.unit(),
+                opacity: if rng.unit() < p.transparent { 0.5 } else { 1.0 },
+            }
         })
         .collect();
-    let focal = 2.2;
-    // Per frame and sample: the peel (depth, id) of the covering triangles.
+    let n = p.objects * p.sides;
+    let opacity = |t: u32| objects[(t / p.sides) as usize].opacity;
+    let focal = 2.0;
+    // Per frame and sample: the peel of the segments the ray hits, by (depth, id).
     let peel = |f: u32| -> Vec<Vec<u32>> {
-        let theta = (p.degrees * f as f64 / p.frames.max(2).saturating_sub(1) as f64).to_radians();
+        let theta = (p.degrees * f as f64 / (p.frames.max(2) - 1) as f64).to_radians();
+        let (sn, cs) = theta.sin_cos();
+        let to_camera = |x: f64, z: f64| (x * cs - z * sn, 3.0 + x * sn + z * cs);
         let mut per_sample: Vec<Vec<(f64, u32)>> = vec![Vec::new(); p.samples as usize];
-        for (t, tr) in tris.iter().enumerate() {
-            let phi = tr.angle - theta;
-            let x = tr.radius * phi.sin();
-            let z = 3.0 - tr.radius * phi.cos();
-            let u = focal * x / z;
-            let hw = focal * tr.half / z;
-            let s_of = |u: f64| (u + 1.0) / 2.0 * p.samples as f64 - 0.5;
-            let lo = s_of(u - hw).ceil().max(0.0) as i64;
-            let hi = s_of(u + hw).floor().min(p.samples as f64 - 1.0) as i64;
-            for s in lo..=hi {
-                let us = (s as f64 + 0.5) / p.samples as f64 * 2.0 - 1.0;
-                let depth = z + tr.tilt * (us - u) * z / focal;
-                per_sample[s as usize].push((depth, t as u32));
+        for (o, ob) in objects.iter().enumerate() {
+            let (cx, cz) = to_camera(ob.x, ob.z);
+            // Screen interval of the object's bounding circle.
+            let s_of =
+                |u: f64| ((u + 1.0) / 2.0 * p.samples as f64 - 0.5).clamp(-1.0, p.samples as f64);
+            let lo = s_of(focal * (cx - ob.radius) / (cz - ob.radius))
+                .floor()
+                .max(0.0) as u32;
+            let hi = s_of(focal * (cx + ob.radius) / (cz - ob.radius))
+                .ceil()
+                .min(p.samples as f64 - 1.0) as u32;
+            let corner = |k: u32| {
+                let a = (k as f64 / p.sides as f64 + ob.phase) * std::f64::consts::TAU;
+                to_camera(ob.x + ob.radius * a.cos(), ob.z + ob.radius * a.sin())
+            };
+            for k in 0..p.sides {
+                let (ax, az) = corner(k);
+                let (bx, bz) = corner(k + 1);
+                let t = o as u32 * p.sides + k;
+                for smp in lo..=hi {
+                    let kk = ((smp as f64 + 0.5) / p.samples as f64 * 2.0 - 1.0) / focal;
+                    let den = (bx - ax) - kk * (bz - az);
+                    if den.abs() < 1e-12 {
+                        continue;
+                    }
+                    let sp = (kk * az - ax) / den;
+                    if (0.0..1.0).contains(&sp) {
+                        let depth = az + sp * (bz - az);
+                        if depth > 0.1 {
+                            per_sample[smp as usize].push((depth, t));
+                        }
+                    }
+                }
             }
         }
         per_sample
@@ -253,7 +284,7 @@ pub fn turntable(p: &Turntable) -> Recording {
                     break;
                 }
                 vis.push(t);
-                transmit *= 1.0 - tris[t as usize].opacity;
+                transmit *= 1.0 - opacity(t);
             }
         }
         vis.sort_unstable();
@@ -295,15 +326,15 @@ pub fn turntable(p: &Turntable) -> Recording {
             }
         })
         .collect();
-    let mut rec = recording_from_frames(p.triangles, &specs);
+    let mut rec = recording_from_frames(n, &specs);
     let mut id = Vec::new();
     for x in [
-        p.triangles as u64,
+        p.objects as u64,
+        p.sides as u64,
         p.frames as u64,
         p.samples as u64,
         p.seed,
         p.degrees.to_bits(),
-        p.tilt.to_bits(),
     ] {
         id.extend_from_slice(&x.to_le_bytes());
     }

@@ -172,7 +172,8 @@ fn camera_turning_180_degrees_forces_splits() {
 #[test]
 fn turntable_half_turn_validates() {
     let rec = turntable(&Turntable {
-        triangles: 60,
+        objects: 6,
+        sides: 8,
         frames: 10,
         samples: 64,
         degrees: 180.0,
@@ -264,7 +265,8 @@ fn order_through_an_undrawn_triangle() {
 #[test]
 fn validator_catches_mutations() {
     let rec = turntable(&Turntable {
-        triangles: 80,
+        objects: 8,
+        sides: 10,
         frames: 8,
         samples: 96,
         degrees: 60.0,
@@ -349,7 +351,8 @@ fn validator_catches_mutations() {
     assert!(!check_graph(recs, &bad).ok);
     // A different recording.
     let other = turntable(&Turntable {
-        triangles: 80,
+        objects: 8,
+        sides: 10,
         frames: 8,
         samples: 96,
         degrees: 60.0,
@@ -364,7 +367,8 @@ fn validator_catches_mutations() {
 #[test]
 fn deterministic_across_thread_counts() {
     let rec = turntable(&Turntable {
-        triangles: 120,
+        objects: 10,
+        sides: 12,
         frames: 12,
         samples: 96,
         degrees: 120.0,
@@ -390,7 +394,8 @@ fn deterministic_across_thread_counts() {
 #[test]
 fn mismatched_recordings_are_refused() {
     let rec = turntable(&Turntable {
-        triangles: 40,
+        objects: 4,
+        sides: 10,
         frames: 6,
         samples: 64,
         ..Turntable::default()

@@ -1,0 +1,78 @@
+//! Benchmark (not a test): merges synthetic turntable recordings with every strategy, layout
+//! and seeding and prints the merge figures and times.
+//!
+//! `cargo run --release -p trisort-merger --example synth_bench -- [objects] [frames] [degrees] [segment] [lib|all]`
+
+use std::time::Instant;
+
+use trisort_merger::synth::{turntable, Turntable};
+use trisort_merger::{merge, Bridge, LayoutChoice, MergeOptions, Seeding, StrategyChoice};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let arg = |k: usize, d: f64| args.get(k).and_then(|s| s.parse().ok()).unwrap_or(d);
+    let p = Turntable {
+        objects: arg(0, 40.0) as u32,
+        sides: 32,
+        frames: arg(1, 24.0) as u32,
+        samples: 512,
+        degrees: arg(2, 90.0),
+        ..Turntable::default()
+    };
+    let segment = args.get(3).and_then(|s| s.parse().ok());
+    let only_lib = args.get(4).is_some_and(|s| s == "lib");
+    let t0 = Instant::now();
+    let rec = turntable(&p);
+    let vis: usize = rec.frames.iter().map(|f| f.visible.len()).sum();
+    println!(
+        "turntable {p:?}: |G| = {}, sum |V_f| = {vis}, generated in {:.2} s",
+        rec.unique_visible.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    println!("seeding  bridge  strategy layout  | index/|G| draws mean  max | drawn-not-vis unordered | seconds");
+    let strategies = if only_lib {
+        vec![StrategyChoice::Lib]
+    } else {
+        vec![
+            StrategyChoice::Lib,
+            StrategyChoice::Lbi,
+            StrategyChoice::Ilb,
+            StrategyChoice::Ibl,
+            StrategyChoice::Bli,
+            StrategyChoice::Bil,
+        ]
+    };
+    for seeding in [Seeding::Interval, Seeding::Paper] {
+        for bridge in [Bridge::Hidden, Bridge::Ignored] {
+            for &strategy in &strategies {
+                for layout in [LayoutChoice::Paper, LayoutChoice::Compact] {
+                    let opts = MergeOptions {
+                        strategy,
+                        layout,
+                        bridge,
+                        seeding,
+                        segment,
+                        ..MergeOptions::default()
+                    };
+                    let t = Instant::now();
+                    let b = merge(std::slice::from_ref(&rec), &opts).expect("merge");
+                    let secs = t.elapsed().as_secs_f64();
+                    let s = &b.stats;
+                    println!(
+                        "{:8} {:7} {:8} {:7} | {:9.3} {:10.1} {:4} | {:13.1} {:9} | {:.3}",
+                        seeding.name(),
+                        bridge.name(),
+                        b.merge.strategy,
+                        b.merge.layout,
+                        s.index_triangles as f64 / s.unique_visible as f64,
+                        s.draws_per_frame_mean,
+                        s.draws_per_frame_max,
+                        s.drawn_not_visible_mean,
+                        s.unordered_samples,
+                        secs
+                    );
+                }
+            }
+        }
+    }
+}
