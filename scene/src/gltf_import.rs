@@ -41,11 +41,22 @@
 //!
 //! # Errors
 //!
-//! Nothing in a file makes the importer panic: the GLB container and every accessor are
-//! bounds-checked here (the `gltf` crate is used for JSON parsing, validation and document
-//! navigation only; its accessor readers can panic on hostile data and are not used). Skins,
-//! morph targets, NaN or infinite positions, node cycles, missing buffers and undecodable
-//! base-colour images are errors; see [`SceneError`].
+//! No file should make the importer panic, and no `catch_unwind` hides one: the GLB container
+//! and every accessor are parsed and bounds-checked here. The `gltf` crate is used for JSON
+//! parsing, validation and document navigation only: its accessor readers and GLB parser can
+//! panic on hostile data and are not used, and where its validation leaves gaps that its
+//! navigation then unwraps (POSITION indices, animation channel targets, image sources, camera
+//! parameters, in gltf 1.4.1) the JSON is checked or read directly. The tests mutate every byte
+//! of a GLB and every number and member of a rich document to hold this.
+//!
+//! Errors: a skin on a node of the scene, morph targets on a mesh of the scene, NaN or infinite
+//! positions, node cycles or nodes with two parents, accessors outside their data, missing or
+//! short buffers, and base-colour images that cannot be read or decoded; see [`SceneError`].
+//! Meshes outside the imported scene are not read, so they cannot fail the import; all nodes,
+//! materials, base-colour images and animations are.
+//!
+//! `stats.materials` counts the file's materials (not the appended default one);
+//! `stats.primitives` counts the triangle primitives of all meshes of the file, once per mesh.
 
 use std::borrow::Cow;
 use std::collections::hash_map::Entry;
@@ -91,6 +102,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 /// [`load`].
 pub fn load_slice(bytes: &[u8], file: &Path) -> Result<Scene, SceneError> {
     let (json, bin) = split_container(bytes, file)?;
+    let json = json.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json);
     let root = gltf::json::Root::from_slice(json).map_err(|e| SceneError::Malformed {
         file: file.to_path_buf(),
         problem: format!("invalid JSON: {e}"),
