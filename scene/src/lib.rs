@@ -161,7 +161,9 @@ mod error;
 pub mod export;
 pub mod gltf_import;
 
+pub use demo_car::{demo_car, DEFAULT_TRIANGLES, DOOR_NODE, DOOR_WINDOW_NODE};
 pub use error::SceneError;
+pub use export::{export_glb, ExportError};
 pub use gltf_import::{load, load_slice};
 
 /// Environment variable naming the folder of the shared test scenes.

@@ -418,3 +418,204 @@ fn windows_are_seen_through_each_other_and_show_the_interior() {
     let names: Vec<&str> = hits.iter().map(|h| name(h.1)).collect();
     assert_eq!(names[..2], [GLASS_MATERIAL, "seat"], "{names:?}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// glTF export.
+
+use trisort_scene::export::{export_glb, ExportError};
+
+/// Triangles of the default scene, counted through node instances.
+fn gltf_triangles(node: gltf::Node, buffers: &[gltf::buffer::Data]) -> usize {
+    let own = node.mesh().map_or(0, |mesh| {
+        mesh.primitives()
+            .map(|p| {
+                assert_eq!(p.mode(), gltf::mesh::Mode::Triangles);
+                let reader = p.reader(|b| Some(&buffers[b.index()]));
+                let n = reader.read_indices().expect("indexed").into_u32().count();
+                assert_eq!(n % 3, 0);
+                n / 3
+            })
+            .sum()
+    });
+    own + node
+        .children()
+        .map(|c| gltf_triangles(c, buffers))
+        .sum::<usize>()
+}
+
+#[test]
+fn exported_car_is_valid_gltf() {
+    let car = demo_car(DEFAULT_TRIANGLES);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("car.glb");
+    export_glb(&car, &path).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+
+    // GLB framing: header, 4-byte aligned JSON and BIN chunks.
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[..4], b"glTF");
+    assert_eq!(word(4), 2);
+    assert_eq!(word(8), bytes.len());
+    let json_len = word(12);
+    assert_eq!(&bytes[16..20], b"JSON");
+    assert_eq!(json_len % 4, 0);
+    let bin_at = 20 + json_len;
+    assert_eq!(&bytes[bin_at + 4..bin_at + 8], b"BIN\0");
+    assert_eq!(word(bin_at) % 4, 0);
+    assert_eq!(bin_at + 8 + word(bin_at), bytes.len());
+
+    let (doc, buffers, images) = gltf::import(&path).expect("gltf crate reads the export");
+    let scene = doc.default_scene().expect("a default scene");
+    let triangles: usize = scene.nodes().map(|n| gltf_triangles(n, &buffers)).sum();
+    assert_eq!(triangles, car.geometry.triangles.len());
+    // One mesh per (node, material) group, POSITION bounds on every primitive.
+    let mut groups = std::collections::BTreeSet::new();
+    for v in &car.geometry.vertices {
+        groups.insert((v.node, v.material));
+    }
+    assert_eq!(doc.meshes().count(), groups.len());
+    for mesh in doc.meshes() {
+        for p in mesh.primitives() {
+            let pos = p.get(&gltf::Semantic::Positions).unwrap();
+            assert!(pos.min().is_some() && pos.max().is_some());
+            assert!(p.get(&gltf::Semantic::Normals).is_some());
+        }
+    }
+    // Materials: glass through KHR_materials_transmission, listed as used.
+    assert!(doc
+        .extensions_used()
+        .any(|e| e == "KHR_materials_transmission"));
+    let glass: Vec<_> = doc
+        .materials()
+        .filter(|m| m.transmission().is_some())
+        .collect();
+    assert_eq!(glass.len(), 1);
+    assert_eq!(glass[0].transmission().unwrap().transmission_factor(), 1.0);
+    assert_eq!(glass[0].alpha_mode(), gltf::material::AlphaMode::Blend);
+    assert!(glass[0].double_sided());
+    // The texture round-trips texel for texel and is used with TEXCOORD_0.
+    assert_eq!(images.len(), 1);
+    let tex = &car.geometry.textures[0];
+    assert_eq!((images[0].width, images[0].height), (tex.width, tex.height));
+    assert_eq!(images[0].format, gltf::image::Format::R8G8B8A8);
+    assert_eq!(images[0].pixels, tex.rgba8);
+    let textured = doc
+        .materials()
+        .find(|m| m.pbr_metallic_roughness().base_color_texture().is_some())
+        .expect("a textured material");
+    assert!(doc
+        .meshes()
+        .flat_map(|m| m.primitives().collect::<Vec<_>>())
+        .any(|p| {
+            p.material().index() == textured.index()
+                && p.get(&gltf::Semantic::TexCoords(0)).is_some()
+        }));
+    // The door hierarchy, with the hinge transform.
+    let door = doc
+        .nodes()
+        .find(|n| n.name() == Some(DOOR_NODE))
+        .expect("door node");
+    assert!(door.children().any(|c| c.name() == Some(DOOR_WINDOW_NODE)));
+    let rest = &car.geometry.nodes[car.node_by_name(DOOR_NODE).unwrap() as usize].rest;
+    let (t, _, _) = door.transform().decomposed();
+    assert!((f64::from(t[0]) - rest[12]).abs() < 1e-6);
+}
+
+#[test]
+fn export_is_deterministic() {
+    let car = demo_car(10_000);
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.glb"), dir.path().join("b.glb"));
+    export_glb(&car, &a).unwrap();
+    export_glb(&car, &b).unwrap();
+    assert_eq!(std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
+}
+
+#[test]
+fn exported_car_round_trips_through_the_importer() {
+    let car = demo_car(DEFAULT_TRIANGLES);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("car.glb");
+    export_glb(&car, &path).unwrap();
+    let back = trisort_scene::load(&path).expect("the importer reads the export");
+    assert_eq!(back.stats.triangles, car.stats.triangles);
+    assert_eq!(back.geometry.triangles.len(), car.geometry.triangles.len());
+    assert_eq!(back.stats.zero_area_triangles, 0);
+    let door = back.node_by_name(DOOR_NODE).expect("door node");
+    let window = back
+        .node_by_name(DOOR_WINDOW_NODE)
+        .expect("door window node");
+    assert_eq!(back.geometry.nodes[window as usize].parent, Some(door));
+    assert!(back
+        .geometry
+        .materials
+        .iter()
+        .any(|m| m.name == GLASS_MATERIAL && m.transmission > 0.0 && m.double_sided));
+    assert_eq!(back.geometry.textures.len(), 1);
+    assert_eq!(
+        back.geometry.textures[0].rgba8,
+        car.geometry.textures[0].rgba8
+    );
+    let ((lo_a, hi_a), (lo_b, hi_b)) = (car.bounds().unwrap(), back.bounds().unwrap());
+    assert!(lo_a.distance(lo_b) < 1e-5 && hi_a.distance(hi_b) < 1e-5);
+    // The door's triangles still move with the door.
+    let moved = |s: &Scene| {
+        (0..s.geometry.triangles.len() as u32)
+            .filter(|&t| {
+                let mut n = Some(s.geometry.triangle_node(t));
+                while let Some(k) = n {
+                    if k == s.node_by_name(DOOR_NODE).unwrap() {
+                        return true;
+                    }
+                    n = s.geometry.nodes[k as usize].parent;
+                }
+                false
+            })
+            .count()
+    };
+    assert_eq!(moved(&back), moved(&car));
+}
+
+#[test]
+fn export_writes_emissive_strength_and_mask_cutoff() {
+    let mut car = demo_car(10_000);
+    car.geometry.materials[0].emissive = [4.0, 2.0, 0.0];
+    car.geometry.materials[2].alpha_mode = trisort_format::AlphaMode::Mask;
+    car.geometry.materials[2].alpha_cutoff = 0.25;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("e.glb");
+    export_glb(&car, &path).unwrap();
+    let (doc, _, _) = gltf::import(&path).unwrap();
+    let m0 = doc.materials().next().unwrap();
+    assert_eq!(m0.emissive_factor(), [1.0, 0.5, 0.0]);
+    assert_eq!(m0.emissive_strength(), Some(4.0));
+    assert!(doc
+        .extensions_used()
+        .any(|e| e == "KHR_materials_emissive_strength"));
+    let m2 = doc.materials().nth(2).unwrap();
+    assert_eq!(m2.alpha_mode(), gltf::material::AlphaMode::Mask);
+    assert_eq!(m2.alpha_cutoff(), Some(0.25));
+}
+
+#[test]
+fn export_errors_name_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut car = demo_car(10_000);
+    let path = dir.path().join("bad.glb");
+    car.geometry.triangles[7][1] = u32::MAX;
+    let err = export_glb(&car, &path).unwrap_err();
+    assert!(matches!(err, ExportError::InvalidScene { .. }), "{err}");
+    assert!(err.to_string().contains("bad.glb") && err.to_string().contains("triangle 7"));
+    assert!(!path.exists());
+
+    let mut car = demo_car(10_000);
+    car.geometry.textures[0].rgba8.pop();
+    let err = export_glb(&car, &path).unwrap_err();
+    assert!(matches!(err, ExportError::Png { texture: 0, .. }), "{err}");
+
+    let car = demo_car(10_000);
+    let missing = dir.path().join("no such dir").join("car.glb");
+    let err = export_glb(&car, &missing).unwrap_err();
+    assert!(matches!(err, ExportError::Write { .. }), "{err}");
+    assert!(err.to_string().contains("car.glb"));
+}
