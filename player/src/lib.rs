@@ -3,8 +3,9 @@
 //! A [`Baked`](trisort_format::Baked) file holds one sorted index buffer (front to back) and,
 //! per frame, a window of indirect draws over it. [`Player::new`] uploads everything once;
 //! [`Player::draw`] binds the frame's uniforms by dynamic offset and issues exactly one
-//! `multi_draw_indexed_indirect` into the caller's render pass (or, on adapters without
-//! `DownlevelFlags::INDIRECT_EXECUTION`, the same ranges one `draw_indexed` at a time).
+//! `multi_draw_indexed_indirect` into the caller's render pass (none for an empty window; on
+//! adapters without `DownlevelFlags::INDIRECT_EXECUTION`, the same ranges one `draw_indexed`
+//! at a time).
 //!
 //! Modes ([`Mode`]) and their blend equations (`s` the fragment, `d` the target):
 //! - `blend`: back to front (the reversed index buffer and draw lists), no depth test, *over*

@@ -147,7 +147,8 @@ impl Player {
     /// Draws frame `frame` into `pass`: binds the pipeline, the frame's uniforms and node
     /// matrices (dynamic offsets), the vertex and index buffers, and issues exactly one
     /// `multi_draw_indexed_indirect` over the frame's window, or, on the
-    /// [`DrawPath::Direct`] path, one `draw_indexed` per range of the window.
+    /// [`DrawPath::Direct`] path, one `draw_indexed` per range of the window. A frame whose
+    /// window is empty issues no draw.
     ///
     /// The pass's attachments must match the [`PlayerConfig`] (formats, sample count); in
     /// `saturate` mode its colour must have been cleared to alpha 0.
@@ -163,6 +164,10 @@ impl Player {
         pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
         pass.set_index_buffer(self.index_buffer.slice(..), self.index_format);
         match self.config.draw_path {
+            // An empty window draws nothing. It issues no call: wgpu 30.0.1 with indirect
+            // validation on draws the first command even when `count` is 0 (wgpu-core
+            // `multi_draw_indirect` adds the command at `offset` before looping to `count`).
+            _ if window.count == 0 => {}
             DrawPath::MultiDrawIndirect => pass.multi_draw_indexed_indirect(
                 &self.indirect,
                 window.first as u64 * ARGS_SIZE,

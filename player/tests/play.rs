@@ -518,3 +518,44 @@ fn pipeline_statistics_count_exactly_the_windows_triangles() {
         );
     }
 }
+
+#[test]
+fn back_faces_mask_cut_outs_and_an_empty_frame() {
+    let Some(gpu) = gpu() else { return };
+    let baked = faces();
+    baked.check_structure().unwrap();
+    let bg = srgb8(BACKGROUND.map(|c| c as f64));
+    for mode in Mode::ALL {
+        let r = HeadlessRenderer::new(&gpu, &baked, &headless(mode, 1)).unwrap();
+        // An empty window issues no draw (wgpu 30 with indirect validation would draw one
+        // command for a multi-draw of count 0) and the frame shows only the background.
+        let mut log = CallLog::default();
+        r.player().draw(&mut log, 0).unwrap();
+        assert!(log.draws().is_empty(), "{mode}: {:?}", log.draws());
+        let f0 = r.render(0).unwrap().rgba8;
+        assert!(
+            f0.chunks(4).all(|p| p[..3] == bg),
+            "{mode}: frame 0 is background only"
+        );
+        let f1 = r.render(1).unwrap().rgba8;
+        assert_close(
+            pixel(&f1, 5, 7),
+            bg,
+            0,
+            &format!("{mode}: single-sided back face culled"),
+        );
+        assert_close(
+            pixel(&f1, 15, 7),
+            srgb8(lit([0.0, 1.0, 0.0, 1.0])[..3].try_into().unwrap()),
+            1,
+            &format!("{mode}: double-sided back face lit with its normal flipped"),
+        );
+        assert_close(
+            pixel(&f1, 6, 23),
+            srgb8(lit(YELLOW)[..3].try_into().unwrap()),
+            1,
+            &format!("{mode}: mask kept (opaque)"),
+        );
+        assert_close(pixel(&f1, 25, 23), bg, 0, &format!("{mode}: mask cut"));
+    }
+}

@@ -207,3 +207,85 @@ pub fn assert_close(got: [u8; 3], want: [u8; 3], tol: u8, what: &str) {
         .unwrap();
     assert!(d <= tol, "{what}: got {got:?}, expected {want:?} (±{tol})");
 }
+
+/// A quad in the plane z whose front face looks away from the camera (clockwise as seen from
+/// +Z, normal −Z), uv running 0 → 1 from x0 to x1.
+fn back_quad(g: &mut Geometry, x0: f32, y0: f32, x1: f32, y1: f32, z: f32, material: u32) {
+    let base = g.vertices.len() as u32;
+    for (x, y) in [(x0, y0), (x0, y1), (x1, y1), (x1, y0)] {
+        g.vertices.push(Vertex {
+            position: [x, y, z],
+            normal: [0.0, 0.0, -1.0],
+            uv: [(x - x0) / (x1 - x0), (y - y0) / (y1 - y0)],
+            material,
+            node: 0,
+        });
+    }
+    g.triangles.push([base, base + 1, base + 2]);
+    g.triangles.push([base, base + 2, base + 3]);
+}
+
+/// Yellow base colour of the masked quad (its texture is white, alpha 1 on the left texel and
+/// 0 on the right one).
+pub const YELLOW: [f32; 4] = [1.0, 1.0, 0.0, 1.0];
+
+/// Culling and alpha cut-outs, and an empty frame. Three quads at z = 0, none overlapping:
+/// - A (triangles 0, 1): single-sided red, seen from the back → culled; x ∈ [−0.9, −0.4],
+///   y ∈ [0.2, 0.8];
+/// - B (2, 3): double-sided green, seen from the back → drawn; x ∈ [−0.3, 0.2], same y;
+/// - C (4, 5): MASK yellow × a 2×1 texture whose right texel is transparent → only the left
+///   half stays; x ∈ [−0.9, 0.9], y ∈ [−0.8, −0.2].
+///
+/// Frame 0 draws nothing (an empty window); frame 1 draws all three.
+pub fn faces() -> Baked {
+    let mut b = quads();
+    let mut g = Geometry {
+        materials: vec![
+            material([1.0, 0.0, 0.0, 1.0], AlphaMode::Opaque),
+            Material {
+                double_sided: true,
+                ..material([0.0, 1.0, 0.0, 1.0], AlphaMode::Opaque)
+            },
+            Material {
+                base_color_texture: Some(0),
+                alpha_cutoff: 0.5,
+                ..material(YELLOW, AlphaMode::Mask)
+            },
+        ],
+        textures: vec![trisort_format::Texture {
+            name: "half".into(),
+            width: 2,
+            height: 1,
+            rgba8: vec![255, 255, 255, 255, 255, 255, 255, 0],
+        }],
+        nodes: b.geometry.nodes.clone(),
+        ..Default::default()
+    };
+    back_quad(&mut g, -0.9, 0.2, -0.4, 0.8, 0.0, 0);
+    back_quad(&mut g, -0.3, 0.2, 0.2, 0.8, 0.0, 1);
+    // C faces the camera.
+    let base = g.vertices.len() as u32;
+    let (x0, y0, x1, y1) = (-0.9f32, -0.8f32, 0.9f32, -0.2f32);
+    for (x, y) in [(x0, y0), (x1, y0), (x1, y1), (x0, y1)] {
+        g.vertices.push(Vertex {
+            position: [x, y, 0.0],
+            normal: [0.0, 0.0, 1.0],
+            uv: [(x - x0) / (x1 - x0), (y - y0) / (y1 - y0)],
+            material: 2,
+            node: 0,
+        });
+    }
+    g.triangles.push([base, base + 1, base + 2]);
+    g.triangles.push([base, base + 2, base + 3]);
+    b.scene_ids = (0..6).collect();
+    b.geometry = g;
+    b.copies = (0..6).collect();
+    b.draws = vec![args(0, 18)];
+    b.frames = vec![
+        FrameWindow { first: 0, count: 0 },
+        FrameWindow { first: 0, count: 1 },
+    ];
+    b.frame_states = vec![frame_state(); 2];
+    b.removed_edges = vec![vec![]; 2];
+    b
+}
