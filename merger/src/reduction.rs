@@ -72,19 +72,21 @@ mod tests {
 
     /// Reachability of every pair, by DFS.
     fn closure(n: usize, edges: &[(u32, u32)]) -> Vec<Vec<bool>> {
-        let mut r = vec![vec![false; n]; n];
-        for s in 0..n {
-            let mut stack = vec![s];
-            while let Some(v) = stack.pop() {
-                for &(a, b) in edges {
-                    if a as usize == v && !r[s][b as usize] {
-                        r[s][b as usize] = true;
-                        stack.push(b as usize);
+        (0..n)
+            .map(|s| {
+                let mut row = vec![false; n];
+                let mut stack = vec![s];
+                while let Some(v) = stack.pop() {
+                    for &(a, b) in edges {
+                        if a as usize == v && !row[b as usize] {
+                            row[b as usize] = true;
+                            stack.push(b as usize);
+                        }
                     }
                 }
-            }
-        }
-        r
+                row
+            })
+            .collect()
     }
 
     proptest! {

@@ -140,6 +140,9 @@ pub(crate) fn seed_intervals(cx: &Context<'_>, seg: Range<u32>) -> Vec<Copy> {
     per_tri.into_iter().flatten().collect()
 }
 
+/// The pieces `(first, last)` a copy is split into.
+type Pieces = Vec<(u32, u32)>;
+
 /// The split copies of one segment.
 pub(crate) struct Splitting {
     /// Final copies (rules 1–3 hold for them with the segment's cell order).
@@ -254,7 +257,7 @@ fn find_conflicts(
 /// The pieces the splits of copy `c` considered for a conflict at frames `lo..=hi` can leave,
 /// each trimmed: keep; cut before lo; cut after hi; both (isolating lo..=hi); cut after lo;
 /// isolate lo; and, where `c.t` is not visible there, drop lo..=hi or drop lo.
-fn split_options(cx: &Context<'_>, c: Copy, lo: u32, hi: u32) -> Vec<Vec<(u32, u32)>> {
+fn split_options(cx: &Context<'_>, c: Copy, lo: u32, hi: u32) -> Vec<Pieces> {
     let trim = |p: u32, q: u32| if p > q { None } else { cx.trim(c.t, p, q) };
     let (a, b) = (c.first, c.last);
     let pieces = |cuts: &[(u32, u32)]| -> Vec<(u32, u32)> {
@@ -309,7 +312,7 @@ fn fix_conflict(
     x: Copy,
     y: Copy,
     frames: &[u32],
-) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
+) -> (Pieces, Pieces) {
     let (lo, hi) = (frames[0], *frames.last().expect("a conflict has a frame"));
     let at =
         |pieces: &[(u32, u32)], f: u32| pieces.iter().copied().find(|&(a, b)| a <= f && f <= b);

@@ -1,0 +1,71 @@
+//! Long synthetic paths: draws per frame stay bounded, cells stay sparse, and the result
+//! still validates.
+
+use trisort_merger::synth::{turntable, Turntable};
+use trisort_merger::{merge, LayoutChoice, MergeOptions, StrategyChoice};
+use trisort_verify::check_graph;
+
+fn ibl_compact(segment: Option<u32>) -> MergeOptions {
+    MergeOptions {
+        strategy: StrategyChoice::Ibl,
+        layout: LayoutChoice::Compact,
+        segment,
+        ..MergeOptions::default()
+    }
+}
+
+/// 1,000 frames (a full turn) in one matrix.
+#[test]
+fn thousand_frames_merge_with_bounded_draws() {
+    let rec = turntable(&Turntable {
+        objects: 12,
+        sides: 16,
+        frames: 1000,
+        samples: 128,
+        degrees: 360.0,
+        ..Turntable::default()
+    });
+    let t = std::time::Instant::now();
+    let baked = merge(std::slice::from_ref(&rec), &ibl_compact(None)).unwrap();
+    let secs = t.elapsed().as_secs_f64();
+    let report = check_graph(std::slice::from_ref(&rec), &baked);
+    assert!(report.ok, "{:?}", report.problems);
+    let s = &baked.stats;
+    eprintln!("1,000 frames: {s:?}, cells {}, {secs:.2} s", baked.merge.cells.len());
+    assert!(s.unique_visible <= s.index_triangles && s.index_triangles <= s.source_triangles);
+    // A window is a set of cells; merged ranges can never outnumber the frame's cells, and
+    // the compact layout bounds them by max(f+1, F−f). Far fewer are used in practice.
+    let worst_cells = (0..1000u32)
+        .map(|f| baked.merge.cells.iter().filter(|c| c.first_frame <= f && f <= c.last_frame).count())
+        .max()
+        .unwrap() as u32;
+    assert!(s.draws_per_frame_max <= worst_cells.min(1000));
+    assert!(s.draws_per_frame_max <= 100, "draws per frame {}", s.draws_per_frame_max);
+}
+
+/// 10,000 frames in segments of 100: every segment has its own matrix.
+#[test]
+fn ten_thousand_frames_in_segments() {
+    let rec = turntable(&Turntable {
+        objects: 6,
+        sides: 12,
+        frames: 10_000,
+        samples: 64,
+        degrees: 3600.0,
+        ..Turntable::default()
+    });
+    let t = std::time::Instant::now();
+    let baked = merge(std::slice::from_ref(&rec), &ibl_compact(Some(100))).unwrap();
+    let secs = t.elapsed().as_secs_f64();
+    let s = &baked.stats;
+    eprintln!("10,000 frames: {s:?}, cells {}, {secs:.2} s", baked.merge.cells.len());
+    assert!(s.index_triangles <= s.source_triangles);
+    // No cell crosses a segment boundary, and a window never holds more ranges than its
+    // segment's compact bound.
+    assert!(baked.merge.cells.iter().all(|c| c.first_frame / 100 == c.last_frame / 100 && c.triangles > 0));
+    assert!(s.draws_per_frame_max <= 100);
+    // Sparse: far fewer cells than the 100 · 5,050 of full matrices.
+    assert!(baked.merge.cells.len() < 100 * 5050 / 20, "{} cells", baked.merge.cells.len());
+    let report = check_graph(std::slice::from_ref(&rec), &baked);
+    assert!(report.ok, "{:?}", report.problems);
+}
