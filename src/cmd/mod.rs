@@ -1,7 +1,10 @@
 //! The subcommands (DESIGN.md § CLI contract).
 
+mod bake;
 mod inspect;
-mod record;
+pub mod merge;
+pub mod record;
+mod verify;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -27,13 +30,13 @@ enum Command {
     /// Record a path over a scene: per-frame visible sets and occlusion graphs (GPU).
     Record(record::RecordArgs),
     /// Merge recordings into a baked file (sorted index buffer + sliding windows).
-    Merge(MergeArgs),
+    Merge(merge::MergeArgs),
     /// Record and merge in one go.
-    Bake(BakeArgs),
+    Bake(bake::BakeArgs),
     /// Play a baked file headless to PNG frames (or in a window).
     Play(PlayArgs),
     /// Check a baked file: graph rules against its recording, images against the exact reference.
-    Verify(VerifyArgs),
+    Verify(verify::VerifyArgs),
     /// Measure frame times and accuracy of the merged player against its rivals.
     Bench(BenchArgs),
     /// Bake and play the built-in procedural car and print its figures.
@@ -81,36 +84,6 @@ impl RecordOpts {
 }
 
 #[derive(Args, Debug)]
-struct MergeArgs {
-    /// Recordings (frame ranges of one scene and path).
-    #[arg(required = true)]
-    recordings: Vec<PathBuf>,
-    /// Output baked file.
-    #[arg(short, long)]
-    output: PathBuf,
-    /// Print the figures as JSON.
-    #[arg(long)]
-    json: bool,
-}
-
-#[derive(Args, Debug)]
-struct BakeArgs {
-    /// Scene (.glb/.gltf, or `demo[:TRIANGLES]`).
-    scene: String,
-    /// Path: TOML file, `gltf`, `orbit:…`, `dolly:…` or `demo`.
-    #[arg(long)]
-    path: String,
-    /// Output baked file.
-    #[arg(short, long)]
-    output: PathBuf,
-    #[command(flatten)]
-    record: RecordOpts,
-    /// Print the figures as JSON.
-    #[arg(long)]
-    json: bool,
-}
-
-#[derive(Args, Debug)]
 struct PlayArgs {
     /// Baked file.
     baked: PathBuf,
@@ -136,21 +109,6 @@ struct PlayArgs {
     #[arg(long)]
     window: bool,
     /// Print per-frame figures as JSON.
-    #[arg(long)]
-    json: bool,
-}
-
-#[derive(Args, Debug)]
-struct VerifyArgs {
-    /// Baked file.
-    baked: PathBuf,
-    /// Recording(s) to check the graph rules against.
-    #[arg(long, num_args = 1..)]
-    recording: Vec<PathBuf>,
-    /// Scene to check the images against.
-    #[arg(long)]
-    scene: Option<String>,
-    /// Print the report as JSON.
     #[arg(long)]
     json: bool,
 }
@@ -182,10 +140,10 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Inspect(a) => inspect::run(a),
         Command::Record(a) => record::run(a),
-        Command::Merge(_) => not_built("merge", 4),
-        Command::Bake(_) => not_built("bake", 5),
+        Command::Merge(a) => merge::run(a),
+        Command::Bake(a) => bake::run(a),
         Command::Play(_) => not_built("play", 5),
-        Command::Verify(_) => not_built("verify", 6),
+        Command::Verify(a) => verify::run(a),
         Command::Bench(_) => not_built("bench", 7),
         Command::Demo(a) => demo(a),
     }

@@ -1,0 +1,223 @@
+//! `trisort merge REC... -o BAKED`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use serde_json::json;
+use trisort_format::{Baked, FileKind, Recording};
+use trisort_merger::{Bridge, LayoutChoice, MergeOptions, Seeding, StrategyChoice};
+
+use crate::common::print_json;
+
+/// Strategy names of the CLI.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum StrategyArg {
+    /// Left, intersection, bottom.
+    Lib,
+    /// Left, bottom, intersection.
+    Lbi,
+    /// Intersection, left, bottom.
+    Ilb,
+    /// Intersection, bottom, left.
+    Ibl,
+    /// Bottom, left, intersection.
+    Bli,
+    /// Bottom, intersection, left.
+    Bil,
+    /// Try all, keep the best (index triangles, then worst-frame draws).
+    Auto,
+}
+
+/// Layout names of the CLI.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum LayoutArg {
+    /// The paper's layout (rows for LIB/BIL, diagonals otherwise).
+    Paper,
+    /// The compact layout (at most max(f+1, F−f) ranges per frame).
+    Compact,
+    /// Try both.
+    Auto,
+}
+
+/// Bridge policy names of the CLI.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum BridgeArg {
+    /// Copies may span frames where the triangle is covered but hidden (or has no fragment).
+    Hidden,
+    /// Copies may span only frames where the triangle has no fragment.
+    Ignored,
+}
+
+/// Seeding names of the CLI.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum SeedingArg {
+    /// Interval splitting (the specification).
+    Interval,
+    /// The paper's diagonal-by-diagonal merge.
+    Paper,
+}
+
+/// Merge options shared by `merge`, `bake` and `demo`.
+#[derive(Args, Debug, Clone)]
+pub struct MergeOpts {
+    /// Merge strategy.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub strategy: StrategyArg,
+    /// Matrix layout.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub layout: LayoutArg,
+    /// What a copy may span besides frames where its triangle is visible.
+    #[arg(long, value_enum, default_value = "hidden")]
+    pub bridge: BridgeArg,
+    /// Keep only equal-depth (tie) edges: plays only with the depth test.
+    #[arg(long)]
+    pub depth_only: bool,
+    /// Cut the path into segments of N frames with their own matrices.
+    #[arg(long)]
+    pub segment: Option<u32>,
+    /// How the matrix is seeded.
+    #[arg(long, value_enum, default_value = "interval")]
+    pub seeding: SeedingArg,
+}
+
+impl MergeOpts {
+    /// The merger's options.
+    pub fn options(&self) -> MergeOptions {
+        MergeOptions {
+            strategy: match self.strategy {
+                StrategyArg::Lib => StrategyChoice::Lib,
+                StrategyArg::Lbi => StrategyChoice::Lbi,
+                StrategyArg::Ilb => StrategyChoice::Ilb,
+                StrategyArg::Ibl => StrategyChoice::Ibl,
+                StrategyArg::Bli => StrategyChoice::Bli,
+                StrategyArg::Bil => StrategyChoice::Bil,
+                StrategyArg::Auto => StrategyChoice::Auto,
+            },
+            layout: match self.layout {
+                LayoutArg::Paper => LayoutChoice::Paper,
+                LayoutArg::Compact => LayoutChoice::Compact,
+                LayoutArg::Auto => LayoutChoice::Auto,
+            },
+            bridge: match self.bridge {
+                BridgeArg::Hidden => Bridge::Hidden,
+                BridgeArg::Ignored => Bridge::Ignored,
+            },
+            depth_only: self.depth_only,
+            segment: self.segment,
+            seeding: match self.seeding {
+                SeedingArg::Interval => Seeding::Interval,
+                SeedingArg::Paper => Seeding::Paper,
+            },
+        }
+    }
+}
+
+/// Arguments of `merge`.
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// Recordings (frame ranges of one scene and path, in any order).
+    #[arg(required = true)]
+    recordings: Vec<PathBuf>,
+    /// Output baked file.
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    opts: MergeOpts,
+    /// Print the figures as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The `--json` figures of a baked file (DESIGN's CLI contract).
+pub fn baked_json(b: &Baked) -> serde_json::Value {
+    let s = &b.stats;
+    json!({
+        "strategy": b.merge.strategy,
+        "layout": b.merge.layout,
+        "bridge": b.merge.bridge,
+        "seeding": b.merge.seeding,
+        "depth_only": b.merge.depth_only,
+        "segment": b.merge.segment,
+        "frames": b.frames.len(),
+        "index_triangles": s.index_triangles,
+        "source_triangles": s.source_triangles,
+        "unique_visible": s.unique_visible,
+        "draws_per_frame_mean": s.draws_per_frame_mean,
+        "draws_per_frame_max": s.draws_per_frame_max,
+        "drawn_not_visible_mean": s.drawn_not_visible_mean,
+        "unordered_samples": s.unordered_samples,
+        "seconds": s.seconds,
+    })
+}
+
+/// Reads recordings, naming the file that fails.
+pub fn read_recordings(files: &[PathBuf]) -> Result<Vec<Recording>> {
+    files
+        .iter()
+        .map(|f| Ok(trisort_format::read_file(FileKind::Recording, f)?))
+        .collect()
+}
+
+/// Merges and writes atomically.
+pub fn merge_to_file(
+    recs: &[Recording],
+    opts: &MergeOptions,
+    output: &std::path::Path,
+    names: &[String],
+) -> Result<Baked> {
+    let baked = trisort_merger::merge(recs, opts).map_err(|e| {
+        // Errors name recordings by index; say which file that is.
+        anyhow::anyhow!(
+            "{e} (recordings: {})",
+            names
+                .iter()
+                .enumerate()
+                .map(|(i, n)| format!("{i} = {n}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    })?;
+    trisort_format::write_file_atomic(FileKind::Baked, output, &baked)
+        .with_context(|| format!("writing {}", output.display()))?;
+    Ok(baked)
+}
+
+pub fn run(a: MergeArgs) -> Result<ExitCode> {
+    let recs = read_recordings(&a.recordings)?;
+    let names: Vec<String> = a
+        .recordings
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let baked = merge_to_file(&recs, &a.opts.options(), &a.output, &names)?;
+    if a.json {
+        print_json(&baked_json(&baked));
+    } else {
+        print_summary(&baked);
+        println!("wrote {}", a.output.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// One human summary of a merge.
+pub fn print_summary(b: &Baked) {
+    let s = &b.stats;
+    println!(
+        "merged {} frames ({} {}, bridge {}): {} index triangles for |G| = {} ({:.2}x), Σ|V_f| = {}; draws per frame {:.1} mean, {} max; drawn-not-visible {:.0} per frame; {} unordered samples; {:.2} s",
+        b.frames.len(),
+        b.merge.strategy,
+        b.merge.layout,
+        b.merge.bridge,
+        s.index_triangles,
+        s.unique_visible,
+        s.index_triangles as f64 / s.unique_visible.max(1) as f64,
+        s.source_triangles,
+        s.draws_per_frame_mean,
+        s.draws_per_frame_max,
+        s.drawn_not_visible_mean,
+        s.unordered_samples,
+        s.seconds
+    );
+}
