@@ -917,3 +917,35 @@ fn every_json_member_removed_or_retyped_never_panics() {
     }
     assert!(rejected > list.len(), "only {rejected} edits were rejected");
 }
+
+#[test]
+fn external_image_is_decoded_and_skipped_primitives_are_noted_once() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("maps")).unwrap();
+    std::fs::write(dir.path().join("maps/base colour.png"), tiny_png()).unwrap();
+    let mut b = Builder::default();
+    let mut doc = tetra_doc(&mut b, "tetra", json!({"material": 0}));
+    let pos = doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"].clone();
+    doc["meshes"][0]["primitives"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"attributes": {"POSITION": pos}, "mode": 1}));
+    // Two instances of the mesh: the line primitive is noted once.
+    doc["nodes"] = json!([{"mesh": 0}, {"mesh": 0, "translation": [3.0, 0.0, 0.0]}]);
+    doc["scenes"] = json!([{"nodes": [0, 1]}]);
+    doc["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+    doc["textures"] = json!([{"source": 0}]);
+    doc["images"] = json!([{"uri": "maps/base%20colour.png"}]);
+    let scene = load_text(dir.path(), "external-image.gltf", &b.gltf(doc)).unwrap();
+    assert_eq!(scene.stats.triangles, 8);
+    let t = &scene.geometry.textures[0];
+    assert_eq!((t.width, t.height), (2, 2));
+    assert_eq!(t.name, "maps/base%20colour.png");
+    let line_notes: Vec<&String> = scene.notes.iter().filter(|n| n.contains("lines")).collect();
+    assert_eq!(line_notes.len(), 1, "{:?}", scene.notes);
+    assert!(
+        line_notes[0].contains("skipped 1 lines"),
+        "{}",
+        line_notes[0]
+    );
+}
