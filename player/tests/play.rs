@@ -411,6 +411,7 @@ fn render_frames_reports_each_frame_with_gpu_time_where_available() {
             .features()
             .contains(wgpu::Features::TIMESTAMP_QUERY);
         assert_eq!(f.gpu_ms.is_some(), timed, "gpu_ms {:?}", f.gpu_ms);
+        eprintln!("frame {}: gpu_ms {:?}", f.frame, f.gpu_ms);
         if let Some(ms) = f.gpu_ms {
             assert!(ms.is_finite() && ms >= 0.0);
         }
@@ -557,5 +558,35 @@ fn back_faces_mask_cut_outs_and_an_empty_frame() {
             &format!("{mode}: mask kept (opaque)"),
         );
         assert_close(pixel(&f1, 25, 23), bg, 0, &format!("{mode}: mask cut"));
+    }
+}
+
+#[test]
+fn glass_plays_at_the_recorded_or_the_chosen_opacity() {
+    let Some(gpu) = gpu() else { return };
+    // The red quad becomes glass, recorded see-through (opacity 0).
+    let mut baked = quads();
+    baked.geometry.materials[0].transmission = 1.0;
+    baked.settings.glass_opacity = 0.0;
+    let bg = BACKGROUND.map(|c| c as f64);
+    let red = lit(RED);
+    for (opacity, want) in [
+        (None, srgb8(bg)),
+        (Some(0.5), srgb8(over([red[0], red[1], red[2], 0.5], bg))),
+        (Some(1.0), srgb8([red[0], red[1], red[2]])),
+    ] {
+        let config = HeadlessConfig {
+            glass_opacity: opacity,
+            ..headless(Mode::Blend, 1)
+        };
+        let r = HeadlessRenderer::new(&gpu, &baked, &config).unwrap();
+        assert_close(
+            pixel(&r.render(0).unwrap().rgba8, 6, 25),
+            want,
+            1,
+            &format!("glass at {opacity:?}"),
+        );
+        // More opaque than recorded is exact: no glass warning.
+        assert!(r.player().warnings().iter().all(|w| !w.contains("glass")));
     }
 }
