@@ -72,7 +72,10 @@ pub(crate) fn sample(scene: &Scene, fps: f64) -> Result<Timeline, PathError> {
     let rest_trs: Vec<(DVec3, DQuat, DVec3)> = animated
         .iter()
         .map(|(n, _)| {
-            DMat4::from_cols_array(&nodes[*n as usize].rest).to_scale_rotation_translation()
+            // A rest transform with a zero scale has no rotation to recover: use identity.
+            let (s, r, t) =
+                DMat4::from_cols_array(&nodes[*n as usize].rest).to_scale_rotation_translation();
+            (s, if r.is_finite() { r } else { DQuat::IDENTITY }, t)
         })
         .collect();
     let mut frames = Vec::with_capacity(frame_count);

@@ -262,3 +262,25 @@ fn bad_scenes_and_options() {
     let (p, _, _) = problem(load("gltf", &Scene::default(), &PathOptions::default()));
     assert_eq!(p, Problem::EmptyScene);
 }
+
+#[test]
+fn zero_scale_rest_node_can_be_animated() {
+    // A node hidden by a zero rest scale (a common glTF idiom) that an animation moves: its
+    // rest rotation cannot be recovered, which must not turn into NaN.
+    let mut scene = animated(vec![Animation {
+        name: "move".into(),
+        channels: vec![Channel {
+            node: 1,
+            property: Property::Translation,
+            interpolation: Interpolation::Linear,
+            times: vec![0.0, 1.0],
+            values: vec![0.0, 1.0, 0.0, 0.0, 2.0, 0.0],
+        }],
+    }]);
+    scene.geometry.nodes[1].rest = DMat4::from_scale(DVec3::ZERO).to_cols_array();
+    let t = gltf(&scene, 2.0);
+    let m = lid(&t, 2);
+    assert!(m.to_cols_array().iter().all(|x| x.is_finite()));
+    assert_eq!(m.w_axis.truncate(), DVec3::new(0.0, 2.0, 0.0));
+    assert_eq!(m.transform_vector3(DVec3::ONE), DVec3::ZERO, "still hidden");
+}

@@ -257,3 +257,23 @@ camera = { key = [{ frame = 0, eye = [0, 1, 6], target = [0, 0, 0] }, { frame = 
     let (b, _fb) = load_toml(inline, &box_scene());
     assert_eq!(a.expect("tables"), b.expect("inline"));
 }
+
+#[test]
+fn the_documented_example_loads() {
+    // The TOML example of the crate documentation, as written there.
+    let lib = include_str!("../src/lib.rs");
+    let mut lines = lib.lines().map(|l| l.strip_prefix("//!").unwrap_or(l));
+    lines
+        .find(|l| l.trim() == "```toml")
+        .expect("a TOML example");
+    let example: Vec<&str> = lines
+        .take_while(|l| l.trim() != "```")
+        .map(|l| l.strip_prefix(' ').unwrap_or(l))
+        .collect();
+    let (t, _f) = load_toml(&example.join("\n"), &box_scene());
+    let t = t.unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(t.frames.len(), 121, "frames 0..=120 (the last door key)");
+    assert_eq!(t.frames[0].camera.znear, 0.05);
+    assert_eq!(t.frames[0].camera.zfar, Some(100.0));
+    assert!(t.frames[90].poses.iter().any(|p| p.node == 2));
+}
