@@ -37,7 +37,7 @@ pub use error::PlayerError;
 pub use headless::{
     quantize_rgba16f, render_frames, HeadlessConfig, HeadlessRenderer, RenderedFrame, BACKGROUND,
 };
-pub use player::{open_baked, Player};
+pub use player::{blend_state, fragment_entry_point, open_baked, Player};
 
 /// Instance flags with wgpu's indirect-call validation (`VALIDATION_INDIRECT_CALL`) switched
 /// on or off, the other flags as wgpu chooses them (build type and `WGPU_*` environment).

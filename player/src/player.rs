@@ -243,8 +243,18 @@ impl Player {
     }
 }
 
+/// The fragment entry point of [`trisort_shaders::PLAYER`] a mode uses: straight alpha for
+/// `blend` and `depth`, premultiplied for `saturate`. With [`blend_state`], what a reference
+/// renderer needs to composite exactly as the player does.
+pub fn fragment_entry_point(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Blend | Mode::Depth => "fs_player_straight",
+        Mode::Saturate => "fs_player_premultiplied",
+    }
+}
+
 /// The blend state of a mode (see the crate documentation for the equations).
-pub(crate) fn blend_state(mode: Mode) -> wgpu::BlendState {
+pub fn blend_state(mode: Mode) -> wgpu::BlendState {
     use wgpu::{BlendComponent, BlendFactor, BlendOperation};
     match mode {
         // Straight alpha, over: colour s.a·s + (1 − s.a)·d, alpha s.a + (1 − s.a)·d.a.
@@ -304,10 +314,7 @@ fn create_pipeline(
             bias: Default::default(),
         }
     });
-    let fragment_entry = match config.mode {
-        Mode::Blend | Mode::Depth => "fs_player_straight",
-        Mode::Saturate => "fs_player_premultiplied",
-    };
+    let fragment_entry = fragment_entry_point(config.mode);
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("trisort player"),
         layout: Some(&layout),
