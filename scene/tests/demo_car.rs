@@ -192,6 +192,10 @@ fn triangle_count_follows_the_request() {
         );
         assert_eq!(car.stats.triangles, got as u64);
     }
+    // Below the supported range: the coarsest car, still whole.
+    let tiny = demo_car(1);
+    assert!((1_000..10_000).contains(&tiny.geometry.triangles.len()));
+    assert!(tiny.node_by_name(DOOR_NODE).is_some());
 }
 
 #[test]
@@ -313,7 +317,7 @@ fn opaque_parts_are_closed_and_face_outwards() {
 
 #[test]
 fn no_parts_interpenetrate() {
-    for request in [10_000, 20_000] {
+    for request in [10_000, 20_000, 150_000, 1_000_000] {
         let car = demo_car(request);
         let hits = intersecting_parts(&car, &[]);
         assert!(hits.is_empty(), "{request}: intersecting parts: {hits:?}");
@@ -366,9 +370,11 @@ fn door_opens_about_its_hinge_without_collisions() {
     let open = centroid(&[door_pose(&car, 45.0)]);
     assert!(closed.x < -0.5, "the driver door is on the −X side");
     assert!(open.x < closed.x - 0.2, "{closed} → {open}");
-    for degrees in [20.0, DOOR_MAX_OPEN_DEGREES] {
-        let hits = intersecting_parts(&car, &[door_pose(&car, degrees)]);
-        assert!(hits.is_empty(), "door at {degrees}°: {hits:?}");
+    for car in [car, demo_car(150_000)] {
+        for degrees in [20.0, DOOR_MAX_OPEN_DEGREES] {
+            let hits = intersecting_parts(&car, &[door_pose(&car, degrees)]);
+            assert!(hits.is_empty(), "door at {degrees}°: {hits:?}");
+        }
     }
 }
 
