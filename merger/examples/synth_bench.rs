@@ -1,7 +1,7 @@
 //! Benchmark (not a test): merges synthetic turntable recordings with every strategy, layout
 //! and seeding and prints the merge figures and times.
 //!
-//! `cargo run --release -p trisort-merger --example synth_bench -- [objects] [frames] [degrees] [segment] [lib|all]`
+//! `cargo run --release -p trisort-merger --example synth_bench -- [objects] [frames] [degrees] [segment] [lib|all] [samples] [transparent] [sides]`
 
 use std::time::Instant;
 
@@ -13,10 +13,11 @@ fn main() {
     let arg = |k: usize, d: f64| args.get(k).and_then(|s| s.parse().ok()).unwrap_or(d);
     let p = Turntable {
         objects: arg(0, 40.0) as u32,
-        sides: 32,
+        sides: arg(7, 32.0) as u32,
         frames: arg(1, 24.0) as u32,
-        samples: 512,
+        samples: arg(5, 512.0) as u32,
         degrees: arg(2, 90.0),
+        transparent: arg(6, 0.3),
         ..Turntable::default()
     };
     let segment = args.get(3).and_then(|s| s.parse().ok());

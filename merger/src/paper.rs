@@ -17,7 +17,8 @@
 //! other than L and B in a window, paths through undrawn triangles) are left to interval
 //! splitting, which runs after this seeding. A triangle that two overlapping cells both kept
 //! (a rejected merge) is trimmed so that no frame draws it twice: longer copies keep their
-//! frames, shorter ones lose the overlap, and every piece is trimmed to its visible frames.
+//! frames, shorter ones lose the overlap, and every piece is trimmed as interval splitting trims
+//! (to its visible frames, extended through frames without fragments).
 //!
 //! Cost: O(Σ over cells of (d + 1) · edges of its triangles), quadratic in the segment length
 //! — use `--segment` on long paths.

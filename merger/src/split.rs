@@ -18,9 +18,14 @@
 //! - a cycle by splitting one multi-frame copy on it between the frames that demand its
 //!   incoming and its outgoing edge, in the middle of the gap that separates them.
 //!
-//! Pieces are trimmed to the triangle's visible frames inside them, and a piece with no
-//! visible frame is dropped, so a copy always spans a visible frame and bridging only ever
-//! shrinks. Each fix adds a copy or shortens one; copies are bounded by Σ|V_f|, so the loop
+//! Pieces are trimmed to the triangle's visible frames inside them, then extended (inside the
+//! piece) through the neighbouring frames where the triangle has no fragment, which is free
+//! (no pixel, no edge) and lets copies share cells; a piece with no visible frame is dropped.
+//! So a copy always spans a visible frame, and what it bridges only ever shrinks.
+//!
+//! Measured alternative, rejected: under `--bridge hidden`, extending seeds through *hidden*
+//! frames too (every copy starting in the corner cell) gave no fewer copies on the synthetic
+//! turntable (IBL compact 1.65 vs 1.52 × |G|) and 3–8 × the drawn-not-visible fill. Each fix adds a copy or shortens one; copies are bounded by Σ|V_f|, so the loop
 //! terminates, at worst at one copy per frame on the diagonal, which is always valid. When a
 //! round finds nothing the copies satisfy rules 1–3: with no inter-cell conflict every path
 //! between drawn copies rises in the layout, so the only remaining demands lie inside cells,

@@ -31,16 +31,30 @@ fn thousand_frames_merge_with_bounded_draws() {
     let report = check_graph(std::slice::from_ref(&rec), &baked);
     assert!(report.ok, "{:?}", report.problems);
     let s = &baked.stats;
-    eprintln!("1,000 frames: {s:?}, cells {}, {secs:.2} s", baked.merge.cells.len());
+    eprintln!(
+        "1,000 frames: {s:?}, cells {}, {secs:.2} s",
+        baked.merge.cells.len()
+    );
     assert!(s.unique_visible <= s.index_triangles && s.index_triangles <= s.source_triangles);
     // A window is a set of cells; merged ranges can never outnumber the frame's cells, and
     // the compact layout bounds them by max(f+1, F−f). Far fewer are used in practice.
     let worst_cells = (0..1000u32)
-        .map(|f| baked.merge.cells.iter().filter(|c| c.first_frame <= f && f <= c.last_frame).count())
+        .map(|f| {
+            baked
+                .merge
+                .cells
+                .iter()
+                .filter(|c| c.first_frame <= f && f <= c.last_frame)
+                .count()
+        })
         .max()
         .unwrap() as u32;
     assert!(s.draws_per_frame_max <= worst_cells.min(1000));
-    assert!(s.draws_per_frame_max <= 100, "draws per frame {}", s.draws_per_frame_max);
+    assert!(
+        s.draws_per_frame_max <= 100,
+        "draws per frame {}",
+        s.draws_per_frame_max
+    );
 }
 
 /// 10,000 frames in segments of 100: every segment has its own matrix.
@@ -58,14 +72,25 @@ fn ten_thousand_frames_in_segments() {
     let baked = merge(std::slice::from_ref(&rec), &ibl_compact(Some(100))).unwrap();
     let secs = t.elapsed().as_secs_f64();
     let s = &baked.stats;
-    eprintln!("10,000 frames: {s:?}, cells {}, {secs:.2} s", baked.merge.cells.len());
+    eprintln!(
+        "10,000 frames: {s:?}, cells {}, {secs:.2} s",
+        baked.merge.cells.len()
+    );
     assert!(s.index_triangles <= s.source_triangles);
     // No cell crosses a segment boundary, and a window never holds more ranges than its
     // segment's compact bound.
-    assert!(baked.merge.cells.iter().all(|c| c.first_frame / 100 == c.last_frame / 100 && c.triangles > 0));
+    assert!(baked
+        .merge
+        .cells
+        .iter()
+        .all(|c| c.first_frame / 100 == c.last_frame / 100 && c.triangles > 0));
     assert!(s.draws_per_frame_max <= 100);
     // Sparse: far fewer cells than the 100 · 5,050 of full matrices.
-    assert!(baked.merge.cells.len() < 100 * 5050 / 20, "{} cells", baked.merge.cells.len());
+    assert!(
+        baked.merge.cells.len() < 100 * 5050 / 20,
+        "{} cells",
+        baked.merge.cells.len()
+    );
     let report = check_graph(std::slice::from_ref(&rec), &baked);
     assert!(report.ok, "{:?}", report.problems);
 }
