@@ -1,12 +1,13 @@
 //! The subcommands (DESIGN.md § CLI contract).
 
 mod bake;
+mod demo;
 mod inspect;
 pub mod merge;
+mod play;
 pub mod record;
-mod verify;
+pub mod verify;
 
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{bail, Result};
@@ -34,13 +35,13 @@ enum Command {
     /// Record and merge in one go.
     Bake(bake::BakeArgs),
     /// Play a baked file headless to PNG frames (or in a window).
-    Play(PlayArgs),
+    Play(play::PlayArgs),
     /// Check a baked file: graph rules against its recording, images against the exact reference.
     Verify(verify::VerifyArgs),
     /// Measure frame times and accuracy of the merged player against its rivals.
     Bench(BenchArgs),
     /// Bake and play the built-in procedural car and print its figures.
-    Demo(DemoArgs),
+    Demo(demo::DemoArgs),
 }
 
 /// Recording options shared by `record` and `bake`.
@@ -84,55 +85,12 @@ impl RecordOpts {
 }
 
 #[derive(Args, Debug)]
-struct PlayArgs {
-    /// Baked file.
-    baked: PathBuf,
-    /// Frames to play, `a..b`.
-    #[arg(long, value_parser = parse_range)]
-    frames: Option<FrameRange>,
-    /// Where to write PNG frames.
-    #[arg(long)]
-    out_dir: Option<PathBuf>,
-    /// Playback size (default: the recorded size).
-    #[arg(long, value_parser = parse_size)]
-    size: Option<(u32, u32)>,
-    /// MSAA samples (default: the recorded count).
-    #[arg(long)]
-    samples: Option<u32>,
-    /// blend, depth or saturate.
-    #[arg(long, default_value = "blend")]
-    mode: String,
-    /// Glass opacity (default: the recorded one).
-    #[arg(long)]
-    glass_opacity: Option<f32>,
-    /// Open a window.
-    #[arg(long)]
-    window: bool,
-    /// Print per-frame figures as JSON.
-    #[arg(long)]
-    json: bool,
-}
-
-#[derive(Args, Debug)]
 struct BenchArgs {
     /// Scene.
     scene: String,
     /// Path.
     #[arg(long)]
     path: String,
-}
-
-#[derive(Args, Debug)]
-pub struct DemoArgs {
-    /// Where to write frames and files.
-    #[arg(long, default_value = "demo-out")]
-    pub out_dir: PathBuf,
-    /// Triangles of the procedural car (about 10 000 to 5 000 000).
-    #[arg(long)]
-    pub triangles: Option<u32>,
-    /// Also write the car as glTF to this file.
-    #[arg(long)]
-    pub export_scene: Option<PathBuf>,
 }
 
 /// Runs a parsed command line.
@@ -142,34 +100,13 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Record(a) => record::run(a),
         Command::Merge(a) => merge::run(a),
         Command::Bake(a) => bake::run(a),
-        Command::Play(_) => not_built("play", 5),
+        Command::Play(a) => play::run(a),
         Command::Verify(a) => verify::run(a),
         Command::Bench(_) => not_built("bench", 7),
-        Command::Demo(a) => demo(a),
+        Command::Demo(a) => demo::run(a),
     }
 }
 
 fn not_built(name: &str, issue: u32) -> Result<ExitCode> {
     bail!("`trisort {name}` is not built yet (issue {issue})")
-}
-
-fn demo(a: DemoArgs) -> Result<ExitCode> {
-    let triangles = a
-        .triangles
-        .unwrap_or(trisort_scene::demo_car::DEFAULT_TRIANGLES);
-    let scene = trisort_scene::demo_car::demo_car(triangles);
-    let path = trisort_paths::demo_default(&scene);
-    std::fs::create_dir_all(&a.out_dir)?;
-    if let Some(p) = &a.export_scene {
-        // EXPORT_PENDING trisort_scene::export::export_glb(&scene, p)?;
-        println!("wrote {}", p.display());
-    }
-    println!(
-        "demo car: {} triangles, {} nodes, {} materials; path: {} frames",
-        scene.stats.triangles,
-        scene.geometry.nodes.len(),
-        scene.geometry.materials.len(),
-        path.frames.len()
-    );
-    bail!("`trisort demo` can only export the scene until the player exists (issue 5)")
 }

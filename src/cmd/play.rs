@@ -1,0 +1,154 @@
+//! `trisort play BAKED`: headless playback to PNG frames.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use serde_json::json;
+use trisort_format::{Baked, FileKind};
+use trisort_player::config::Mode;
+use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
+use trisort_shaders::gpu::Gpu;
+
+use crate::common::{parse_range, parse_size, print_json, progress_bar, FrameRange};
+
+/// Arguments of `play`.
+#[derive(Args, Debug)]
+pub struct PlayArgs {
+    /// Baked file.
+    baked: PathBuf,
+    /// Frames to play, half-open `a..b` (default: all).
+    #[arg(long, value_parser = parse_range)]
+    frames: Option<FrameRange>,
+    /// Where to write PNG frames (`frame-NNNNN.png`); none: render and time only.
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
+    /// Playback size (default: the recorded size).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// MSAA samples (default: the recorded count).
+    #[arg(long)]
+    samples: Option<u32>,
+    /// blend (back to front, no depth test), depth (front to back, depth test) or saturate.
+    #[arg(long, default_value = "blend")]
+    mode: Mode,
+    /// Glass opacity (default: the recorded one).
+    #[arg(long)]
+    glass_opacity: Option<f32>,
+    /// Open a window (needs a display).
+    #[arg(long)]
+    window: bool,
+    /// Print per-frame figures as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Writes a frame as PNG atomically.
+pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
+    let mut bytes = Vec::new();
+    image::write_buffer_with_format(
+        &mut std::io::Cursor::new(&mut bytes),
+        rgba8,
+        width,
+        height,
+        image::ExtendedColorType::Rgba8,
+        image::ImageFormat::Png,
+    )
+    .with_context(|| format!("encoding {}", path.display()))?;
+    trisort_format::container::write_bytes_atomic(path, &bytes)?;
+    Ok(())
+}
+
+/// Renders frames of a baked file, optionally writing PNGs; prints the player's warnings.
+pub fn play_frames(
+    gpu: &Gpu,
+    baked: &Baked,
+    config: &HeadlessConfig,
+    frames: std::ops::Range<u32>,
+    out_dir: Option<&Path>,
+) -> Result<Vec<RenderedFrame>> {
+    let renderer = HeadlessRenderer::new(gpu, baked, config)?;
+    for w in renderer.player().warnings() {
+        eprintln!("trisort: warning: {w}");
+    }
+    if let Some(d) = out_dir {
+        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
+    }
+    // One untimed render first: the first draw compiles pipelines (≈150 ms on lavapipe),
+    // which is not playback cost.
+    if !frames.is_empty() {
+        renderer.render(frames.start)?;
+    }
+    let bar = progress_bar(frames.len() as u64, "play");
+    let mut out = Vec::new();
+    for f in frames {
+        let r = renderer.render(f)?;
+        if let Some(d) = out_dir {
+            write_png(
+                &d.join(format!("frame-{f:05}.png")),
+                config.size.0,
+                config.size.1,
+                &r.rgba8,
+            )?;
+        }
+        bar.inc(1);
+        out.push(RenderedFrame {
+            rgba8: Vec::new(),
+            ..r
+        });
+    }
+    bar.finish_and_clear();
+    Ok(out)
+}
+
+pub fn run(a: PlayArgs) -> Result<ExitCode> {
+    if a.window {
+        bail!("--window needs a display and a windowing build; this build plays headless only (use --out-dir)");
+    }
+    let baked: Baked = trisort_format::read_file(FileKind::Baked, &a.baked)?;
+    let n = baked.frames.len() as u32;
+    let range = match a.frames {
+        Some(r) => r.resolve(n)?,
+        None => 0..n,
+    };
+    let mut config = HeadlessConfig::recorded(&baked);
+    config.mode = a.mode;
+    config.glass_opacity = a.glass_opacity;
+    if let Some(s) = a.size {
+        config.size = s;
+    }
+    if let Some(s) = a.samples {
+        config.samples = s;
+    }
+    let gpu = Gpu::new()?;
+    let frames = play_frames(&gpu, &baked, &config, range, a.out_dir.as_deref())?;
+    if a.json {
+        let list: Vec<_> = frames
+            .iter()
+            .map(|f| json!({"frame": f.frame, "gpu_ms": f.gpu_ms}))
+            .collect();
+        print_json(&json!({ "device": gpu.info.name, "mode": a.mode.name(), "frames": list }));
+    } else {
+        let ms: Vec<f64> = frames.iter().filter_map(|f| f.gpu_ms).collect();
+        let timing = if ms.is_empty() {
+            "no GPU timestamps on this adapter".to_string()
+        } else {
+            format!(
+                "GPU {:.3} ms per frame mean, {:.3} max",
+                ms.iter().sum::<f64>() / ms.len() as f64,
+                ms.iter().cloned().fold(0.0, f64::max)
+            )
+        };
+        println!(
+            "played {} frames ({} mode) on {}: {timing}",
+            frames.len(),
+            a.mode.name(),
+            gpu.info.name
+        );
+        if let Some(d) = &a.out_dir {
+            println!("wrote {}", d.display());
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
