@@ -1,7 +1,7 @@
 //! Benchmark (not a test): merges synthetic turntable recordings with every strategy, layout
 //! and seeding and prints the merge figures and times.
 //!
-//! `cargo run --release -p trisort-merger --example synth_bench -- [objects] [frames] [degrees] [segment] [lib|all] [samples] [transparent] [sides]`
+//! `cargo run --release -p trisort-merger --example synth_bench -- [objects] [frames] [degrees] [segment] [lib|all] [samples] [transparent] [sides] [size]`
 
 use std::time::Instant;
 
@@ -18,10 +18,12 @@ fn main() {
         samples: arg(5, 512.0) as u32,
         degrees: arg(2, 90.0),
         transparent: arg(6, 0.3),
+        size: arg(8, 1.0),
         ..Turntable::default()
     };
     let segment = args.get(3).and_then(|s| s.parse().ok());
-    let only_lib = args.get(4).is_some_and(|s| s == "lib");
+    let only = args.get(4).cloned().unwrap_or_default();
+    let fast = std::env::var("SYNTH_BENCH_FAST").is_ok();
     let t0 = Instant::now();
     let rec = turntable(&p);
     let vis: usize = rec.frames.iter().map(|f| f.visible.len()).sum();
@@ -31,20 +33,31 @@ fn main() {
         t0.elapsed().as_secs_f64()
     );
     println!("seeding  bridge  strategy layout  | index/|G| draws mean  max | drawn-not-vis unordered | seconds");
-    let strategies = if only_lib {
-        vec![StrategyChoice::Lib]
+    let all = [
+        (StrategyChoice::Lib, "lib"),
+        (StrategyChoice::Lbi, "lbi"),
+        (StrategyChoice::Ilb, "ilb"),
+        (StrategyChoice::Ibl, "ibl"),
+        (StrategyChoice::Bli, "bli"),
+        (StrategyChoice::Bil, "bil"),
+    ];
+    let strategies: Vec<StrategyChoice> = all
+        .iter()
+        .filter(|(_, n)| only.is_empty() || only == "all" || only == *n)
+        .map(|(s, _)| *s)
+        .collect();
+    let seedings: &[Seeding] = if fast {
+        &[Seeding::Interval]
     } else {
-        vec![
-            StrategyChoice::Lib,
-            StrategyChoice::Lbi,
-            StrategyChoice::Ilb,
-            StrategyChoice::Ibl,
-            StrategyChoice::Bli,
-            StrategyChoice::Bil,
-        ]
+        &[Seeding::Interval, Seeding::Paper]
     };
-    for seeding in [Seeding::Interval, Seeding::Paper] {
-        for bridge in [Bridge::Hidden, Bridge::Ignored] {
+    let bridges: &[Bridge] = if fast {
+        &[Bridge::Hidden]
+    } else {
+        &[Bridge::Hidden, Bridge::Ignored]
+    };
+    for &seeding in seedings {
+        for &bridge in bridges {
             for &strategy in &strategies {
                 for layout in [LayoutChoice::Paper, LayoutChoice::Compact] {
                     let opts = MergeOptions {

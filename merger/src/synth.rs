@@ -157,6 +157,8 @@ pub struct Turntable {
     pub degrees: f64,
     /// Fraction of transparent objects (opacity 0.5); the rest are opaque.
     pub transparent: f64,
+    /// Object radius scale (radii are 0.08–0.28 times this).
+    pub size: f64,
     /// Random seed.
     pub seed: u64,
 }
@@ -170,6 +172,7 @@ impl Default for Turntable {
             samples: 256,
             degrees: 90.0,
             transparent: 0.3,
+            size: 1.0,
             seed: 1,
         }
     }
@@ -216,7 +219,7 @@ pub fn turntable(p: &Turntable) -> Recording {
             Object {
                 x: r * a.cos(),
                 z: r * a.sin(),
-                radius: 0.08 + 0.2 * rng.unit(),
+                radius: (0.08 + 0.2 * rng.unit()) * p.size,
                 phase: rng.unit(),
                 opacity: if rng.unit() < p.transparent { 0.5 } else { 1.0 },
             }
@@ -335,6 +338,8 @@ pub fn turntable(p: &Turntable) -> Recording {
         p.samples as u64,
         p.seed,
         p.degrees.to_bits(),
+        p.transparent.to_bits(),
+        p.size.to_bits(),
     ] {
         id.extend_from_slice(&x.to_le_bytes());
     }
