@@ -6,8 +6,9 @@
 //! - *inter-cell conflicts*: at frame f, a drawn ancestor x of drawn y in E_f* (through any
 //!   triangles) whose cell comes later in the layout than y's. Found in linear time per frame
 //!   by carrying, in topological order, the latest cell of any drawn ancestor;
-//! - *cell cycles*: cycles in a cell's union-over-frames constraint graph (the camera turned
-//!   around), found by Kahn's algorithm and a walk back through the left-over vertices;
+//! - *cell cycles* (searched only in rounds with no conflict: they are rare and cost more to
+//!   find): cycles in a cell's union-over-frames constraint graph (the camera turned around),
+//!   found by Kahn's algorithm and a walk back through the left-over vertices;
 //!
 //! and then fixes each one whose copies are still untouched this round:
 //! - a conflict (x, y, f) by the cheapest of the splits "cut before f", "cut after f",
@@ -165,7 +166,12 @@ pub(crate) fn split_until_valid(
     loop {
         let lookup = CopyLookup::new(&copies);
         let conflicts = find_conflicts(cx, seg.clone(), order, &copies, &lookup);
-        let cycles = find_cell_cycles(cx, seg.clone(), &copies, &lookup);
+        // Cell cycles are rare and costlier to find: look for them once no conflict is left.
+        let cycles = if conflicts.is_empty() {
+            find_cell_cycles(cx, seg.clone(), &copies, &lookup)
+        } else {
+            Vec::new()
+        };
         if conflicts.is_empty() && cycles.is_empty() {
             return Splitting { copies };
         }
