@@ -115,9 +115,12 @@ proptest! {
         let depth = MergeOptions { depth_only: true, ..MergeOptions::default() };
         let baked = merge(&recs, &depth).expect("merge");
         assert_valid(&recs, &baked, "depth-only");
-        let seg = MergeOptions { segment: Some(2), ..MergeOptions::default() };
-        let baked = merge(&recs, &seg).expect("merge");
-        assert_valid(&recs, &baked, "segments of 2");
+        for seeding in [Seeding::Interval, Seeding::Paper] {
+            let seg = MergeOptions { segment: Some(2), seeding, ..MergeOptions::default() };
+            let baked = merge(&recs, &seg).expect("merge");
+            assert_valid(&recs, &baked, "segments of 2");
+            assert!(baked.merge.cells.iter().all(|c| c.first_frame / 2 == c.last_frame / 2));
+        }
     }
 }
 
@@ -412,4 +415,40 @@ fn mismatched_recordings_are_refused() {
     assert!(e.to_string().contains("comes next"), "{e}");
     let e = merge(&parts[..1], &MergeOptions::default()).unwrap_err();
     assert!(e.to_string().contains("0..3 of a 6-frame"), "{e}");
+}
+
+/// Frames that see nothing, and a path that sees nothing at all, merge and validate.
+#[test]
+fn frames_without_visible_triangles() {
+    let frames = vec![
+        FrameSpec::default(),
+        FrameSpec {
+            visible: vec![1, 2],
+            edges: vec![(1, 2, 1)],
+            ..FrameSpec::default()
+        },
+        FrameSpec::default(),
+        FrameSpec {
+            visible: vec![2],
+            hidden: vec![1],
+            edges: vec![(2, 1, 1)],
+            ..FrameSpec::default()
+        },
+    ];
+    let rec = recording_from_frames(4, &frames);
+    assert_all_valid(std::slice::from_ref(&rec), "empty frames");
+    let baked = merge(std::slice::from_ref(&rec), &MergeOptions::default()).unwrap();
+    // Copies extend (for free) through frames where their triangle has no fragment, so frame
+    // 0 draws both triangles; one copy each suffices.
+    assert_eq!(baked.stats.index_triangles, 2);
+    assert_eq!(
+        trisort_merger::cell_counts(&baked)
+            .iter()
+            .map(|c| c.2)
+            .sum::<u32>(),
+        baked.copies.len() as u32
+    );
+    let nothing = recording_from_frames(4, &[FrameSpec::default(), FrameSpec::default()]);
+    let baked = merge(std::slice::from_ref(&nothing), &MergeOptions::default()).unwrap();
+    assert!(baked.copies.is_empty() && check_graph(std::slice::from_ref(&nothing), &baked).ok);
 }
