@@ -15,6 +15,8 @@
 #![deny(missing_docs)]
 
 pub mod partial;
+#[cfg(test)]
+mod coverage_test;
 mod peeler;
 
 use std::collections::HashMap;
@@ -27,7 +29,7 @@ use trisort_shaders::gpu::Gpu;
 use trisort_shaders::scene_gpu::View;
 
 use partial::{Graph, Visibility};
-use peeler::Peeler;
+pub use peeler::{Layer, Peeler};
 
 /// Errors while recording.
 #[derive(Debug, thiserror::Error)]

@@ -1,4 +1,7 @@
 //! The GPU depth peeler: one render pass per layer, then a gather pass and a readback.
+//!
+//! Public so that the exact reference (`trisort-reference`) peels with the very pipeline the
+//! recorder uses: the same shader, the same (depth, id) keys, the same per-sample targets.
 
 use std::ops::Range;
 
@@ -9,8 +12,9 @@ use wgpu::util::DeviceExt;
 
 use crate::RecordError;
 
-/// One peel layer read back: per sample (id + 1 or 0, alpha, depth).
-pub(crate) struct Layer {
+/// One peel layer read back: per sample (id + 1 or 0, alpha, depth). Sample `s` of pixel
+/// (x, y) is slot `(y · width + x) · samples + s`.
+pub struct Layer {
     /// Per sample: drawn position + 1, 0 where the layer has no fragment.
     pub ids: Vec<u32>,
     /// Per sample: the fragment's opacity.
@@ -23,7 +27,7 @@ pub(crate) struct Layer {
 const CHUNK_TRIANGLES: u32 = 1 << 22;
 
 /// The peeling pipeline for one scene at one view.
-pub(crate) struct Peeler<'g> {
+pub struct Peeler<'g> {
     gpu: &'g Gpu,
     scene: SceneGpu,
     pipeline: wgpu::RenderPipeline,
