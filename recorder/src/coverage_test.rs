@@ -13,7 +13,12 @@ use crate::peeler::Peeler;
 
 const SIZE: u32 = 16;
 /// Standard 4× sample positions inside a pixel.
-const SAMPLES: [(f32, f32); 4] = [(0.375, 0.125), (0.875, 0.375), (0.125, 0.625), (0.625, 0.875)];
+const SAMPLES: [(f32, f32); 4] = [
+    (0.375, 0.125),
+    (0.875, 0.375),
+    (0.125, 0.625),
+    (0.625, 0.875),
+];
 
 /// Pixel coordinates (x right, y down) → world position on the plane z = −1 seen by
 /// `frame()` (fov with tan(fov/2) = 1, aspect 1: x_world = ndc_x).
@@ -25,25 +30,49 @@ fn at(px: f32, py: f32, z: f32) -> [f32; 3] {
 
 fn edge_case_scene() -> Geometry {
     let mut g = Geometry {
-        materials: vec![Material { double_sided: true, ..Default::default() }],
-        nodes: vec![Node { name: "root".into(), parent: None, rest: DMat4::IDENTITY.to_cols_array() }],
+        materials: vec![Material {
+            double_sided: true,
+            ..Default::default()
+        }],
+        nodes: vec![Node {
+            name: "root".into(),
+            parent: None,
+            rest: DMat4::IDENTITY.to_cols_array(),
+        }],
         ..Default::default()
     };
     let tri = |g: &mut Geometry, a: [f32; 3], b: [f32; 3], c: [f32; 3]| {
         let base = g.vertices.len() as u32;
         for p in [a, b, c] {
-            g.vertices.push(Vertex { position: p, normal: [0.0, 0.0, 1.0], uv: [0.0; 2], material: 0, node: 0 });
+            g.vertices.push(Vertex {
+                position: p,
+                normal: [0.0, 0.0, 1.0],
+                uv: [0.0; 2],
+                material: 0,
+                node: 0,
+            });
         }
         g.triangles.push([base, base + 1, base + 2]);
     };
     // Background behind everything.
-    tri(&mut g, at(-1.0, -1.0, -3.0), at(40.0, -1.0, -3.0), at(-1.0, 40.0, -3.0));
+    tri(
+        &mut g,
+        at(-1.0, -1.0, -3.0),
+        at(40.0, -1.0, -3.0),
+        at(-1.0, 40.0, -3.0),
+    );
     // A grid whose vertices sit on sample positions: every edge passes through samples, and
     // neighbouring triangles share edges (each sample must belong to exactly one of them).
     for gy in 0..6 {
         for gx in 0..6 {
             let (sx, sy) = SAMPLES[(gx + gy) % 4];
-            let p = |dx: usize, dy: usize| at((gx + dx) as f32 * 1.5 + sx, (gy + dy) as f32 * 1.5 + sy, -1.0);
+            let p = |dx: usize, dy: usize| {
+                at(
+                    (gx + dx) as f32 * 1.5 + sx,
+                    (gy + dy) as f32 * 1.5 + sy,
+                    -1.0,
+                )
+            };
             tri(&mut g, p(0, 0), p(1, 0), p(1, 1));
             tri(&mut g, p(0, 0), p(1, 1), p(0, 1));
         }
@@ -64,17 +93,34 @@ fn edge_case_scene() -> Geometry {
     // pixel centre, which no 4× sample is near.
     for k in 0..40 {
         let (px, py) = ((k % 8) as f32 * 2.0, 10.0 + (k / 8) as f32);
-        let (cx, cy) = if k % 2 == 0 { SAMPLES[k % 4] } else { (0.5, 0.5) };
+        let (cx, cy) = if k % 2 == 0 {
+            SAMPLES[k % 4]
+        } else {
+            (0.5, 0.5)
+        };
         let s = 0.04 + 0.01 * (k % 5) as f32;
         let (x, y) = (px + cx, py + cy);
-        tri(&mut g, at(x - s, y + s, -0.8), at(x + s, y + s, -0.8), at(x, y - s, -0.8));
+        tri(
+            &mut g,
+            at(x - s, y + s, -0.8),
+            at(x + s, y + s, -0.8),
+            at(x, y - s, -0.8),
+        );
     }
     g
 }
 
 fn frame() -> FrameState {
     let view = DMat4::look_at_rh(DVec3::ZERO, -DVec3::Z, DVec3::Y);
-    FrameState { camera: Camera { view: view.to_cols_array(), yfov: std::f64::consts::FRAC_PI_2, znear: 0.1, zfar: Some(10.0) }, poses: vec![] }
+    FrameState {
+        camera: Camera {
+            view: view.to_cols_array(),
+            yfov: std::f64::consts::FRAC_PI_2,
+            znear: 0.1,
+            zfar: Some(10.0),
+        },
+        poses: vec![],
+    }
 }
 
 /// Ids per sample (id + 1, 0 for none) from a plain depth-tested render through the player's
@@ -88,7 +134,9 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
     );
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("coverage"),
-        source: wgpu::ShaderSource::Wgsl(trisort_shaders::compose(&["primitive_index"], &body).into()),
+        source: wgpu::ShaderSource::Wgsl(
+            trisort_shaders::compose(&["primitive_index"], &body).into(),
+        ),
     });
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: None,
@@ -98,8 +146,17 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("coverage"),
         layout: Some(&layout),
-        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_player"), compilation_options: Default::default(), buffers: &[Some(vertex_layout())] },
-        primitive: wgpu::PrimitiveState { front_face: wgpu::FrontFace::Ccw, cull_mode: None, ..Default::default() },
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_player"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertex_layout())],
+        },
+        primitive: wgpu::PrimitiveState {
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: None,
+            ..Default::default()
+        },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: wgpu::TextureFormat::Depth32Float,
             depth_write_enabled: Some(true),
@@ -107,7 +164,11 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
             stencil: Default::default(),
             bias: Default::default(),
         }),
-        multisample: wgpu::MultisampleState { count: 4, mask: !0, alpha_to_coverage_enabled: false },
+        multisample: wgpu::MultisampleState {
+            count: 4,
+            mask: !0,
+            alpha_to_coverage_enabled: false,
+        },
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some("fs_coverage"),
@@ -120,7 +181,11 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
     let tex = |format| {
         device.create_texture(&wgpu::TextureDescriptor {
             label: None,
-            size: wgpu::Extent3d { width: SIZE, height: SIZE, depth_or_array_layers: 1 },
+            size: wgpu::Extent3d {
+                width: SIZE,
+                height: SIZE,
+                depth_or_array_layers: 1,
+            },
             mip_level_count: 1,
             sample_count: 4,
             dimension: wgpu::TextureDimension::D2,
@@ -131,13 +196,19 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
     };
     let ids = tex(wgpu::TextureFormat::Rg32Uint);
     let depth = tex(wgpu::TextureFormat::Depth32Float);
-    let (idv, dv) = (ids.create_view(&Default::default()), depth.create_view(&Default::default()));
+    let (idv, dv) = (
+        ids.create_view(&Default::default()),
+        depth.create_view(&Default::default()),
+    );
     let indices: Vec<u32> = g.triangles.iter().flatten().copied().collect();
-    let index = wgpu::util::DeviceExt::create_buffer_init(device, &wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(&indices),
-        usage: wgpu::BufferUsages::INDEX,
-    });
+    let index = wgpu::util::DeviceExt::create_buffer_init(
+        device,
+        &wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytemuck::cast_slice(&indices),
+            usage: wgpu::BufferUsages::INDEX,
+        },
+    );
     // Gather with the recorder's own compute shader.
     let gather = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("gather"),
@@ -158,19 +229,34 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let dims = wgpu::util::DeviceExt::create_buffer_init(device, &wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(&[SIZE, SIZE, 4, 0]),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
+    let dims = wgpu::util::DeviceExt::create_buffer_init(
+        device,
+        &wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytemuck::cast_slice(&[SIZE, SIZE, 4, 0]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        },
+    );
     let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
         layout: &gather_pipeline.get_bind_group_layout(0),
         entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&idv) },
-            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&dv) },
-            wgpu::BindGroupEntry { binding: 2, resource: out.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 3, resource: dims.as_entire_binding() },
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&idv),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&dv),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: out.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: dims.as_entire_binding(),
+            },
         ],
     });
     let mut enc = device.create_command_encoder(&Default::default());
@@ -181,11 +267,17 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
                 view: &idv,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &dv,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
                 stencil_ops: None,
             }),
             ..Default::default()
@@ -213,7 +305,12 @@ fn recorded_samples_equal_an_independent_render_through_the_player_state() {
     let Some(gpu) = Gpu::for_tests() else { return };
     let g = edge_case_scene();
     let frames = [frame()];
-    let view = View { width: SIZE, height: SIZE, samples: 4, glass_opacity: 0.0 };
+    let view = View {
+        width: SIZE,
+        height: SIZE,
+        samples: 4,
+        glass_opacity: 0.0,
+    };
     let all: Vec<u32> = (0..g.triangles.len() as u32).collect();
     let peeler = Peeler::new(&gpu, &g, &all, &frames, view).unwrap();
     let mut recorded = vec![];
@@ -225,19 +322,41 @@ fn recorded_samples_equal_an_independent_render_through_the_player_state() {
         .unwrap();
     let independent = independent_render(&gpu, &g, &frames, view);
     assert_eq!(recorded.len(), independent.len());
-    let differing: Vec<usize> = (0..recorded.len()).filter(|&i| recorded[i] != independent[i]).collect();
-    assert!(differing.is_empty(), "{} of {} samples differ, first at slot {:?}", differing.len(), recorded.len(), differing.first());
+    let differing: Vec<usize> = (0..recorded.len())
+        .filter(|&i| recorded[i] != independent[i])
+        .collect();
+    assert!(
+        differing.is_empty(),
+        "{} of {} samples differ, first at slot {:?}",
+        differing.len(),
+        recorded.len(),
+        differing.first()
+    );
     // The scene does exercise the cases: many distinct triangles own samples, some samples
     // of sub-pixel triangles are covered, and each pixel's samples are not all alike.
     let distinct: std::collections::BTreeSet<u32> = recorded.iter().copied().collect();
-    assert!(distinct.len() > 60, "only {} triangles own samples", distinct.len());
+    assert!(
+        distinct.len() > 60,
+        "only {} triangles own samples",
+        distinct.len()
+    );
     // Sub-pixel triangles are scene ids 85..125 (ids + 1 in the samples): the even ones hold
     // exactly one sample each, the odd ones none.
     let first_sub_pixel = 1 + 72 + 12;
     for k in 0..40u32 {
-        let n = recorded.iter().filter(|&&id| id == first_sub_pixel + k + 1).count();
-        assert_eq!(n, if k % 2 == 0 { 1 } else { 0 }, "sub-pixel triangle {k} covers {n} samples");
+        let n = recorded
+            .iter()
+            .filter(|&&id| id == first_sub_pixel + k + 1)
+            .count();
+        assert_eq!(
+            n,
+            if k % 2 == 0 { 1 } else { 0 },
+            "sub-pixel triangle {k} covers {n} samples"
+        );
     }
-    let mixed = recorded.chunks_exact(4).filter(|p| p.iter().any(|&x| x != p[0])).count();
+    let mixed = recorded
+        .chunks_exact(4)
+        .filter(|p| p.iter().any(|&x| x != p[0]))
+        .count();
     assert!(mixed > 30, "only {mixed} pixels with differing samples");
 }

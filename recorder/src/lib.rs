@@ -14,9 +14,9 @@
 //! are finished are masked so later layers do no work there.
 #![deny(missing_docs)]
 
-pub mod partial;
 #[cfg(test)]
 mod coverage_test;
+pub mod partial;
 mod peeler;
 
 use std::collections::HashMap;

@@ -7,12 +7,24 @@ use trisort_shaders::gpu::Gpu;
 
 /// `copies` copies of `g` on a grid, each under a new root node translated by `spacing`.
 fn instanced(g: &Geometry, copies: u32, spacing: f64) -> Geometry {
-    let mut out = Geometry { materials: g.materials.clone(), textures: g.textures.clone(), ..Default::default() };
+    let mut out = Geometry {
+        materials: g.materials.clone(),
+        textures: g.textures.clone(),
+        ..Default::default()
+    };
     let side = (copies as f64).sqrt().ceil() as u32;
     for c in 0..copies {
         let node_base = out.nodes.len() as u32;
-        let offset = DVec3::new((c % side) as f64 * spacing, 0.0, (c / side) as f64 * spacing);
-        out.nodes.push(Node { name: format!("copy{c}"), parent: None, rest: DMat4::from_translation(offset).to_cols_array() });
+        let offset = DVec3::new(
+            (c % side) as f64 * spacing,
+            0.0,
+            (c / side) as f64 * spacing,
+        );
+        out.nodes.push(Node {
+            name: format!("copy{c}"),
+            parent: None,
+            rest: DMat4::from_translation(offset).to_cols_array(),
+        });
         for n in &g.nodes {
             out.nodes.push(Node {
                 name: n.name.clone(),
@@ -21,26 +33,50 @@ fn instanced(g: &Geometry, copies: u32, spacing: f64) -> Geometry {
             });
         }
         let vbase = out.vertices.len() as u32;
-        out.vertices.extend(g.vertices.iter().map(|v| trisort_format::Vertex { node: v.node + node_base + 1, ..*v }));
-        out.triangles.extend(g.triangles.iter().map(|t| t.map(|i| i + vbase)));
+        out.vertices
+            .extend(g.vertices.iter().map(|v| trisort_format::Vertex {
+                node: v.node + node_base + 1,
+                ..*v
+            }));
+        out.triangles
+            .extend(g.triangles.iter().map(|t| t.map(|i| i + vbase)));
     }
     out
 }
 
 #[test]
 fn five_million_triangles_record_one_frame() {
-    let Some(path) = trisort_scene::test_scene("CarConcept/CarConcept.glb") else { return };
+    let Some(path) = trisort_scene::test_scene("CarConcept/CarConcept.glb") else {
+        return;
+    };
     let Some(gpu) = Gpu::for_tests() else { return };
     let car = trisort_scene::load(&path).unwrap();
-    let scene = trisort_scene::Scene { geometry: instanced(&car.geometry, 24, 6.0), ..car };
-    assert!(scene.geometry.triangles.len() > 5_000_000, "{}", scene.geometry.triangles.len());
-    let timeline = trisort_paths::load("orbit:frames=1,elevation=35,distance=1.2", &scene, &Default::default()).unwrap();
+    let scene = trisort_scene::Scene {
+        geometry: instanced(&car.geometry, 24, 6.0),
+        ..car
+    };
+    assert!(
+        scene.geometry.triangles.len() > 5_000_000,
+        "{}",
+        scene.geometry.triangles.len()
+    );
+    let timeline = trisort_paths::load(
+        "orbit:frames=1,elevation=35,distance=1.2",
+        &scene,
+        &Default::default(),
+    )
+    .unwrap();
     let job = RecordJob {
         geometry: &scene.geometry,
         frames: &timeline.frames,
         scene_hash: [0; 32],
         path_hash: timeline.hash(),
-        settings: RecordSettings { width: 64, height: 64, samples: 4, ..Default::default() },
+        settings: RecordSettings {
+            width: 64,
+            height: 64,
+            samples: 4,
+            ..Default::default()
+        },
         range: None,
         phase: Phase::Graphs,
         known_visible: None,
@@ -53,5 +89,9 @@ fn five_million_triangles_record_one_frame() {
     // Copies far from the camera are visible too: ids from several instances.
     let per_copy = car.geometry.triangles.len() as u32;
     let copies: std::collections::BTreeSet<u32> = f.visible.iter().map(|t| t / per_copy).collect();
-    assert!(copies.len() > 4, "visible triangles from {} copies only", copies.len());
+    assert!(
+        copies.len() > 4,
+        "visible triangles from {} copies only",
+        copies.len()
+    );
 }
