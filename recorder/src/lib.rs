@@ -14,6 +14,7 @@
 //! are finished are masked so later layers do no work there.
 #![deny(missing_docs)]
 
+pub mod bench;
 #[cfg(test)]
 mod coverage_test;
 pub mod partial;

@@ -45,6 +45,7 @@ pub struct Peeler<'g> {
     params_stride: u64,
     dims: wgpu::Buffer,
     view: View,
+    plain: wgpu::RenderPipeline,
 }
 
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
@@ -282,7 +283,53 @@ impl<'g> Peeler<'g> {
             contents: bytemuck::cast_slice(&[view.width, view.height, view.samples, 0]),
             usage: wgpu::BufferUsages::UNIFORM,
         });
+        // A plain pass over the same triangles for benchmarks: same vertex stage, depth test,
+        // one colour per pixel.
+        let plain_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("plain"),
+            source: wgpu::ShaderSource::Wgsl(trisort_shaders::plain_shader().into()),
+        });
+        let plain_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("plain"),
+            bind_group_layouts: &[Some(&scene.layout)],
+            immediate_size: 0,
+        });
+        let plain = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("plain"),
+            layout: Some(&plain_layout),
+            vertex: wgpu::VertexState {
+                module: &plain_module,
+                entry_point: Some("vs_plain"),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout())],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: wgpu::MultisampleState {
+                count: view.samples,
+                mask: !0,
+                alpha_to_coverage_enabled: false,
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &plain_module,
+                entry_point: Some("fs_plain"),
+                compilation_options: Default::default(),
+                targets: &[Some(ID_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
         Ok(Peeler {
+            plain,
             gpu,
             scene,
             pipeline,
@@ -326,9 +373,7 @@ impl<'g> Peeler<'g> {
         let mut done = vec![0u32; slots];
         gpu.queue
             .write_buffer(&self.done, 0, bytemuck::cast_slice(&done));
-        let chunk_ranges: Vec<Range<u32>> = (0..self.triangles.div_ceil(CHUNK_TRIANGLES).max(1))
-            .map(|c| c * CHUNK_TRIANGLES..((c + 1) * CHUNK_TRIANGLES).min(self.triangles))
-            .collect();
+        let chunk_ranges = self.chunks();
         let n = chunk_ranges.len();
         for (first, offset_group) in [(1u32, 0usize), (0, n)] {
             for (c, r) in chunk_ranges.iter().enumerate() {
@@ -377,6 +422,118 @@ impl<'g> Peeler<'g> {
         }
     }
 
+    fn chunks(&self) -> Vec<Range<u32>> {
+        (0..self.triangles.div_ceil(CHUNK_TRIANGLES).max(1))
+            .map(|c| c * CHUNK_TRIANGLES..((c + 1) * CHUNK_TRIANGLES).min(self.triangles))
+            .collect()
+    }
+
+    /// Benchmarks: wall milliseconds of one render pass (submitted and waited for): a peel
+    /// layer (`layer_no` 0: the first, else a later one against whatever the previous-layer
+    /// textures hold) or, with `plain`, the plain pass over the same triangles.
+    pub fn time_render(&self, frame: u32, layer_no: u32, plain: bool) -> Result<f64, RecordError> {
+        let device = &self.gpu.device;
+        let chunks = self.chunks();
+        let cur = (layer_no % 2) as usize;
+        let prev = 1 - cur;
+        let dv = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (depth_views, id_views) = (
+            [dv(&self.depth[0]), dv(&self.depth[1])],
+            [dv(&self.ids[0]), dv(&self.ids[1])],
+        );
+        let peel_bg = self.peel_bind_group(&depth_views[prev], &id_views[prev]);
+        let t = std::time::Instant::now();
+        let mut enc = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = self.begin_layer_pass(&mut enc, &id_views[cur], &depth_views[cur]);
+            pass.set_pipeline(if plain { &self.plain } else { &self.pipeline });
+            pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+            pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
+            pass.set_index_buffer(self.index.slice(..), wgpu::IndexFormat::Uint32);
+            let group = if layer_no == 0 { 0 } else { chunks.len() };
+            for (c, r) in chunks.iter().enumerate() {
+                if !plain {
+                    pass.set_bind_group(
+                        1,
+                        &peel_bg,
+                        &[((group + c) as u64 * self.params_stride) as u32],
+                    );
+                }
+                pass.draw_indexed(r.start * 3..r.end * 3, 0, 0..1);
+            }
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.gpu
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RecordError::Device(e.to_string()))?;
+        Ok(t.elapsed().as_secs_f64() * 1000.0)
+    }
+
+    fn peel_bind_group(
+        &self,
+        prev_depth: &wgpu::TextureView,
+        prev_ids: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        self.gpu
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("peel"),
+                layout: &self.peel_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &self.params,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(16),
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(prev_depth),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(prev_ids),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: self.done.as_entire_binding(),
+                    },
+                ],
+            })
+    }
+
+    fn begin_layer_pass<'e>(
+        &self,
+        enc: &'e mut wgpu::CommandEncoder,
+        ids: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) -> wgpu::RenderPass<'e> {
+        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("peel layer"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: ids,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        })
+    }
+
     fn layer(
         &self,
         frame: u32,
@@ -389,32 +546,7 @@ impl<'g> Peeler<'g> {
         let dv = |t: &wgpu::Texture| t.create_view(&Default::default());
         let depth_views = [dv(&self.depth[0]), dv(&self.depth[1])];
         let id_views = [dv(&self.ids[0]), dv(&self.ids[1])];
-        let peel_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("peel"),
-            layout: &self.peel_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &self.params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(16),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&depth_views[prev]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&id_views[prev]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: self.done.as_entire_binding(),
-                },
-            ],
-        });
+        let peel_bg = self.peel_bind_group(&depth_views[prev], &id_views[prev]);
         let gather_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather"),
             layout: &self.gather_layout,
@@ -441,27 +573,7 @@ impl<'g> Peeler<'g> {
             label: Some("peel layer"),
         });
         {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("peel layer"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &id_views[cur],
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_views[cur],
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                ..Default::default()
-            });
+            let mut pass = self.begin_layer_pass(&mut enc, &id_views[cur], &depth_views[cur]);
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
             pass.set_vertex_buffer(0, self.scene.vertices.slice(..));

@@ -19,6 +19,17 @@ pub const SMOKE: &str = include_str!("wgsl/smoke.wgsl");
 /// Entry points of the player (`vs_player`, `fs_player_straight`, `fs_player_premultiplied`).
 pub const PLAYER: &str = include_str!("wgsl/player.wgsl");
 
+/// The exact reference's compositing entry points (`fs_reference_straight`,
+/// `fs_reference_premultiplied`); compose with [`reference_shader`].
+pub const REFERENCE: &str = include_str!("wgsl/reference.wgsl");
+
+/// The complete shader of the exact reference's compositing passes: [`COMMON`], the player's
+/// [`PLAYER`] entry points and the reference's own (needs `Features::PRIMITIVE_INDEX`). The
+/// reference draws with `vs_player` and shades with the player's `player_colour`.
+pub fn reference_shader() -> String {
+    compose(&["primitive_index"], &format!("{PLAYER}\n{REFERENCE}"))
+}
+
 /// Depth peeling entry points (`vs_peel`, `fs_peel`); compose with [`peel_shader`].
 pub const PEEL: &str = include_str!("wgsl/peel.wgsl");
 
@@ -73,15 +84,25 @@ pub fn gather_shader(samples: u32) -> String {
     peel_types(GATHER, samples)
 }
 
+/// The plain benchmark pass (`vs_plain`, `fs_plain`); compose with [`plain_shader`].
+pub const PLAIN: &str = include_str!("wgsl/plain.wgsl");
+
+/// The complete plain benchmark shader.
+pub fn plain_shader() -> String {
+    compose(&[], PLAIN)
+}
+
 /// Every shader of the crate by name, composed and ready to compile (used by the naga test).
 pub fn all() -> Vec<(&'static str, String)> {
     vec![
         ("smoke", compose(&[], SMOKE)),
         ("player", compose(&[], PLAYER)),
+        ("reference", reference_shader()),
         ("peel 1x", peel_shader(1)),
         ("peel 4x", peel_shader(4)),
         ("gather 1x", gather_shader(1)),
         ("gather 4x", gather_shader(4)),
+        ("plain", plain_shader()),
     ]
 }
 
