@@ -249,7 +249,9 @@ pub enum MergeError {
 /// `stats.seconds` is left 0 (callers measure and report the time).
 ///
 /// Errors when the recordings are not frame ranges of one path recorded with graphs (see
-/// [`MergeError`]).
+/// [`MergeError`]). Frames the recorder marked truncated are merged as recorded (their graph
+/// is incomplete); the validator fails on them. The device is taken from the first
+/// recording (in frame order).
 pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, MergeError> {
     if opts.segment == Some(0) {
         return Err(MergeError::ZeroSegment);
