@@ -151,42 +151,19 @@ impl Baked {
         &self.draws[w.first as usize..(w.first + w.count) as usize]
     }
 
-    /// Checks the structural consistency a reader must rely on before using the file:
-    /// indices in range, draws inside the index buffer, windows inside the draw list, one
-    /// frame state and one removed-edge list per frame. Returns the first problem found.
+    /// Checks the structural consistency a reader must rely on before using the file: the
+    /// geometry ([`Geometry::check_structure`]: indices in range, finite positions), scene ids
+    /// ascending, draws inside the index buffer, windows inside the draw list, one frame state
+    /// and one removed-edge list per frame, finite cameras and poses of existing nodes
+    /// ([`crate::camera::check_frame_state`]). Returns the first problem found.
     pub fn check_structure(&self) -> Result<(), String> {
         let g = &self.geometry;
-        let nv = g.vertices.len() as u64;
-        for (k, t) in g.triangles.iter().enumerate() {
-            if t.iter().any(|&v| v as u64 >= nv) {
-                return Err(format!("triangle {k} refers to a vertex beyond {nv}"));
-            }
-        }
-        for (k, v) in g.vertices.iter().enumerate() {
-            if v.material as usize >= g.materials.len() || v.node as usize >= g.nodes.len() {
-                return Err(format!("vertex {k} refers to a missing material or node"));
-            }
-            if !v.position.iter().all(|x| x.is_finite()) {
-                return Err(format!("vertex {k} has a non-finite position"));
-            }
-        }
-        for (k, m) in g.materials.iter().enumerate() {
-            if let Some(t) = m.base_color_texture {
-                let Some(tex) = g.textures.get(t as usize) else {
-                    return Err(format!("material {k} refers to missing texture {t}"));
-                };
-                if tex.rgba8.len() as u64 != tex.width as u64 * tex.height as u64 * 4 {
-                    return Err(format!("texture {t} has the wrong number of bytes"));
-                }
-            }
-        }
-        for (k, n) in g.nodes.iter().enumerate() {
-            if n.parent.is_some_and(|p| p as usize >= k) {
-                return Err(format!("node {k} has a parent that does not precede it"));
-            }
-        }
+        g.check_structure()?;
         if self.scene_ids.len() != g.triangles.len() {
             return Err("scene_ids and triangles differ in length".into());
+        }
+        if self.scene_ids.windows(2).any(|w| w[0] >= w[1]) {
+            return Err("scene_ids are not strictly ascending".into());
         }
         let ntri = g.triangles.len() as u64;
         if let Some(k) = self.copies.iter().position(|&c| c as u64 >= ntri) {
@@ -215,9 +192,7 @@ impl Baked {
             return Err("per-frame lists differ in length".into());
         }
         for (f, s) in self.frame_states.iter().enumerate() {
-            if s.poses.iter().any(|p| p.node as usize >= g.nodes.len()) {
-                return Err(format!("frame {f} poses a missing node"));
-            }
+            crate::camera::check_frame_state(f, s, Some(g.nodes.len()))?;
         }
         Ok(())
     }

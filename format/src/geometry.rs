@@ -141,6 +141,54 @@ impl Geometry {
         self.vertices[self.triangles[t as usize][0] as usize].node
     }
 
+    /// Checks the structural consistency a reader relies on before using the geometry:
+    /// triangle vertices in range, vertex materials and nodes in range, finite positions,
+    /// finite material factors, textures present with the right byte count, parents before
+    /// children, finite rest transforms. Returns the first problem found.
+    pub fn check_structure(&self) -> Result<(), String> {
+        let nv = self.vertices.len() as u64;
+        for (k, t) in self.triangles.iter().enumerate() {
+            if t.iter().any(|&v| v as u64 >= nv) {
+                return Err(format!("triangle {k} refers to a vertex beyond {nv}"));
+            }
+        }
+        for (k, v) in self.vertices.iter().enumerate() {
+            if v.material as usize >= self.materials.len() || v.node as usize >= self.nodes.len() {
+                return Err(format!("vertex {k} refers to a missing material or node"));
+            }
+            if !v.position.iter().all(|x| x.is_finite()) {
+                return Err(format!("vertex {k} has a non-finite position"));
+            }
+        }
+        for (k, m) in self.materials.iter().enumerate() {
+            let factors = m
+                .base_color
+                .iter()
+                .chain(&m.emissive)
+                .chain([&m.alpha_cutoff, &m.transmission]);
+            if !factors.into_iter().all(|x| x.is_finite()) {
+                return Err(format!("material {k} has a non-finite factor"));
+            }
+            if let Some(t) = m.base_color_texture {
+                let Some(tex) = self.textures.get(t as usize) else {
+                    return Err(format!("material {k} refers to missing texture {t}"));
+                };
+                if tex.rgba8.len() as u64 != tex.width as u64 * tex.height as u64 * 4 {
+                    return Err(format!("texture {t} has the wrong number of bytes"));
+                }
+            }
+        }
+        for (k, n) in self.nodes.iter().enumerate() {
+            if n.parent.is_some_and(|p| p as usize >= k) {
+                return Err(format!("node {k} has a parent that does not precede it"));
+            }
+            if !n.rest.iter().all(|x| x.is_finite()) {
+                return Err(format!("node {k}'s rest transform is not finite"));
+            }
+        }
+        Ok(())
+    }
+
     /// A copy holding only the given triangles (scene ids, ascending, no duplicates), with
     /// only the vertices they use; materials, textures and nodes are kept whole so their
     /// indices stay valid. Triangle k of the result is `ids[k]` of `self`.

@@ -129,6 +129,120 @@ impl Recording {
         crate::hash_bytes(&postcard::to_allocvec(self).expect("a Recording always serializes"))
     }
 
+    /// Checks the structural consistency a reader relies on before using the recording, and
+    /// returns the first problem found:
+    /// - settings: size ≥ 1, 1 or 4 samples, saturation in (0, 1], glass opacity in [0, 1];
+    /// - `unique_visible` (G) strictly ascending, every id below `scene_triangles`;
+    /// - frames ascending and contiguous, inside the path's `frame_states`;
+    /// - per frame: visible and covered sets strictly ascending and inside G; edges and ties
+    ///   sorted by (from, to) without duplicates, between distinct triangles of G, with a
+    ///   positive weight; a `Visibility` recording has no covered set, edges or ties;
+    /// - a `Graphs` recording's geometry holds one triangle per member of G and passes
+    ///   [`Geometry::check_structure`]; a `Visibility` recording holds none;
+    /// - every frame state passes [`crate::camera::check_frame_state`] (finite cameras; poses
+    ///   of existing nodes when the geometry is present).
+    ///
+    /// O(size of the recording).
+    pub fn check_structure(&self) -> Result<(), String> {
+        let s = &self.settings;
+        if s.width == 0 || s.height == 0 || (s.samples != 1 && s.samples != 4) {
+            return Err(format!(
+                "settings {}x{} at {} samples are impossible",
+                s.width, s.height, s.samples
+            ));
+        }
+        let saturation_ok = s.saturation > 0.0 && s.saturation <= 1.0;
+        if !saturation_ok || !(0.0..=1.0).contains(&s.glass_opacity) {
+            return Err(format!(
+                "saturation {} or glass opacity {} is out of range",
+                s.saturation, s.glass_opacity
+            ));
+        }
+        let g = &self.unique_visible;
+        if g.windows(2).any(|w| w[0] >= w[1]) {
+            return Err("the visible set G is not strictly ascending".into());
+        }
+        if let Some(&t) = g.last().filter(|&&t| t >= self.scene_triangles) {
+            return Err(format!(
+                "G names triangle {t}, but the scene has {}",
+                self.scene_triangles
+            ));
+        }
+        let in_g = |t: u32| g.binary_search(&t).is_ok();
+        let path_frames = self.frame_states.len() as u64;
+        let first = self.frames.first().map_or(0, |f| f.frame);
+        for (k, fr) in self.frames.iter().enumerate() {
+            let f = fr.frame;
+            if f as u64 != first as u64 + k as u64 {
+                return Err(format!(
+                    "frame record {k} is frame {f}; frames must be contiguous from {first}"
+                ));
+            }
+            if f as u64 >= path_frames {
+                return Err(format!(
+                    "frame {f} lies beyond the path's {path_frames} frames"
+                ));
+            }
+            for (what, set) in [("visible", &fr.visible), ("covered", &fr.covered)] {
+                if set.windows(2).any(|w| w[0] >= w[1]) {
+                    return Err(format!(
+                        "frame {f}: the {what} set is not strictly ascending"
+                    ));
+                }
+                if let Some(&t) = set.iter().find(|&&t| !in_g(t)) {
+                    return Err(format!("frame {f}: {what} triangle {t} is not in G"));
+                }
+            }
+            for (what, list) in [("edges", &fr.edges), ("ties", &fr.ties)] {
+                if list
+                    .windows(2)
+                    .any(|w| (w[0].from, w[0].to) >= (w[1].from, w[1].to))
+                {
+                    return Err(format!(
+                        "frame {f}: {what} are not sorted without duplicates"
+                    ));
+                }
+                if let Some(e) = list
+                    .iter()
+                    .find(|e| e.from == e.to || e.weight == 0 || !in_g(e.from) || !in_g(e.to))
+                {
+                    return Err(format!(
+                        "frame {f}: edge {} → {} (weight {}) is a loop, has no weight or leaves G",
+                        e.from, e.to, e.weight
+                    ));
+                }
+            }
+            if self.phase == Phase::Visibility
+                && !(fr.covered.is_empty() && fr.edges.is_empty() && fr.ties.is_empty())
+            {
+                return Err(format!("frame {f}: a visibility recording holds graphs"));
+            }
+        }
+        let nodes = match self.phase {
+            Phase::Graphs => {
+                if self.geometry.triangles.len() != g.len() {
+                    return Err(format!(
+                        "the geometry holds {} triangles for the {} of G",
+                        self.geometry.triangles.len(),
+                        g.len()
+                    ));
+                }
+                self.geometry.check_structure()?;
+                Some(self.geometry.nodes.len())
+            }
+            Phase::Visibility => {
+                if !self.geometry.triangles.is_empty() {
+                    return Err("a visibility recording holds geometry".into());
+                }
+                None
+            }
+        };
+        for (f, st) in self.frame_states.iter().enumerate() {
+            crate::camera::check_frame_state(f, st, nodes)?;
+        }
+        Ok(())
+    }
+
     /// The half-open range of recorded frames.
     pub fn frame_range(&self) -> std::ops::Range<u32> {
         match (self.frames.first(), self.frames.last()) {

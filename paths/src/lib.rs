@@ -226,6 +226,13 @@ pub fn load(spec: &str, scene: &Scene, opts: &PathOptions) -> Result<Timeline, P
     keyframes::load_file(Path::new(spec), scene)
 }
 
+/// Parses TOML keyframe text (the [TOML format](#the-toml-keyframe-format)) as if read from a
+/// file at `name`, which errors use for their location. [`load`] reads a file and does the
+/// same; this entry point serves callers that hold the text (and the fuzzer).
+pub fn load_toml_str(text: &str, name: &Path, scene: &Scene) -> Result<Timeline, PathError> {
+    keyframes::parse(text, name, scene)
+}
+
 /// The demo car's default path: 48 frames at 30 fps orbiting the scene once at 15°
 /// elevation (2.75 bounding radii from the centre), while the node named `DriverDoor`, if
 /// there is one, opens about its local +Y axis through its origin (its hinge) to 60° and

@@ -37,7 +37,7 @@ pub fn run(a: InspectArgs) -> Result<ExitCode> {
     };
     match kind {
         Some(FileKind::Recording) => {
-            let rec: Recording = trisort_format::read_file(FileKind::Recording, &path)?;
+            let rec: Recording = crate::cmd::merge::read_recording(&path)?;
             let v = crate::cmd::record::recording_json(&rec, None);
             if a.json {
                 print_json(&v);
@@ -77,6 +77,9 @@ pub fn run(a: InspectArgs) -> Result<ExitCode> {
         }
         Some(FileKind::Baked) => {
             let baked: trisort_format::Baked = trisort_format::read_file(FileKind::Baked, &path)?;
+            baked
+                .check_structure()
+                .map_err(|e| anyhow::anyhow!("{}: malformed baked file: {e}", a.file))?;
             let s = &baked.stats;
             let v = json!({
                 "strategy": baked.merge.strategy, "layout": baked.merge.layout,

@@ -152,12 +152,18 @@ pub fn baked_json(b: &Baked) -> serde_json::Value {
     })
 }
 
-/// Reads recordings, naming the file that fails.
+/// Reads recordings and checks their structure ([`Recording::check_structure`]), naming the
+/// file that fails.
 pub fn read_recordings(files: &[PathBuf]) -> Result<Vec<Recording>> {
-    files
-        .iter()
-        .map(|f| Ok(trisort_format::read_file(FileKind::Recording, f)?))
-        .collect()
+    files.iter().map(|f| read_recording(f)).collect()
+}
+
+/// Reads one recording and checks its structure, naming the file in the error.
+pub fn read_recording(file: &std::path::Path) -> Result<Recording> {
+    let rec: Recording = trisort_format::read_file(FileKind::Recording, file)?;
+    rec.check_structure()
+        .map_err(|e| anyhow::anyhow!("{}: malformed recording: {e}", file.display()))?;
+    Ok(rec)
 }
 
 /// Merges and writes atomically.

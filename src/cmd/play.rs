@@ -107,6 +107,9 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
         bail!("--window needs a display and a windowing build; this build plays headless only (use --out-dir)");
     }
     let baked: Baked = trisort_format::read_file(FileKind::Baked, &a.baked)?;
+    baked
+        .check_structure()
+        .map_err(|e| anyhow::anyhow!("{}: malformed baked file: {e}", a.baked.display()))?;
     let n = baked.frames.len() as u32;
     let range = match a.frames {
         Some(r) => r.resolve(n)?,

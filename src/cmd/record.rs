@@ -195,8 +195,11 @@ fn union_of_visibility(
     let mut seen = vec![false; n];
     let mut g = Vec::new();
     for f in files {
-        let rec: Recording = trisort_format::read_file(FileKind::Recording, f)?;
-        if rec.scene_hash != scene.hash() || rec.path_hash != timeline.hash() {
+        let rec: Recording = crate::cmd::merge::read_recording(f)?;
+        if rec.scene_hash != scene.hash()
+            || rec.path_hash != timeline.hash()
+            || rec.frame_states.len() != n
+        {
             bail!("{}: recorded from another scene or path", f.display());
         }
         for fr in &rec.frames {
