@@ -32,7 +32,7 @@ fn main() {
         rec.unique_visible.len(),
         t0.elapsed().as_secs_f64()
     );
-    println!("seeding  bridge  strategy layout  | index/|G| draws mean  max | drawn-not-vis unordered | seconds");
+    println!("seeding  bridge  strategy layout  | index/|G| draws mean  max | drawn-not-vis unordered | seconds | cell edges -> reduced");
     let all = [
         (StrategyChoice::Lib, "lib"),
         (StrategyChoice::Lbi, "lbi"),
@@ -73,7 +73,7 @@ fn main() {
                     let secs = t.elapsed().as_secs_f64();
                     let s = &b.stats;
                     println!(
-                        "{:8} {:7} {:8} {:7} | {:9.3} {:10.1} {:4} | {:13.1} {:9} | {:.3}",
+                        "{:8} {:7} {:8} {:7} | {:9.3} {:10.1} {:4} | {:13.1} {:9} | {:.3} | {} -> {}",
                         seeding.name(),
                         bridge.name(),
                         b.merge.strategy,
@@ -83,7 +83,9 @@ fn main() {
                         s.draws_per_frame_max,
                         s.drawn_not_visible_mean,
                         s.unordered_samples,
-                        secs
+                        secs,
+                        s.cell_constraint_edges,
+                        s.cell_constraint_edges_reduced
                     );
                 }
             }
