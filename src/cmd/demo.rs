@@ -86,6 +86,16 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         Some(&frames_dir),
     )?;
     let play_s = t_play.elapsed().as_secs_f64();
+    let t_images = Instant::now();
+    let images = crate::cmd::verify::verify_images(
+        &gpu,
+        &baked,
+        &scene.geometry,
+        trisort_reference::ImageCheck::recorded(&baked, trisort_player::Mode::Blend),
+        0..baked.frames.len() as u32,
+        |_| Ok(()),
+    )?;
+    let images_s = t_images.elapsed().as_secs_f64();
     let s = &baked.stats;
     let gpu_ms: Vec<f64> = played.iter().filter_map(|f| f.gpu_ms).collect();
     println!("frames:                 {}", baked.frames.len());
@@ -130,14 +140,25 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
             format!("FAILED: {:?}", report.problems)
         }
     );
-    println!("times:                  record {record_s:.1} s, merge {merge_s:.2} s, play {play_s:.1} s, total {:.1} s", t0.elapsed().as_secs_f64());
+    let worst = |f: fn(&trisort_reference::FrameImageReport) -> u8| {
+        images.frames.iter().map(f).max().unwrap_or(0)
+    };
+    println!(
+        "images (verify, blend):  {}: {} frames against the exact reference, max channel diff {}/255 ({}/255 on ordered pixels), {} unordered samples",
+        if images.ok { "all frames OK" } else { "FAILED" },
+        images.frames.len(),
+        worst(|f| f.comparison.max_channel_diff),
+        worst(|f| f.comparison.max_channel_diff_ordered),
+        images.frames.iter().map(|f| f.unordered_samples).sum::<u64>()
+    );
+    println!("times:                  record {record_s:.1} s, merge {merge_s:.2} s, play {play_s:.1} s, verify images {images_s:.1} s, total {:.1} s", t0.elapsed().as_secs_f64());
     println!(
         "wrote {} and {} PNG frames in {}",
         baked_path.display(),
         played.len(),
         frames_dir.display()
     );
-    Ok(if report.ok {
+    Ok(if report.ok && images.ok {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(crate::cmd::verify::VERIFY_FAILED)

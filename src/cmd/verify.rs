@@ -1,15 +1,31 @@
-//! `trisort verify BAKED`: graph rules against recordings (and, later, images).
+//! `trisort verify BAKED`: the graph rules against recordings (`--recording`), the images
+//! against the exact reference of the full scene (`--scene`), or both.
+//!
+//! Images: each frame of `--frames` is played by the player and rendered by the exact
+//! reference (`trisort_reference`) at the same size, sample count and mode. At the recorded
+//! pattern (the file's size and samples, on its recording device) a frame fails when `depth`
+//! mode is not bit-exact, or when `blend`/`saturate` differ by more than 1/255 in a colour
+//! channel at a pixel without an unordered sample. Off the pattern the error is measured and a
+//! frame fails only above `--max-error N`: the largest colour-channel difference on ordered
+//! pixels, in 1/255 units (no `--max-error`: measure only). The error of an 8-bit sRGB
+//! deployment target is reported separately (`srgb8`) and never gated on.
 
-use std::path::PathBuf;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
-use serde_json::json;
-use trisort_format::{Baked, FileKind};
+use serde_json::{json, Value};
+use trisort_format::{Baked, Geometry};
+use trisort_player::Mode;
+use trisort_reference::compare::{difference_image, mask_image};
+use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
+use trisort_shaders::gpu::Gpu;
 
 use crate::cmd::merge::read_recordings;
-use crate::common::print_json;
+use crate::cmd::play::write_png;
+use crate::common::{load_scene, parse_range, parse_size, print_json, FrameRange};
 
 /// Exit code of a verification that ran and found the baked file wrong.
 pub const VERIFY_FAILED: u8 = 3;
@@ -22,52 +38,231 @@ pub struct VerifyArgs {
     /// Recording(s) the file was merged from: checks the graph rules.
     #[arg(long, num_args = 1..)]
     recording: Vec<PathBuf>,
-    /// Scene: checks the images against the exact reference.
+    /// Scene (.glb/.gltf or demo[:TRIANGLES]): checks the images against the exact reference.
     #[arg(long)]
     scene: Option<String>,
+    /// Compositing mode of the image check.
+    #[arg(long, default_value = "blend")]
+    mode: Mode,
+    /// Image size WIDTHxHEIGHT (default: the recorded size).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// MSAA samples (default: the recorded count).
+    #[arg(long)]
+    samples: Option<u32>,
+    /// Frames to check, half-open `a..b` (default: all).
+    #[arg(long, value_parser = parse_range)]
+    frames: Option<FrameRange>,
+    /// Off the recorded pattern: fail a frame whose largest colour-channel difference on
+    /// ordered pixels exceeds N/255 (default: measure only).
+    #[arg(long, value_name = "N")]
+    max_error: Option<u8>,
+    /// Write, for each failing frame, the player's frame, the reference, a difference image
+    /// and the unordered mask as PNGs.
+    #[arg(long)]
+    diff_dir: Option<PathBuf>,
+    /// With `--diff-dir`: write the images of every checked frame, not only failing ones.
+    #[arg(long)]
+    diff_all: bool,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
 }
 
-pub fn run(a: VerifyArgs) -> Result<ExitCode> {
-    let baked: Baked = trisort_format::read_file(FileKind::Baked, &a.baked)?;
-    if a.scene.is_some() {
-        bail!("image verification (--scene) is not built yet (issue 6); use --recording for the graph rules");
-    }
-    if a.recording.is_empty() {
-        bail!("nothing to verify against: give --recording REC (graph rules)");
-    }
-    let recs = read_recordings(&a.recording)?;
-    let report = trisort_verify::check_graph(&recs, &baked);
-    let frames: Vec<_> = report
-        .frames
-        .iter()
-        .map(|f| {
-            let mut v = serde_json::to_value(f).expect("report serializes");
-            v["graph_violations"] = json!(f.graph_violations);
-            v
-        })
-        .collect();
-    if a.json {
-        print_json(
-            &json!({ "ok": report.ok, "frames": frames, "problems": report.problems, "bad_copies": report.bad_copies }),
+/// Image verification of a range of frames.
+pub struct ImageReport {
+    /// Whether every frame passed.
+    pub ok: bool,
+    /// Whether the check ran at the recorded pattern.
+    pub at_recorded_pattern: bool,
+    /// Per frame.
+    pub frames: Vec<FrameImageReport>,
+}
+
+/// Checks the scene against the file's scene hash: the reference must render the scene the
+/// file was baked from.
+pub fn check_scene(baked: &Baked, scene: &trisort_scene::Scene, spec: &str) -> Result<()> {
+    let hash = scene.hash();
+    if hash != baked.scene_hash {
+        bail!(
+            "scene {spec} (hash {}) is not the scene the baked file was made from (hash {}): give the same scene file, or for demo the same demo:TRIANGLES",
+            &trisort_format::hash_hex(&hash)[..16],
+            &trisort_format::hash_hex(&baked.scene_hash)[..16]
         );
+    }
+    Ok(())
+}
+
+/// Verifies `frames` of `baked` against the exact reference of `geometry`, calling `each`
+/// with every verified frame (for difference images and progress).
+pub fn verify_images(
+    gpu: &Gpu,
+    baked: &Baked,
+    geometry: &Geometry,
+    check: ImageCheck,
+    frames: Range<u32>,
+    mut each: impl FnMut(&VerifiedFrame) -> Result<()>,
+) -> Result<ImageReport> {
+    let verifier = ImageVerifier::new(gpu, baked, geometry, check)?;
+    let mut report = ImageReport {
+        ok: true,
+        at_recorded_pattern: verifier.at_recorded_pattern(),
+        frames: Vec::with_capacity(frames.len()),
+    };
+    for f in frames {
+        let v = verifier
+            .verify(f)
+            .with_context(|| format!("verifying frame {f}"))?;
+        each(&v)?;
+        report.ok &= v.report.ok;
+        report.frames.push(v.report);
+    }
+    Ok(report)
+}
+
+fn write_diff(dir: &Path, v: &VerifiedFrame, size: (u32, u32)) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let f = v.report.frame;
+    let (w, h) = size;
+    let r = &v.reference;
+    write_png(&dir.join(format!("{f:05}-player.png")), w, h, &v.player)?;
+    write_png(&dir.join(format!("{f:05}-reference.png")), w, h, &r.rgba8)?;
+    write_png(
+        &dir.join(format!("{f:05}-diff.png")),
+        w,
+        h,
+        &difference_image(&v.player, &r.rgba8, &r.unordered),
+    )?;
+    write_png(
+        &dir.join(format!("{f:05}-unordered.png")),
+        w,
+        h,
+        &mask_image(&r.unordered),
+    )?;
+    Ok(())
+}
+
+pub fn run(a: VerifyArgs) -> Result<ExitCode> {
+    let baked: Baked = trisort_player::open_baked(&a.baked)?;
+    if a.recording.is_empty() && a.scene.is_none() {
+        bail!("nothing to verify against: give --recording REC (graph rules) and/or --scene SCENE (images)");
+    }
+    let graph = if a.recording.is_empty() {
+        None
     } else {
-        let bad: Vec<_> = report
+        let recs = read_recordings(&a.recording)?;
+        Some(trisort_verify::check_graph(&recs, &baked))
+    };
+    let images = match &a.scene {
+        None => None,
+        Some(spec) => {
+            let scene = load_scene(spec)?;
+            check_scene(&baked, &scene, spec)?;
+            let n = baked.frames.len() as u32;
+            let range = match a.frames {
+                Some(r) => r.resolve(n)?,
+                None if n == 0 => bail!("the baked file has no frames"),
+                None => 0..n,
+            };
+            let check = ImageCheck {
+                size: a
+                    .size
+                    .unwrap_or((baked.settings.width, baked.settings.height)),
+                samples: a.samples.unwrap_or(baked.settings.samples.max(1)),
+                max_error: a.max_error,
+                ..ImageCheck::recorded(&baked, a.mode)
+            };
+            if check.samples != 1 && check.samples != 4 {
+                bail!("--samples {}: only 1 and 4 are supported", check.samples);
+            }
+            let gpu = Gpu::new()?;
+            if !a.json {
+                println!("device: {}", gpu.describe());
+            }
+            let size = check.size;
+            let report = verify_images(&gpu, &baked, &scene.geometry, check, range, |v| {
+                if let Some(dir) = &a.diff_dir {
+                    if a.diff_all || !v.report.ok {
+                        write_diff(dir, v, size)?;
+                    }
+                }
+                Ok(())
+            })?;
+            Some((report, check))
+        }
+    };
+    let ok = graph.as_ref().is_none_or(|g| g.ok) && images.as_ref().is_none_or(|i| i.0.ok);
+    if a.json {
+        print_json(&json_report(ok, graph.as_ref(), images.as_ref()));
+    } else {
+        print_report(&a.baked, graph.as_ref(), images.as_ref());
+        println!(
+            "{}: {}",
+            a.baked.display(),
+            if ok { "OK" } else { "FAILED" }
+        );
+    }
+    Ok(if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(VERIFY_FAILED)
+    })
+}
+
+fn json_report(
+    ok: bool,
+    graph: Option<&trisort_verify::GraphReport>,
+    images: Option<&(ImageReport, ImageCheck)>,
+) -> Value {
+    let graph_frame = |f: u32| graph.and_then(|g| g.frames.iter().find(|r| r.frame == f));
+    let frames: Vec<Value> = match images {
+        Some((report, _)) => report
             .frames
             .iter()
-            .filter(|f| {
-                f.graph_violations > 0
-                    || f.visible_missing > 0
-                    || f.drawn_twice > 0
-                    || f.bridge_violations > 0
-                    || f.truncated
+            .map(|fr| {
+                let mut v = serde_json::to_value(fr).expect("report serializes");
+                if let Some(g) = graph_frame(fr.frame) {
+                    v["graph_violations"] = json!(g.graph_violations);
+                    v["graph"] = serde_json::to_value(g).expect("report serializes");
+                }
+                v
             })
-            .collect();
+            .collect(),
+        None => graph
+            .map(|g| {
+                g.frames
+                    .iter()
+                    .map(|f| serde_json::to_value(f).expect("report serializes"))
+                    .collect()
+            })
+            .unwrap_or_default(),
+    };
+    let mut out = json!({ "ok": ok, "frames": frames });
+    if let Some(g) = graph {
+        out["graph_ok"] = json!(g.ok);
+        out["problems"] = json!(g.problems);
+        out["bad_copies"] = json!(g.bad_copies);
+    }
+    if let Some((report, check)) = images {
+        out["images_ok"] = json!(report.ok);
+        out["mode"] = json!(check.mode.name());
+        out["size"] = json!([check.size.0, check.size.1]);
+        out["samples"] = json!(check.samples);
+        out["at_recorded_pattern"] = json!(report.at_recorded_pattern);
+        out["max_error"] = json!(check.max_error);
+    }
+    out
+}
+
+fn print_report(
+    baked: &Path,
+    graph: Option<&trisort_verify::GraphReport>,
+    images: Option<&(ImageReport, ImageCheck)>,
+) {
+    if let Some(report) = graph {
+        let bad: Vec<_> = report.frames.iter().filter(|f| !f.ok()).collect();
         println!(
-            "{}: {} ({} frames checked, {} with problems, {} unordered samples)",
-            a.baked.display(),
+            "graph rules: {} ({} frames checked, {} with problems, {} unordered samples)",
             if report.ok { "OK" } else { "FAILED" },
             report.frames.len(),
             bad.len(),
@@ -84,9 +279,47 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             println!("  frame {}: {:?}", f.frame, f);
         }
     }
-    Ok(if report.ok {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(VERIFY_FAILED)
-    })
+    if let Some((report, check)) = images {
+        let bad = report.frames.iter().filter(|f| !f.ok).count();
+        println!(
+            "images of {} ({} mode, {}x{}, {}x MSAA, {}): {} ({} frames checked, {} failing)",
+            baked.display(),
+            check.mode,
+            check.size.0,
+            check.size.1,
+            check.samples,
+            if report.at_recorded_pattern {
+                "recorded pattern".to_string()
+            } else {
+                match check.max_error {
+                    Some(m) => format!("off the recorded pattern, max error {m}/255"),
+                    None => "off the recorded pattern, measured only".to_string(),
+                }
+            },
+            if report.ok { "OK" } else { "FAILED" },
+            report.frames.len(),
+            bad
+        );
+        println!(
+            "  frame  ok  differing  ordered  max  max_ord  psnr   flip     unordered  srgb8_max"
+        );
+        for f in &report.frames {
+            let c = &f.comparison;
+            println!(
+                "  {:5}  {:3} {:9}  {:7}  {:3}  {:7}  {:5.1}  {:.5}  {:9}  {}",
+                f.frame,
+                if f.ok { "yes" } else { "NO" },
+                c.pixels_differing,
+                c.pixels_differing_ordered,
+                c.max_channel_diff,
+                c.max_channel_diff_ordered,
+                c.psnr,
+                c.flip_mean,
+                f.unordered_samples,
+                f.srgb8
+                    .map(|s| s.max_channel_diff.to_string())
+                    .unwrap_or_else(|| "-".into())
+            );
+        }
+    }
 }

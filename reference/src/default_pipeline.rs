@@ -1,0 +1,176 @@
+//! The *default pipeline*: what engines do today, as a comparison renderer for `bench`.
+//!
+//! Every triangle of the scene, with the depth test: first the opaque ones (`OPAQUE` and
+//! `MASK` materials) in ascending id order with depth writes, then the transparent ones
+//! (`BLEND` materials and transmissive glass) in ascending id order, unsorted, with the depth
+//! test on and depth writes off. Both passes use the player's vertex shader, its
+//! `fs_player_straight` and its `over` blend state, into the same `Rgba16Float` MSAA target,
+//! resolved and quantized once like the player's frames. Its error against the exact
+//! reference is what sorting buys.
+
+use trisort_format::{AlphaMode, FrameState, Geometry};
+use trisort_player::{blend_state, quantize_rgba16f, Mode};
+use trisort_shaders::gpu::Gpu;
+use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use wgpu::util::DeviceExt;
+
+use crate::target::{clear_colour, halves, Target, DEPTH_FORMAT};
+use crate::ReferenceError;
+
+/// Whether a scene triangle is drawn in the transparent pass: its material (that of its first
+/// vertex) is `BLEND` or transmissive.
+pub fn is_transparent(geometry: &Geometry, triangle: usize) -> bool {
+    let v = geometry.triangles[triangle][0] as usize;
+    let m = &geometry.materials[geometry.vertices[v].material as usize];
+    m.alpha_mode == AlphaMode::Blend || m.transmission > 0.0
+}
+
+/// The default pipeline for one scene at one view.
+pub struct DefaultRenderer<'g> {
+    gpu: &'g Gpu,
+    scene: SceneGpu,
+    opaque_pipeline: wgpu::RenderPipeline,
+    transparent_pipeline: wgpu::RenderPipeline,
+    opaque: (wgpu::Buffer, u32),
+    transparent: (wgpu::Buffer, u32),
+    target: Target,
+}
+
+impl<'g> DefaultRenderer<'g> {
+    /// Uploads the whole scene for rendering at `view`. Errors where the adapter cannot
+    /// multisample the targets.
+    pub fn new(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+    ) -> Result<DefaultRenderer<'g>, ReferenceError> {
+        let device = &gpu.device;
+        let target = Target::new(
+            gpu,
+            (view.width, view.height),
+            view.samples,
+            trisort_player::headless::COLOR_FORMAT,
+            true,
+        )?;
+        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("default pipeline"),
+            source: wgpu::ShaderSource::Wgsl(
+                trisort_shaders::compose(&[], trisort_shaders::PLAYER).into(),
+            ),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("default pipeline"),
+            bind_group_layouts: &[Some(&scene.layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |write: bool| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(if write {
+                    "default pipeline (opaque)"
+                } else {
+                    "default pipeline (transparent)"
+                }),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_player"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(vertex_layout())],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    front_face: wgpu::FrontFace::Ccw,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(write),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState {
+                    count: view.samples,
+                    mask: !0,
+                    alpha_to_coverage_enabled: false,
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(trisort_player::fragment_entry_point(Mode::Blend)),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: trisort_player::headless::COLOR_FORMAT,
+                        blend: Some(blend_state(Mode::Blend)),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let opaque_pipeline = pipeline(true);
+        let transparent_pipeline = pipeline(false);
+        let mut lists = [Vec::new(), Vec::new()];
+        for (t, tri) in geometry.triangles.iter().enumerate() {
+            lists[is_transparent(geometry, t) as usize].extend_from_slice(tri);
+        }
+        let upload = |indices: &Vec<u32>| {
+            let n = indices.len() as u32;
+            let data: &[u32] = if indices.is_empty() { &[0; 3] } else { indices };
+            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("default pipeline indices"),
+                contents: bytemuck::cast_slice(data),
+                usage: wgpu::BufferUsages::INDEX,
+            });
+            (buffer, n)
+        };
+        Ok(DefaultRenderer {
+            gpu,
+            opaque: upload(&lists[0]),
+            transparent: upload(&lists[1]),
+            scene,
+            opaque_pipeline,
+            transparent_pipeline,
+            target,
+        })
+    }
+
+    /// Number of triangles drawn per frame (opaque, transparent).
+    pub fn triangles(&self) -> (u32, u32) {
+        (self.opaque.1 / 3, self.transparent.1 / 3)
+    }
+
+    /// Records frame `frame` into `pass`, whose attachments must match the view (an
+    /// `Rgba16Float` colour and a `Depth32Float` depth at its sample count): the opaque draw,
+    /// then the transparent one.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, frame: u32) {
+        pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+        pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
+        for (pipeline, (index, count)) in [
+            (&self.opaque_pipeline, &self.opaque),
+            (&self.transparent_pipeline, &self.transparent),
+        ] {
+            if *count == 0 {
+                continue;
+            }
+            pass.set_pipeline(pipeline);
+            pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..*count, 0, 0..1);
+        }
+    }
+
+    /// Renders frame `frame` over the player's background and returns it as 8-bit sRGB RGBA
+    /// (quantized once, like the player's frames).
+    pub fn render(&self, frame: u32) -> Result<Vec<u8>, ReferenceError> {
+        let bytes = self
+            .target
+            .render(self.gpu, clear_colour(Mode::Blend), |pass| {
+                self.draw(pass, frame);
+                Ok(())
+            })?;
+        Ok(quantize_rgba16f(&halves(&bytes), None))
+    }
+}

@@ -1,0 +1,484 @@
+//! The exact reference of DESIGN.md § Frame accuracy.
+//!
+//! `blend` and `saturate`: the *full* scene (every triangle, not only G) is peeled per sample
+//! to completion with the recorder's own [`Peeler`] (same shader, same (depth, id) keys, same
+//! per-sample targets). The layers are then composited in the mode's order (`blend`: back to
+//! front; `saturate`: front to back, under) through the player's vertex shader, its
+//! `player_colour`, its blend state and its `Rgba16Float` target, one render pass with one draw
+//! per layer: each triangle of a layer writes only the samples where the peel found it in that
+//! layer (`@builtin(sample_mask)`, see `shaders/src/wgsl/reference.wgsl`); shading stays per
+//! pixel as in the player. The pass resolves MSAA like the headless player and the result is
+//! quantized once with [`quantize_rgba16f`].
+//!
+//! `depth`: the player's depth mode shows, per sample, the nearest fragment (the lowest id on a
+//! depth tie) composited *over* the background, because it draws front to back and the first
+//! fragment's depth write hides every later one. The reference composites the first peel layer
+//! alone the same way. For opaque scenes that is exactly DESIGN's "plain z-buffer of all
+//! triangles in ascending id order with `Less`" ([`whole_scene_baked`] played in depth mode;
+//! a test checks both agree bit for bit); with transparency the z-buffer in id order blends a
+//! near transparent fragment over whatever farther fragment happened to have a lower id, which
+//! no sorted front-to-back player draws, so it cannot be the reference there.
+//!
+//! The player draws only the triangles visible before saturation; the reference composites
+//! every layer. What lies behind a saturated sample contributes at most the residual
+//! transmittance (1 − threshold, 0.002 by default) to it.
+
+use std::collections::HashSet;
+
+use trisort_format::{
+    Baked, DrawIndexedIndirectArgs, FrameState, FrameWindow, Geometry, RecordSettings,
+};
+use trisort_player::{blend_state, quantize_rgba16f, Mode, BACKGROUND};
+use trisort_recorder::Peeler;
+use trisort_shaders::gpu::Gpu;
+use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use wgpu::util::DeviceExt;
+
+use crate::target::{clear_colour, halves, Target};
+use crate::ReferenceError;
+
+/// The pattern and mode a reference frame is rendered at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceConfig {
+    /// Image size (width, height).
+    pub size: (u32, u32),
+    /// MSAA samples (1 or 4).
+    pub samples: u32,
+    /// Compositing mode.
+    pub mode: Mode,
+    /// Opacity of transmissive glass.
+    pub glass_opacity: f32,
+    /// Safety bound on peel layers; a frame that hits it is reported truncated.
+    pub max_layers: u32,
+}
+
+impl ReferenceConfig {
+    /// A baked file's recorded pattern (size, samples, glass opacity) in `mode`, with a layer
+    /// bound of 4096.
+    pub fn recorded(baked: &Baked, mode: Mode) -> ReferenceConfig {
+        ReferenceConfig {
+            size: (baked.settings.width, baked.settings.height),
+            samples: baked.settings.samples.max(1),
+            mode,
+            glass_opacity: baked.settings.glass_opacity,
+            max_layers: 4096,
+        }
+    }
+
+    fn view(&self) -> View {
+        View {
+            width: self.size.0,
+            height: self.size.1,
+            samples: self.samples,
+            glass_opacity: self.glass_opacity,
+        }
+    }
+}
+
+/// The intra-frame cycle edges a merger removed, looked up by scene id: a sample is
+/// *unordered* when two consecutive fragments of the peel of G there, a then b, form a removed
+/// edge a → b (DESIGN rule 3).
+pub struct RemovedEdges {
+    /// Per scene triangle: G-local id + 1, 0 for triangles outside G.
+    local: Vec<u32>,
+    /// Per frame: the removed edges (G-local ids).
+    per_frame: Vec<HashSet<(u32, u32)>>,
+    /// Per frame: their total weight as the baked file records it.
+    recorded: Vec<u64>,
+}
+
+impl RemovedEdges {
+    /// The removed edges of `baked`, for a scene of `scene_triangles` triangles. Errors when
+    /// the file names scene ids the scene lacks.
+    pub fn of_baked(baked: &Baked, scene_triangles: usize) -> Result<RemovedEdges, ReferenceError> {
+        let mut local = vec![0u32; scene_triangles];
+        for (k, &s) in baked.scene_ids.iter().enumerate() {
+            let slot = local.get_mut(s as usize).ok_or_else(|| {
+                ReferenceError::Invalid(format!(
+                    "the baked file names scene triangle {s}; the scene has {scene_triangles}"
+                ))
+            })?;
+            *slot = k as u32 + 1;
+        }
+        Ok(RemovedEdges {
+            local,
+            per_frame: baked
+                .removed_edges
+                .iter()
+                .map(|es| es.iter().map(|e| (e.from, e.to)).collect())
+                .collect(),
+            recorded: baked
+                .removed_edges
+                .iter()
+                .map(|es| es.iter().map(|e| e.weight as u64).sum())
+                .collect(),
+        })
+    }
+
+    /// The removed edges' total weight of frame `f` as the file records it (its claimed
+    /// `unordered_samples`).
+    pub fn recorded_weight(&self, f: u32) -> u64 {
+        self.recorded.get(f as usize).copied().unwrap_or(0)
+    }
+}
+
+/// One frame of the exact reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceFrame {
+    /// Frame index.
+    pub frame: u32,
+    /// `width × height` pixels, RGBA8, sRGB-encoded, alpha 255 (as [`quantize_rgba16f`]).
+    pub rgba8: Vec<u8>,
+    /// Per pixel: whether it has an unordered sample (all false without [`RemovedEdges`]).
+    pub unordered: Vec<bool>,
+    /// Number of (sample, removed edge) occurrences found by the peel.
+    pub unordered_samples: u64,
+    /// Peel layers peeled (`depth` mode stops after the first where the frame has no removed
+    /// edge).
+    pub layers: u32,
+    /// Whether the peel stopped at `max_layers` with fragments left.
+    pub truncated: bool,
+}
+
+/// Composite-pass resources of one layer.
+struct LayerDraw {
+    bind_group: wgpu::BindGroup,
+    index: wgpu::Buffer,
+    triangles: u32,
+}
+
+/// The exact reference renderer for one scene at one pattern and mode.
+pub struct ExactReference<'g> {
+    gpu: &'g Gpu,
+    config: ReferenceConfig,
+    /// Every scene triangle (vertex indices), to build each layer's index list.
+    triangles: Vec<[u32; 3]>,
+    peeler: Peeler<'g>,
+    scene: SceneGpu,
+    pipeline: wgpu::RenderPipeline,
+    composite_layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+    target: Target,
+}
+
+/// A baked file that draws every triangle of `geometry` in ascending id order in every frame
+/// (front-to-back playback is the stored order): played by the player in `depth` mode it is
+/// the plain z-buffer of all triangles in id order (equal to the `depth` reference on opaque
+/// scenes).
+pub fn whole_scene_baked(
+    geometry: &Geometry,
+    frames: &[FrameState],
+    settings: RecordSettings,
+) -> Baked {
+    let n = geometry.triangles.len() as u32;
+    let frame_count = frames.len() as u32;
+    Baked {
+        tool_version: trisort_format::TOOL_VERSION.to_string(),
+        scene_hash: [0; 32],
+        path_hash: [0; 32],
+        recording_hashes: vec![],
+        settings,
+        device: Default::default(),
+        merge: Default::default(),
+        stats: Default::default(),
+        geometry: geometry.clone(),
+        scene_ids: (0..n).collect(),
+        copies: (0..n).collect(),
+        draws: (0..frame_count)
+            .map(|_| DrawIndexedIndirectArgs {
+                index_count: 3 * n,
+                instance_count: 1,
+                first_index: 0,
+                base_vertex: 0,
+                first_instance: 0,
+            })
+            .collect(),
+        frames: (0..frame_count)
+            .map(|f| FrameWindow { first: f, count: 1 })
+            .collect(),
+        frame_states: frames.to_vec(),
+        removed_edges: vec![vec![]; frames.len()],
+    }
+}
+
+impl<'g> ExactReference<'g> {
+    /// Uploads the full scene `geometry` with the path's `frames` for rendering at `config`.
+    /// Errors where the device lacks what the peeler needs (`PRIMITIVE_INDEX`, multisampled
+    /// integer targets) or cannot multisample the targets.
+    pub fn new(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        config: ReferenceConfig,
+    ) -> Result<ExactReference<'g>, ReferenceError> {
+        if config.size.0 == 0 || config.size.1 == 0 || !(config.samples == 1 || config.samples == 4)
+        {
+            return Err(ReferenceError::Invalid(format!(
+                "{}x{} at {} samples: sizes must be positive and samples 1 or 4",
+                config.size.0, config.size.1, config.samples
+            )));
+        }
+        let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
+        let view = config.view();
+        let peeler = Peeler::new(gpu, geometry, &all, frames, view)?;
+        let device = &gpu.device;
+        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let storage = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("reference composite"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(16),
+                    },
+                    count: None,
+                },
+                storage(1),
+                storage(2),
+            ],
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("reference composite"),
+            source: wgpu::ShaderSource::Wgsl(trisort_shaders::reference_shader().into()),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("reference composite"),
+            bind_group_layouts: &[Some(&scene.layout), Some(&composite_layout)],
+            immediate_size: 0,
+        });
+        // The fragment outputs of `trisort_player::fragment_entry_point(mode)`, masked.
+        let entry = match config.mode {
+            Mode::Saturate => "fs_reference_premultiplied",
+            Mode::Blend | Mode::Depth => "fs_reference_straight",
+        };
+        // The player's pipeline state (see `trisort_player`'s `create_pipeline`), with the
+        // reference's fragment entry point.
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("reference composite"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_player"),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout())],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState {
+                count: config.samples,
+                mask: !0,
+                alpha_to_coverage_enabled: false,
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: trisort_player::headless::COLOR_FORMAT,
+                    blend: Some(blend_state(config.mode)),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("reference composite params"),
+            contents: bytemuck::cast_slice(&[config.size.0, config.samples, 0, 0]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let target = Target::new(
+            gpu,
+            config.size,
+            config.samples,
+            trisort_player::headless::COLOR_FORMAT,
+            false,
+        )?;
+        Ok(ExactReference {
+            gpu,
+            config,
+            triangles: geometry.triangles.clone(),
+            peeler,
+            scene,
+            pipeline,
+            composite_layout,
+            params,
+            target,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &ReferenceConfig {
+        &self.config
+    }
+
+    /// Renders frame `frame`. With `removed`, also finds the unordered samples of the frame.
+    pub fn render(
+        &self,
+        frame: u32,
+        removed: Option<&RemovedEdges>,
+    ) -> Result<ReferenceFrame, ReferenceError> {
+        let (w, h) = self.config.size;
+        let pixels = w as usize * h as usize;
+        let depth_mode = self.config.mode == Mode::Depth;
+        let samples = self.config.samples as usize;
+        let slots = self.peeler.slots();
+        let mut layer_ids: Vec<Vec<u32>> = Vec::new();
+        let mut last_g = vec![0u32; if removed.is_some() { slots } else { 0 }];
+        let mut unordered_sample = vec![false; pixels];
+        let mut unordered_samples = 0u64;
+        let no_edges = HashSet::new();
+        let edges = removed.map(|r| r.per_frame.get(frame as usize).unwrap_or(&no_edges));
+        // `depth` composites only the first layer; it peels on only to find unordered samples.
+        let full = !depth_mode || edges.is_some_and(|e| !e.is_empty());
+        let (layers, truncated) =
+            self.peeler
+                .peel(frame, self.config.max_layers, |k, layer, _| {
+                    if let (Some(r), Some(edges)) = (removed, edges) {
+                        for (i, &id) in layer.ids.iter().enumerate() {
+                            if id == 0 {
+                                continue;
+                            }
+                            let local = r.local.get((id - 1) as usize).copied().unwrap_or(0);
+                            if local == 0 {
+                                continue;
+                            }
+                            let prev = last_g[i];
+                            if prev != 0 && edges.contains(&(prev - 1, local - 1)) {
+                                unordered_samples += 1;
+                                unordered_sample[i / samples] = true;
+                            }
+                            last_g[i] = local;
+                        }
+                    }
+                    if !depth_mode || k == 0 {
+                        layer_ids.push(layer.ids.clone());
+                    }
+                    Ok(full)
+                })?;
+        let draws = self.layer_draws(&layer_ids)?;
+        let order: Vec<&LayerDraw> = match self.config.mode {
+            Mode::Blend => draws.iter().rev().collect(),
+            Mode::Depth | Mode::Saturate => draws.iter().collect(),
+        };
+        let (target, scene, pipeline) = (&self.target, &self.scene, &self.pipeline);
+        let bytes = target.render(self.gpu, clear_colour(self.config.mode), |pass| {
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &scene.bind_group, &scene.offsets(frame));
+            pass.set_vertex_buffer(0, scene.vertices.slice(..));
+            for d in order {
+                pass.set_bind_group(1, &d.bind_group, &[]);
+                pass.set_index_buffer(d.index.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..d.triangles * 3, 0, 0..1);
+            }
+            Ok(())
+        })?;
+        let under = (self.config.mode == Mode::Saturate).then_some(BACKGROUND);
+        Ok(ReferenceFrame {
+            frame,
+            rgba8: quantize_rgba16f(&halves(&bytes), under),
+            unordered: unordered_sample,
+            unordered_samples,
+            layers,
+            truncated: truncated && full,
+        })
+    }
+
+    /// Per layer: its ids as a storage buffer, the index list of the triangles it holds
+    /// (ascending id) and their ids.
+    fn layer_draws(&self, layers: &[Vec<u32>]) -> Result<Vec<LayerDraw>, ReferenceError> {
+        let device = &self.gpu.device;
+        let (layout, params) = (&self.composite_layout, &self.params);
+        let mut seen = vec![u32::MAX; self.triangles.len()];
+        let mut out = Vec::with_capacity(layers.len());
+        for (k, ids) in layers.iter().enumerate() {
+            let mut tris: Vec<u32> = Vec::new();
+            for &id in ids {
+                if id == 0 {
+                    continue;
+                }
+                let t = (id - 1) as usize;
+                let s = seen.get_mut(t).ok_or_else(|| {
+                    ReferenceError::Invalid(format!("peel returned triangle {t} beyond the scene"))
+                })?;
+                if *s != k as u32 {
+                    *s = k as u32;
+                    tris.push(t as u32);
+                }
+            }
+            tris.sort_unstable();
+            let mut index: Vec<u32> = Vec::with_capacity(tris.len() * 3);
+            for &t in &tris {
+                index.extend_from_slice(&self.triangles[t as usize]);
+            }
+            if tris.is_empty() {
+                tris.push(0);
+                index.extend_from_slice(&[0, 0, 0]);
+            }
+            let buffer = |label, contents: &[u8], usage| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage,
+                })
+            };
+            let ids_buf = buffer(
+                "reference layer ids",
+                bytemuck::cast_slice(ids),
+                wgpu::BufferUsages::STORAGE,
+            );
+            let draw_ids = buffer(
+                "reference layer triangles",
+                bytemuck::cast_slice(&tris),
+                wgpu::BufferUsages::STORAGE,
+            );
+            let index_buf = buffer(
+                "reference layer indices",
+                bytemuck::cast_slice(&index),
+                wgpu::BufferUsages::INDEX,
+            );
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("reference layer"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: ids_buf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: draw_ids.as_entire_binding(),
+                    },
+                ],
+            });
+            out.push(LayerDraw {
+                bind_group,
+                index: index_buf,
+                triangles: (index.len() / 3) as u32,
+            });
+        }
+        Ok(out)
+    }
+}

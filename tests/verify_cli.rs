@@ -1,0 +1,225 @@
+//! `trisort verify --scene` through the real binary: the JSON keys of DESIGN's CLI contract,
+//! graph and image checks together, difference images, a scene that is not the baked one,
+//! the off-pattern measure with `--max-error`, and the mutation check (a file whose order was
+//! corrupted on purpose fails with exit code 3).
+
+mod support;
+
+use std::path::Path;
+
+use support::*;
+use trisort_format::{Baked, FileKind, Recording};
+
+const SCENE: &str = "demo:10000";
+
+/// Bakes the demo car (2 frames, 64², 4×) into `dir/car.baked` (recording beside it).
+fn bake(dir: &Path) {
+    run(
+        dir,
+        &[
+            "bake",
+            SCENE,
+            "--path",
+            "orbit:frames=2,degrees=40",
+            "--size",
+            "64x64",
+            "--samples",
+            "4",
+            "-o",
+            "car.baked",
+        ],
+        true,
+    );
+}
+
+#[test]
+fn verify_reports_contract_keys_and_writes_difference_images() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    bake(dir.path());
+    let v = run_json(
+        dir.path(),
+        &[
+            "verify",
+            "car.baked",
+            "--recording",
+            "car.baked.rec",
+            "--scene",
+            SCENE,
+            "--diff-dir",
+            "diff",
+            "--diff-all",
+            "--frames",
+            "1..2",
+        ],
+    );
+    assert_eq!(v["ok"], true, "{v}");
+    assert_eq!(v["at_recorded_pattern"], true);
+    let frames = v["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 1);
+    let f = &frames[0];
+    assert_eq!(f["frame"], 1);
+    for key in [
+        "frame",
+        "graph_violations",
+        "unordered_samples",
+        "pixels_differing",
+        "pixels_differing_ordered",
+        "max_channel_diff",
+        "max_channel_diff_ordered",
+        "psnr",
+        "flip_mean",
+    ] {
+        assert!(!f[key].is_null(), "verify --json lacks frames[].{key}: {f}");
+    }
+    assert_eq!(f["graph_violations"], 0);
+    assert!(f["max_channel_diff_ordered"].as_u64().unwrap() <= 1);
+    assert!(!f["srgb8"].is_null(), "the 8-bit sRGB figure is reported");
+    for name in ["player", "reference", "diff", "unordered"] {
+        let p = dir.path().join(format!("diff/00001-{name}.png"));
+        let img = image::open(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        assert_eq!((img.width(), img.height()), (64, 64));
+    }
+    // The player's frame and the reference are the same picture.
+    let a = image::open(dir.path().join("diff/00001-player.png")).unwrap();
+    let b = image::open(dir.path().join("diff/00001-reference.png")).unwrap();
+    assert_eq!(a.to_rgba8(), b.to_rgba8());
+}
+
+#[test]
+fn another_scene_is_refused_with_a_clear_error() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    bake(dir.path());
+    let out = run(
+        dir.path(),
+        &["verify", "car.baked", "--scene", "demo:12000"],
+        false,
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("not the scene the baked file was made from"),
+        "{err}"
+    );
+}
+
+#[test]
+fn off_pattern_is_measured_and_gated_only_by_max_error() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    bake(dir.path());
+    // Twice the recorded size: measured, not failed.
+    let v = run_json(
+        dir.path(),
+        &[
+            "verify",
+            "car.baked",
+            "--scene",
+            SCENE,
+            "--size",
+            "128x128",
+            "--frames",
+            "0..1",
+        ],
+    );
+    assert_eq!(v["at_recorded_pattern"], false);
+    assert_eq!(v["ok"], true);
+    let max = v["frames"][0]["max_channel_diff_ordered"].as_u64().unwrap();
+    assert!(max > 0, "holes show at twice the size: {v}");
+    // The same with a bound below the measured error fails (exit 3).
+    let bound = (max - 1).to_string();
+    let out = run(
+        dir.path(),
+        &[
+            "verify",
+            "car.baked",
+            "--scene",
+            SCENE,
+            "--size",
+            "128x128",
+            "--frames",
+            "0..1",
+            "--max-error",
+            &bound,
+        ],
+        false,
+    );
+    assert_eq!(out.status.code(), Some(3));
+}
+
+/// The mutation check: swapping the positions of two triangles drawn in frame 0 that the
+/// recording orders (the heaviest edge between different materials) breaks the images, and
+/// verify fails with exit code 3, writing the failing frame's images.
+#[test]
+fn corrupted_order_fails_verification() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    bake(dir.path());
+    let path = dir.path().join("car.baked");
+    let mut baked: Baked = trisort_format::read_file(FileKind::Baked, &path).unwrap();
+    let rec: Recording =
+        trisort_format::read_file(FileKind::Recording, &dir.path().join("car.baked.rec")).unwrap();
+    let local = |scene_id: u32| baked.scene_ids.binary_search(&scene_id).unwrap() as u32;
+    let material = |t: u32| {
+        let g = &baked.geometry;
+        g.vertices[g.triangles[t as usize][0] as usize].material
+    };
+    // Positions in `copies` drawn in frame 0.
+    let drawn: Vec<usize> = baked
+        .frame_draws(0)
+        .iter()
+        .flat_map(|d| (d.first_index / 3..(d.first_index + d.index_count) / 3).map(|p| p as usize))
+        .collect();
+    let position = |t: u32| drawn.iter().copied().find(|&p| baked.copies[p] == t);
+    let edge = rec.frames[0]
+        .edges
+        .iter()
+        .filter(|e| material(local(e.from)) != material(local(e.to)))
+        .max_by_key(|e| e.weight)
+        .expect("frame 0 has an edge between different materials");
+    let (a, b) = (local(edge.from), local(edge.to));
+    let (pa, pb) = (position(a).unwrap(), position(b).unwrap());
+    assert!(pa < pb, "front is drawn before back in the stored order");
+    baked.copies.swap(pa, pb);
+    trisort_format::write_file_atomic(FileKind::Baked, &path, &baked).unwrap();
+
+    let out = run(
+        dir.path(),
+        &[
+            "verify",
+            "car.baked",
+            "--scene",
+            SCENE,
+            "--frames",
+            "0..1",
+            "--diff-dir",
+            "diff",
+            "--json",
+        ],
+        false,
+    );
+    assert_eq!(out.status.code(), Some(3));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["ok"], false);
+    let f = &v["frames"][0];
+    assert_eq!(f["ok"], false);
+    assert!(f["pixels_differing_ordered"].as_u64().unwrap() > 0, "{f}");
+    assert!(f["max_channel_diff_ordered"].as_u64().unwrap() > 1, "{f}");
+    assert!(dir.path().join("diff/00000-diff.png").is_file());
+    // The graph rules catch it too.
+    let out = run(
+        dir.path(),
+        &["verify", "car.baked", "--recording", "car.baked.rec"],
+        false,
+    );
+    assert_eq!(out.status.code(), Some(3));
+}
