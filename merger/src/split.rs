@@ -11,26 +11,34 @@
 //!   found by Kahn's algorithm and a walk back through the left-over vertices;
 //!
 //! and then fixes each one whose copies are still untouched this round:
-//! - a conflict (x, y, f) by the cheapest of the splits "cut before f", "cut after f",
-//!   "isolate f" and "drop f" (the last only where the triangle is not visible at f) of x
-//!   and/or y after which f's piece of x lies in an earlier cell than f's piece of y, in the
-//!   same cell (the cell's own order then decides), or f is no longer drawn. Cost = new
-//!   copies; ties keep the longer pieces;
+//! - a conflicting pair (x, y), with all the frames `lo..=hi` (sorted set S) where x must
+//!   precede y but its cell comes later, by the best pair of splits of x and y among: keep,
+//!   cut before lo, cut after hi, isolate lo..=hi, cut after lo, isolate lo, and — where the
+//!   triangle is not visible there — drop lo..=hi or drop lo. A frame of S is fixed when x's
+//!   piece there lies in an earlier cell than y's, in the same cell (whose own order then
+//!   decides), or one of them is no longer drawn. Best = fewest frames of S left unfixed,
+//!   then fewest new copies, then the longest pieces; lo is always fixed;
 //! - a cycle by splitting one multi-frame copy on it between the frames that demand its
-//!   incoming and its outgoing edge, in the middle of the gap that separates them.
+//!   incoming and its outgoing edge, in the middle of the gap that separates them (else
+//!   between two frames that only one of them demands, else in the middle of the longest
+//!   copy on the cycle).
 //!
 //! Pieces are trimmed to the triangle's visible frames inside them, then extended (inside the
 //! piece) through the neighbouring frames where the triangle has no fragment, which is free
 //! (no pixel, no edge) and lets copies share cells; a piece with no visible frame is dropped.
 //! So a copy always spans a visible frame, and what it bridges only ever shrinks.
 //!
-//! Measured alternative, rejected: under `--bridge hidden`, extending seeds through *hidden*
-//! frames too (every copy starting in the corner cell) gave no fewer copies on the synthetic
-//! turntable (IBL compact 1.65 vs 1.52 × |G|) and 3–8 × the drawn-not-visible fill. Each fix adds a copy or shortens one; copies are bounded by Σ|V_f|, so the loop
+//! Each fix adds a copy or shortens one; copies are bounded by Σ|V_f|, so the loop
 //! terminates, at worst at one copy per frame on the diagonal, which is always valid. When a
 //! round finds nothing the copies satisfy rules 1–3: with no inter-cell conflict every path
 //! between drawn copies rises in the layout, so the only remaining demands lie inside cells,
 //! and those graphs are acyclic.
+//!
+//! Variants measured on the synthetic turntable and rejected (`merger/BENCHMARKS.md`):
+//! extending seeds through *hidden* frames (every copy starting in the corner cell), letting
+//! a fix extend both copies into one cell, snapping seed spans to a frame grid, and fixing
+//! only a fraction of the conflicts per round: none saved more than 5 % of the copies, and
+//! each cost fill or time.
 
 use std::ops::Range;
 
