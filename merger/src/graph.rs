@@ -55,6 +55,8 @@ pub(crate) struct Input<'a> {
 pub(crate) fn check_recordings(recordings: &[Recording]) -> Result<Input<'_>, MergeError> {
     let first = recordings.first().ok_or(MergeError::NoRecordings)?;
     for (k, r) in recordings.iter().enumerate() {
+        r.check_structure()
+            .map_err(|why| MergeError::Invalid { recording: k, why })?;
         let differs = |what: &'static str| Err(MergeError::Mismatch { recording: k, what });
         if r.phase != Phase::Graphs {
             return Err(MergeError::NotGraphs { recording: k });

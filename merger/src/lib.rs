@@ -175,6 +175,14 @@ pub enum MergeError {
     /// No recording was given.
     #[error("no recording to merge")]
     NoRecordings,
+    /// A recording fails its own structure check ([`Recording::check_structure`]).
+    #[error("recording {recording} is malformed: {why}")]
+    Invalid {
+        /// Index of the recording.
+        recording: usize,
+        /// The first problem found.
+        why: String,
+    },
     /// A recording holds only phase 1 (visibility).
     #[error("recording {recording} has no graphs (phase 1 only); record phase 2 first")]
     NotGraphs {

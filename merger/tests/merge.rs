@@ -413,6 +413,11 @@ fn mismatched_recordings_are_refused() {
     let parts = split_frames(&rec, &[0, 3]);
     let e = merge(&parts[1..], &MergeOptions::default()).unwrap_err();
     assert!(e.to_string().contains("comes next"), "{e}");
+    let mut bad = rec.clone();
+    bad.frames[0].visible.reverse();
+    assert!(bad.frames[0].visible.len() >= 2);
+    let e = merge(std::slice::from_ref(&bad), &MergeOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("recording 0 is malformed"), "{e}");
     let e = merge(&parts[..1], &MergeOptions::default()).unwrap_err();
     assert!(e.to_string().contains("0..3 of a 6-frame"), "{e}");
 }
