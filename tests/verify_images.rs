@@ -350,3 +350,57 @@ fn alpha_blend_mode_test_verifies_in_every_mode() {
     let (_, baked) = bake(&gpu, &s.geometry, &frames, settings(96, 4));
     verify_all_modes(&gpu, "AlphaBlendModeTest", &baked, &s.geometry);
 }
+
+/// The default pipeline (opaque first, transparent unsorted in id order, depth writes off)
+/// equals the exact reference where id order happens to be back-to-front, and differs where
+/// it is not: what sorting buys.
+#[test]
+fn default_pipeline_is_exact_only_when_id_order_is_back_to_front() {
+    let Some(gpu) = Gpu::for_tests() else { return };
+    let frames = [frame_at(DVec3::ZERO)];
+    let view = trisort_shaders::scene_gpu::View {
+        width: 64,
+        height: 64,
+        samples: 4,
+        glass_opacity: 0.0,
+    };
+    let render = |g: &Geometry| {
+        let default = trisort_reference::DefaultRenderer::new(&gpu, g, &frames, view)
+            .expect("default pipeline");
+        let config = trisort_reference::ReferenceConfig {
+            size: (64, 64),
+            samples: 4,
+            mode: Mode::Blend,
+            glass_opacity: 0.0,
+            max_layers: 64,
+        };
+        let reference =
+            trisort_reference::ExactReference::new(&gpu, g, &frames, config).expect("reference");
+        let d = default.render(0).expect("default frame");
+        let r = reference.render(0, None).expect("reference frame");
+        trisort_reference::compare(&d, &r.rgba8, 64, 64, &[])
+    };
+    let materials = || {
+        vec![
+            material([0.9, 0.1, 0.1], 0.5),
+            material([0.1, 0.2, 0.9], 0.5),
+            material([0.7, 0.7, 0.7], 1.0),
+        ]
+    };
+    // Ids back to front: opaque wall, then the far transparent quad, then the near one.
+    let mut sorted = scene(materials());
+    quad(&mut sorted, -1.0, 1.0, -1.0, 1.0, -6.0, -6.0, 2);
+    quad(&mut sorted, -0.6, 0.4, -0.6, 0.4, -4.0, -4.0, 1);
+    quad(&mut sorted, -0.4, 0.6, -0.4, 0.6, -2.0, -2.0, 0);
+    let c = render(&sorted);
+    assert_eq!(c.pixels_differing, 0, "{c:?}");
+    // The same quads with the transparent ones in front-to-back id order.
+    let mut unsorted = scene(materials());
+    quad(&mut unsorted, -1.0, 1.0, -1.0, 1.0, -6.0, -6.0, 2);
+    quad(&mut unsorted, -0.4, 0.6, -0.4, 0.6, -2.0, -2.0, 0);
+    quad(&mut unsorted, -0.6, 0.4, -0.6, 0.4, -4.0, -4.0, 1);
+    let c = render(&unsorted);
+    // The overlap of the two transparent quads (about 8 × 10 pixels) is wrong.
+    assert!(c.pixels_differing >= 60 && c.max_channel_diff > 10, "{c:?}");
+    assert!(c.psnr < 45.0 && c.flip_mean > 0.0, "{c:?}");
+}
