@@ -456,7 +456,13 @@ fn malformed_baked_files_are_named_not_played() {
             &file,
             problem,
         );
-        fails(d, &["play", &file, "--out-dir", "frames"], &[1], &file, problem);
+        fails(
+            d,
+            &["play", &file, "--out-dir", "frames"],
+            &[1],
+            &file,
+            problem,
+        );
         std::fs::remove_file(d.join(&file)).unwrap();
     }
 }

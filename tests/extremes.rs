@@ -1,0 +1,923 @@
+//! Numerical extremes through the real pipeline: scenes written here as glTF binaries and
+//! TOML paths, baked by the `trisort` binary at 32²–64², then checked against the graph rules
+//! (`verify --recording`) and against facts computed independently from the geometry. Each
+//! test states what must hold; the limits found are documented in README § Testing.
+
+mod support;
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use serde_json::json;
+use support::*;
+use trisort_format::{Baked, FileKind, Recording};
+
+// ---------------------------------------------------------------------------------------------
+// Scene and path writers.
+
+/// A material: linear RGBA base colour; alpha < 1 makes it BLEND. Always double-sided.
+#[derive(Clone, Copy)]
+struct Mat([f32; 4]);
+
+/// One node with one single-primitive mesh of unindexed triangles (local positions).
+struct Part {
+    translation: [f64; 3],
+    material: usize,
+    triangles: Vec<[[f32; 3]; 3]>,
+}
+
+fn part(material: usize, triangles: Vec<[[f32; 3]; 3]>) -> Part {
+    Part {
+        translation: [0.0; 3],
+        material,
+        triangles,
+    }
+}
+
+/// Two triangles spanning [x0,x1]×[y0,y1] at depth z, ids in this order.
+fn quad(x0: f32, x1: f32, y0: f32, y1: f32, z: f32) -> Vec<[[f32; 3]; 3]> {
+    vec![
+        [[x0, y0, z], [x1, y0, z], [x1, y1, z]],
+        [[x0, y0, z], [x1, y1, z], [x0, y1, z]],
+    ]
+}
+
+/// A glTF 2.0 binary of `parts` (one root node each, in order: triangle ids follow it).
+fn glb(parts: &[Part], mats: &[Mat]) -> Vec<u8> {
+    let mut bin: Vec<u8> = Vec::new();
+    let mut nodes = vec![];
+    let mut meshes = vec![];
+    let mut accessors = vec![];
+    let mut views = vec![];
+    for (k, p) in parts.iter().enumerate() {
+        let offset = bin.len();
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        for v in p.triangles.iter().flatten() {
+            for c in 0..3 {
+                lo[c] = lo[c].min(v[c]);
+                hi[c] = hi[c].max(v[c]);
+                bin.extend_from_slice(&v[c].to_le_bytes());
+            }
+        }
+        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bin.len() - offset}));
+        accessors.push(
+            json!({"bufferView": k, "componentType": 5126, "count": p.triangles.len() * 3,
+            "type": "VEC3", "min": lo, "max": hi}),
+        );
+        meshes
+            .push(json!({"primitives": [{"attributes": {"POSITION": k}, "material": p.material}]}));
+        nodes.push(json!({"name": format!("part{k}"), "mesh": k, "translation": p.translation}));
+    }
+    let materials: Vec<_> = mats
+        .iter()
+        .map(|m| {
+            json!({"pbrMetallicRoughness": {"baseColorFactor": m.0, "metallicFactor": 0.0},
+                "alphaMode": if m.0[3] < 1.0 { "BLEND" } else { "OPAQUE" }, "doubleSided": true})
+        })
+        .collect();
+    let doc = json!({
+        "asset": {"version": "2.0"}, "scene": 0,
+        "scenes": [{"nodes": (0..parts.len()).collect::<Vec<_>>()}],
+        "nodes": nodes, "meshes": meshes, "materials": materials,
+        "accessors": accessors, "bufferViews": views, "buffers": [{"byteLength": bin.len()}],
+    });
+    let mut json_bytes = serde_json::to_vec(&doc).unwrap();
+    while !json_bytes.len().is_multiple_of(4) {
+        json_bytes.push(b' ');
+    }
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json_bytes);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    out
+}
+
+/// A TOML path: one camera key per frame (`(eye, target)`), so no frame is interpolated.
+fn path_toml(yfov: f64, clip: Option<(f64, f64)>, keys: &[([f64; 3], [f64; 3])]) -> String {
+    let mut s = String::from("[camera]\n");
+    s += &format!("yfov = {yfov:?}\n");
+    if let Some((near, far)) = clip {
+        s += &format!("znear = {near:?}\nzfar = {far:?}\n");
+    }
+    for (f, (eye, target)) in keys.iter().enumerate() {
+        s += &format!("[[camera.key]]\nframe = {f}\neye = {eye:?}\ntarget = {target:?}\n");
+    }
+    s
+}
+
+/// The result of a bake: the recording and the baked file.
+struct Baking {
+    rec: Recording,
+    baked: Baked,
+}
+
+/// Writes the scene and path, bakes at `size`² with `samples`, checks the graph rules with
+/// `verify --recording` and returns both files. `None` when no GPU (the test skips).
+fn bake(
+    dir: &Path,
+    name: &str,
+    scene: &[u8],
+    path: &str,
+    size: u32,
+    samples: u32,
+) -> Option<Baking> {
+    bake_with(dir, name, scene, path, size, samples, &[])
+}
+
+fn bake_with(
+    dir: &Path,
+    name: &str,
+    scene: &[u8],
+    path: &str,
+    size: u32,
+    samples: u32,
+    extra: &[&str],
+) -> Option<Baking> {
+    if !gpu_available() {
+        return None;
+    }
+    std::fs::write(dir.join(format!("{name}.glb")), scene).unwrap();
+    std::fs::write(dir.join(format!("{name}.toml")), path).unwrap();
+    let (glb, toml, out) = (
+        format!("{name}.glb"),
+        format!("{name}.toml"),
+        format!("{name}.baked"),
+    );
+    let size = format!("{size}x{size}");
+    let samples = samples.to_string();
+    let mut args = vec![
+        "bake",
+        &glb,
+        "--path",
+        &toml,
+        "-o",
+        &out,
+        "--size",
+        &size,
+        "--samples",
+        &samples,
+    ];
+    args.extend_from_slice(extra);
+    run(dir, &args, true);
+    let rec: Recording =
+        trisort_format::read_file(FileKind::Recording, &dir.join(format!("{out}.rec"))).unwrap();
+    let baked: Baked = trisort_format::read_file(FileKind::Baked, &dir.join(&out)).unwrap();
+    rec.check_structure().unwrap();
+    baked.check_structure().unwrap();
+    Some(Baking { rec, baked })
+}
+
+/// The bake must pass `verify --recording` (the graph rules) and `verify --scene` (its frames
+/// against the exact reference of the full scene, at the recorded pattern) in every mode:
+/// depth bit-exact, blend and saturate within 1/255 except at pixels with an unordered sample.
+/// Returns the blend-mode report.
+fn assert_verifies(dir: &Path, name: &str) -> serde_json::Value {
+    let baked = format!("{name}.baked");
+    let v = run_json(
+        dir,
+        &[
+            "verify",
+            &baked,
+            "--recording",
+            &format!("{name}.baked.rec"),
+        ],
+    );
+    assert_eq!(v["ok"], true, "{name}: {v}");
+    let glb = format!("{name}.glb");
+    let mut blend = serde_json::Value::Null;
+    for mode in ["blend", "depth", "saturate"] {
+        let v = run_json(dir, &["verify", &baked, "--scene", &glb, "--mode", mode]);
+        assert_eq!(v["ok"], true, "{name}, {mode} mode: {v}");
+        if mode == "blend" {
+            blend = v;
+        }
+    }
+    blend
+}
+
+fn edge_weight(r: &Recording, f: usize, from: &[u32], to: &[u32]) -> u32 {
+    r.frames[f]
+        .edges
+        .iter()
+        .filter(|e| from.contains(&e.from) && to.contains(&e.to))
+        .map(|e| e.weight)
+        .sum()
+}
+
+fn set(v: &[u32]) -> BTreeSet<u32> {
+    v.iter().copied().collect()
+}
+
+/// Looks from the origin down −Z (view = identity).
+const EYE0: [f64; 3] = [0.0, 0.0, 0.0];
+const AHEAD: [f64; 3] = [0.0, 0.0, -1.0];
+
+// ---------------------------------------------------------------------------------------------
+
+/// Coplanar decals: where two opaque surfaces share a plane, the lower id is in front, so a
+/// decal is visible only if its ids are lower than its base's. Left: decal before its base
+/// (ids 0–1, base 2–3): the decal shows, every decal → base edge is a tie. Right: decal after
+/// its base (base 4–5, decal 6–7): hidden. That holds exactly where the rasterized depths are
+/// bit-equal: here, in the frontal frame, where the plane's depth is constant. Two oblique
+/// frames follow, where triangles with different vertices in one plane z-fight at the last
+/// bit (printed: the number of samples the later decal wins); every frame passes the rules.
+#[test]
+fn coplanar_decals_lower_id_in_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut left = quad(-0.7, -0.3, -0.2, 0.2, -2.0);
+    left.extend(quad(-1.9, -0.1, -1.0, 1.0, -2.0));
+    let mut right = quad(0.1, 1.9, -1.0, 1.0, -2.0);
+    right.extend(quad(0.3, 0.7, -0.2, 0.2, -2.0));
+    let scene = glb(
+        &[part(0, left), part(0, right)],
+        &[Mat([0.8, 0.2, 0.2, 1.0])],
+    );
+    let path = path_toml(
+        90.0,
+        Some((0.1, 10.0)),
+        &[
+            (EYE0, [0.0, 0.0, -2.0]),
+            ([0.7, 0.3, 0.0], [0.0, 0.0, -2.0]),
+            ([-0.9, -0.2, 0.3], [0.0, 0.0, -2.0]),
+        ],
+    );
+    let Some(b) = bake(dir.path(), "decal", &scene, &path, 48, 4) else {
+        return;
+    };
+    let f0 = &b.rec.frames[0];
+    assert!(
+        f0.visible.contains(&0) && f0.visible.contains(&1),
+        "decal with lower ids shows: {:?}",
+        f0.visible
+    );
+    assert!(
+        f0.visible.contains(&2) || f0.visible.contains(&3),
+        "its base shows around it"
+    );
+    assert!(edge_weight(&b.rec, 0, &[0, 1], &[2, 3]) > 0, "decal → base");
+    assert_eq!(
+        edge_weight(&b.rec, 0, &[2, 3], &[0, 1]),
+        0,
+        "never base → decal"
+    );
+    for e in f0.edges.iter().filter(|e| e.from <= 1) {
+        assert!(
+            f0.ties.contains(e),
+            "frontal view: decal → base is an exact depth tie: {e:?}"
+        );
+    }
+    assert!(
+        !f0.visible.contains(&6) && !f0.visible.contains(&7),
+        "frontal view: a coplanar decal with higher ids than its base is hidden"
+    );
+    // Oblique views: the two quads' triangles are set up from different vertices, so their
+    // interpolated depths may differ in the last bit and the decal can win some samples
+    // (z-fighting). The recording follows the depth buffer sample by sample; the bake
+    // reproduces it (the rules pass), whatever the geometry intended.
+    for f in 1..b.rec.frames.len() {
+        eprintln!(
+            "frame {f}: decal after its base wins {} samples, decal before its base loses {}",
+            edge_weight(&b.rec, f, &[6, 7], &[4, 5]),
+            edge_weight(&b.rec, f, &[2, 3], &[0, 1])
+        );
+    }
+    assert_verifies(dir.path(), "decal");
+}
+
+/// Pixel-space corner → world point on the plane z = −1 seen by the identity camera with
+/// a 90° field of view at `size`².
+fn px_to_world(p: [f64; 2], size: u32) -> [f32; 3] {
+    let s = size as f64;
+    [
+        (p[0] / s * 2.0 - 1.0) as f32,
+        (1.0 - p[1] / s * 2.0) as f32,
+        -1.0,
+    ]
+}
+
+/// Signed distances (pixels) of `q` from the three edges of `t`, positive inside.
+fn edge_distances(t: &[[f64; 2]; 3], q: [f64; 2]) -> [f64; 3] {
+    let area =
+        (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]);
+    let sign = area.signum();
+    let mut d = [0.0; 3];
+    for k in 0..3 {
+        let (a, b) = (t[k], t[(k + 1) % 3]);
+        let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+        d[k] = sign * ((b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])) / len;
+    }
+    d
+}
+
+/// Sub-pixel triangles: 256 opaque triangles with legs of 0.3–0.95 px in front of a background, one per
+/// 2×2-pixel cell at a pseudo-random place. At the standard sample positions (1×: the pixel
+/// centre; 4×: (⅜,⅛), (⅞,⅜), (⅛,⅝), (⅝,⅞)), every triangle that contains a sample with a
+/// margin of 0.02 px (beyond the rasterizer's sub-pixel snapping) must be in V_f, and every
+/// triangle that misses all samples by that margin must have no fragment (not in G). Sampled
+/// ones are never lost; unsampled ones cost nothing.
+#[test]
+fn sub_pixel_triangles_covering_a_sample_are_never_lost() {
+    let dir = tempfile::tempdir().unwrap();
+    let size = 32u32;
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut rnd = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut tiny_px = vec![];
+    for cy in 0..size / 2 {
+        for cx in 0..size / 2 {
+            let scale = 0.3 + 0.65 * rnd();
+            let (ox, oy) = (
+                cx as f64 * 2.0 + 0.05 + 0.95 * rnd(),
+                cy as f64 * 2.0 + 0.05 + 0.95 * rnd(),
+            );
+            let t: [[f64; 2]; 3] = [
+                [ox, oy],
+                [ox + scale, oy + scale * 0.3 * rnd()],
+                [ox + scale * 0.3 * rnd(), oy + scale],
+            ];
+            tiny_px.push(t);
+        }
+    }
+    let background = quad(-3.0, 3.0, -3.0, 3.0, -2.0); // ids 0, 1
+    let tiny: Vec<[[f32; 3]; 3]> = tiny_px
+        .iter()
+        .map(|t| t.map(|p| px_to_world(p, size)))
+        .collect();
+    let scene = glb(
+        &[part(0, background), part(1, tiny)],
+        &[Mat([0.2, 0.2, 0.2, 1.0]), Mat([0.9, 0.9, 0.1, 1.0])],
+    );
+    let path = path_toml(90.0, Some((0.1, 10.0)), &[(EYE0, AHEAD)]);
+    for (samples, pattern) in [
+        (1u32, vec![[0.5, 0.5]]),
+        (
+            4,
+            vec![
+                [0.375, 0.125],
+                [0.875, 0.375],
+                [0.125, 0.625],
+                [0.625, 0.875],
+            ],
+        ),
+    ] {
+        let name = format!("subpixel{samples}");
+        let Some(b) = bake(dir.path(), &name, &scene, &path, size, samples) else {
+            return;
+        };
+        let visible = set(&b.rec.frames[0].visible);
+        let (mut sure_in, mut sure_out) = (0, 0);
+        for (k, t) in tiny_px.iter().enumerate() {
+            let id = 2 + k as u32;
+            let mut covers = false;
+            let mut near = false;
+            for py in 0..size {
+                for px in 0..size {
+                    for s in &pattern {
+                        let d = edge_distances(t, [px as f64 + s[0], py as f64 + s[1]]);
+                        let min = d.iter().cloned().fold(f64::INFINITY, f64::min);
+                        covers |= min >= 0.02;
+                        near |= min > -0.02;
+                    }
+                }
+            }
+            if covers {
+                sure_in += 1;
+                assert!(
+                    visible.contains(&id),
+                    "{samples}x: triangle {id} covers a sample but is not in V_0"
+                );
+            } else if !near {
+                sure_out += 1;
+                assert!(
+                    !b.rec.unique_visible.contains(&id),
+                    "{samples}x: triangle {id} misses every sample but is in G"
+                );
+            }
+        }
+        eprintln!(
+            "{samples}x: {sure_in} triangles surely sampled, {sure_out} surely missed, of {}",
+            tiny_px.len()
+        );
+        assert!(
+            sure_in >= 20 && sure_out >= 20,
+            "the scene tests both sides: {sure_in} in, {sure_out} out"
+        );
+        assert_verifies(dir.path(), &name);
+    }
+}
+
+/// Overlapping quads, some transparent: a scene whose graphs have edges and ties.
+fn layered_parts(offset: [f64; 3]) -> Vec<Part> {
+    let mut a = part(0, quad(-1.0, 0.6, -0.8, 0.8, 0.0));
+    let mut b = part(1, quad(-0.4, 1.2, -1.0, 0.5, -0.7));
+    let mut c = part(0, quad(-1.5, 1.5, -1.5, 1.5, -1.6));
+    let mut d = part(
+        1,
+        [
+            quad(-0.2, 0.9, -0.3, 0.9, 0.4),
+            quad(-0.9, 0.3, -0.9, 0.2, -1.1),
+        ]
+        .concat(),
+    );
+    for p in [&mut a, &mut b, &mut c, &mut d] {
+        p.translation = offset;
+    }
+    vec![a, b, c, d]
+}
+
+/// A scene and camera 10⁶ units from the origin record exactly what they record at the
+/// origin: the same V_f, C_f, edges, ties and layers, and the same sorted copies and draws.
+/// Node matrices are composed with the camera in f64 and cast once, so the camera-relative
+/// positions the GPU sees are the same as at the origin (f32 world positions would be
+/// quantized to 1/16 unit there).
+#[test]
+fn far_from_the_origin_records_what_the_origin_records() {
+    let dir = tempfile::tempdir().unwrap();
+    let mats = [Mat([0.2, 0.5, 0.9, 1.0]), Mat([0.9, 0.4, 0.1, 0.5])];
+    let eyes = [
+        [0.0, 0.0, 4.0],
+        [2.5, 1.0, 3.0],
+        [-3.0, -0.5, 2.0],
+        [0.5, 2.5, 3.5],
+    ];
+    let mut results = vec![];
+    for (name, off) in [("origin", 0.0), ("far", 1.0e6)] {
+        let o = [off; 3];
+        let scene = glb(&layered_parts(o), &mats);
+        let keys: Vec<_> = eyes
+            .iter()
+            .map(|e| ([e[0] + off, e[1] + off, e[2] + off], [off, off, off - 0.3]))
+            .collect();
+        let path = path_toml(50.0, Some((0.5, 20.0)), &keys);
+        let Some(b) = bake(dir.path(), name, &scene, &path, 48, 4) else {
+            return;
+        };
+        assert_verifies(dir.path(), name);
+        results.push(b);
+    }
+    let (a, b) = (&results[0], &results[1]);
+    assert!(
+        a.rec.frames.iter().all(|f| !f.edges.is_empty()),
+        "a scene with edges"
+    );
+    assert_eq!(a.rec.unique_visible, b.rec.unique_visible);
+    for (fa, fb) in a.rec.frames.iter().zip(&b.rec.frames) {
+        assert_eq!(
+            fa, fb,
+            "frame {} differs 10⁶ units from the origin",
+            fa.frame
+        );
+    }
+    assert_eq!(a.baked.copies, b.baked.copies);
+    assert_eq!(a.baked.draws, b.baked.draws);
+}
+
+/// znear = 10⁻³ and zfar = 10⁶ (a ratio of 10⁹) with a standard [0, 1] f32 depth: pairs of
+/// opaque strips at distance z and z + Δz, the farther strip with the lower ids, one pair per
+/// image column. Depth is d = far/(far−near)·(1 − near/z), so the pair's depths differ by
+/// ≈ near·Δz/z², and f32 resolves that only where it exceeds the spacing of floats below 1
+/// (2⁻²⁴ ≈ 6·10⁻⁸): Δz ≳ limit(z) = 2⁻²⁴·z²/near (6·10⁻⁵ at z = 1, 0.6 at z = 100 for
+/// near = 10⁻³). Pairs 16× above the limit must be ordered by distance (the nearer strip
+/// visible, the farther hidden); pairs 1000× below it are an exact depth tie, and the
+/// recording follows the depth buffer, not the geometry: the lower id, the farther strip,
+/// shows. Between, the outcome depends on rounding (printed). Recorder, player (depth mode)
+/// and reference all compare the same f32 depths, so the bake stays exact either way.
+#[test]
+fn extreme_clip_planes_order_what_f32_depth_resolves() {
+    let dir = tempfile::tempdir().unwrap();
+    let (near, far) = (1.0e-3, 1.0e6);
+    let limit = |z: f64| 2f64.powi(-24) * z * z / near;
+    let distances = [0.01f64, 1.0, 100.0];
+    let factors = [16.0, 4.0, 1.0, 0.25, 1.0e-3];
+    let mut parts = vec![];
+    let mut pairs = vec![]; // (z, factor, far ids, near ids)
+    let columns = distances.len() * factors.len();
+    for &z in &distances {
+        for &factor in &factors {
+            let column = pairs.len();
+            let dz = limit(z) * factor;
+            // Column k of the image at distance z (90° field of view: half-width z).
+            let x0 = (-1.0 + 2.0 * column as f64 / columns as f64) * z;
+            let x1 = (-1.0 + 2.0 * (column + 1) as f64 / columns as f64) * z;
+            let first = 2 * parts.len() as u32;
+            for depth in [z + dz, z] {
+                parts.push(part(
+                    0,
+                    quad(
+                        x0 as f32,
+                        x1 as f32,
+                        (-0.5 * z) as f32,
+                        (0.5 * z) as f32,
+                        -depth as f32,
+                    ),
+                ));
+            }
+            pairs.push((z, factor, [first, first + 1], [first + 2, first + 3]));
+        }
+    }
+    let scene = glb(&parts, &[Mat([0.5, 0.5, 0.5, 1.0])]);
+    let path = path_toml(90.0, Some((near, far)), &[(EYE0, AHEAD)]);
+    let Some(b) = bake(dir.path(), "clip", &scene, &path, 60, 1) else {
+        return;
+    };
+    assert_verifies(dir.path(), "clip");
+    let vis = set(&b.rec.frames[0].visible);
+    for (z, factor, far_ids, near_ids) in pairs {
+        let shows = |ids: [u32; 2]| ids.iter().any(|t| vis.contains(t));
+        eprintln!(
+            "znear {near:e}, zfar {far:e}: z = {z}, Δz = {:.3e} ({factor}x the limit): nearer strip visible {}, farther strip visible {}",
+            limit(z) * factor,
+            shows(near_ids),
+            shows(far_ids)
+        );
+        assert!(
+            shows(near_ids) != shows(far_ids),
+            "z = {z}, {factor}x: one opaque strip hides the other"
+        );
+        if factor >= 16.0 {
+            assert!(
+                shows(near_ids),
+                "z = {z}, {factor}x the limit: f32 depth resolves it, the nearer strip must show"
+            );
+        }
+        if factor <= 1.0e-3 {
+            assert!(
+                shows(far_ids),
+                "z = {z}, {factor}x the limit: a depth tie, the lower id (farther strip) shows"
+            );
+        }
+    }
+}
+
+/// Two surfaces 10⁻⁵ apart at distance 10⁴: below f32 resolution there (one float step at
+/// 10⁴ is ≈ 10⁻³), both transparent, the nearer one with the higher ids. The camera-relative
+/// transform rounds both to the same depth, so every sample is an exact tie and the lower id
+/// (the farther surface) is in front: every edge between them goes lower → higher and is a
+/// tie. The baked order follows it, and the graph rules pass; the player draws that order
+/// (blend: reversed, so the lower id lands on top) and the reference peels the same ties.
+#[test]
+fn surfaces_closer_than_f32_resolution_tie_by_id() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut far_part = part(0, quad(-1000.0, 1000.0, -1000.0, 1000.0, -1.0e-5));
+    far_part.translation = [0.0, 0.0, -1.0e4];
+    let mut near_part = part(1, quad(-1000.0, 1000.0, -1000.0, 1000.0, 0.0));
+    near_part.translation = [0.0, 0.0, -1.0e4];
+    let scene = glb(
+        &[far_part, near_part],
+        &[Mat([0.9, 0.1, 0.1, 0.5]), Mat([0.1, 0.1, 0.9, 0.5])],
+    );
+    let path = path_toml(
+        5.0,
+        Some((1.0, 2.0e4)),
+        &[(EYE0, AHEAD), ([30.0, -20.0, 0.0], [0.0, 0.0, -1.0e4])],
+    );
+    let Some(b) = bake(dir.path(), "sub_f32", &scene, &path, 32, 4) else {
+        return;
+    };
+    assert_verifies(dir.path(), "sub_f32");
+    for f in &b.rec.frames {
+        assert_eq!(
+            f.visible,
+            vec![0, 1, 2, 3],
+            "frame {}: both transparent surfaces visible",
+            f.frame
+        );
+        let across: Vec<_> = f
+            .edges
+            .iter()
+            .filter(|e| (e.from < 2) != (e.to < 2))
+            .collect();
+        assert!(!across.is_empty());
+        for e in across {
+            assert!(
+                e.from < 2,
+                "frame {}: the lower id is in front: {e:?}",
+                f.frame
+            );
+            assert!(
+                f.ties.contains(e),
+                "frame {}: an exact depth tie: {e:?}",
+                f.frame
+            );
+        }
+    }
+    // The baked order puts the far surface's copies before the near one's in every frame.
+    for f in 0..b.baked.frames.len() {
+        let order: Vec<u32> = b
+            .baked
+            .frame_draws(f)
+            .iter()
+            .flat_map(|d| {
+                b.baked.copies
+                    [(d.first_index / 3) as usize..((d.first_index + d.index_count) / 3) as usize]
+                    .to_vec()
+            })
+            .map(|c| b.baked.scene_ids[c as usize])
+            .collect();
+        let last_far = order.iter().rposition(|&t| t < 2).unwrap();
+        let first_near = order.iter().position(|&t| t >= 2).unwrap();
+        assert!(last_far < first_near, "frame {f}: {order:?}");
+    }
+}
+
+/// A one-frame path: one frame, one cell, one draw; the graph rules pass and it plays.
+#[test]
+fn a_one_frame_path_bakes_and_plays() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = glb(
+        &layered_parts([0.0; 3]),
+        &[Mat([0.2, 0.5, 0.9, 1.0]), Mat([0.9, 0.4, 0.1, 0.5])],
+    );
+    let path = path_toml(50.0, None, &[([0.5, 0.3, 4.0], [0.0, 0.0, -0.3])]);
+    let Some(b) = bake(dir.path(), "one", &scene, &path, 32, 4) else {
+        return;
+    };
+    assert_verifies(dir.path(), "one");
+    assert_eq!(b.baked.frames.len(), 1);
+    assert_eq!(b.baked.merge.cells.len(), 1);
+    assert_eq!(b.baked.stats.draws_per_frame_max, 1);
+    assert_eq!(
+        b.baked.copies.len(),
+        b.rec.unique_visible.len(),
+        "one copy per triangle of G"
+    );
+    run(
+        dir.path(),
+        &["play", "one.baked", "--out-dir", "frames"],
+        true,
+    );
+    assert!(dir.path().join("frames/frame-00000.png").is_file());
+}
+
+/// A camera orbiting 200° around two parallel transparent quads sees their order invert: A
+/// in front of B at the start, B in front of A after 180°. One copy per triangle cannot be
+/// drawn in both orders, so the merger must split (index triangles > |G|), and every frame
+/// still passes the graph rules.
+#[test]
+fn an_orbit_past_180_degrees_inverts_the_order_and_splits() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = glb(
+        &[
+            part(0, quad(-0.5, 0.5, -0.5, 0.5, 0.25)),
+            part(1, quad(-0.5, 0.5, -0.5, 0.5, -0.25)),
+        ],
+        &[Mat([0.9, 0.2, 0.2, 0.5]), Mat([0.2, 0.2, 0.9, 0.5])],
+    );
+    if !gpu_available() {
+        return;
+    }
+    std::fs::write(dir.path().join("orbit.glb"), &scene).unwrap();
+    let v = run_json(
+        dir.path(),
+        &[
+            "bake",
+            "orbit.glb",
+            "--path",
+            "orbit:frames=8,degrees=200,elevation=10",
+            "-o",
+            "orbit.baked",
+            "--size",
+            "32x32",
+            "--samples",
+            "4",
+        ],
+    );
+    assert_verifies(dir.path(), "orbit");
+    let rec: Recording =
+        trisort_format::read_file(FileKind::Recording, &dir.path().join("orbit.baked.rec"))
+            .unwrap();
+    let (a, b) = ([0u32, 1], [2u32, 3]);
+    let last = rec.frames.len() - 1;
+    assert!(
+        edge_weight(&rec, 0, &a, &b) > 0 && edge_weight(&rec, 0, &b, &a) == 0,
+        "A in front of B at 0°"
+    );
+    assert!(
+        edge_weight(&rec, last, &b, &a) > 0 && edge_weight(&rec, last, &a, &b) == 0,
+        "B in front of A at 200°"
+    );
+    let (index, g) = (
+        v["index_triangles"].as_u64().unwrap(),
+        v["unique_visible"].as_u64().unwrap(),
+    );
+    assert_eq!(g, 4);
+    assert!(
+        index > g,
+        "the inversion forces a split: {index} copies for |G| = {g}"
+    );
+}
+
+/// A camera inside the model's bounding box: a closed room of 12 inward-facing wall
+/// triangles around the camera, with a transparent pane inside; clip planes derived by the
+/// path (the eye lies inside the box, so znear comes from the bounding radius). Every frame
+/// sees walls and the pane, no wall behind the camera, nothing truncated, and the rules pass.
+#[test]
+fn a_camera_inside_the_bounding_box() {
+    let dir = tempfile::tempdir().unwrap();
+    let (lo, hi) = (-5.0f32, 5.0f32);
+    let face = |axis: usize, at: f32| -> Vec<[[f32; 3]; 3]> {
+        let p = |u: f32, v: f32| {
+            let mut q = [0.0f32; 3];
+            q[axis] = at;
+            q[(axis + 1) % 3] = u;
+            q[(axis + 2) % 3] = v;
+            q
+        };
+        vec![
+            [p(lo, lo), p(hi, lo), p(hi, hi)],
+            [p(lo, lo), p(hi, hi), p(lo, hi)],
+        ]
+    };
+    // Walls: ids 0–1 x = −5, 2–3 x = +5, 4–5 y = −5, 6–7 y = +5, 8–9 z = −5, 10–11 z = +5.
+    let walls: Vec<_> = [(0, lo), (0, hi), (1, lo), (1, hi), (2, lo), (2, hi)]
+        .iter()
+        .flat_map(|&(a, at)| face(a, at))
+        .collect();
+    let pane = quad(-1.0, 1.0, -1.0, 1.0, -2.0); // ids 12, 13
+    let scene = glb(
+        &[part(0, walls), part(1, pane)],
+        &[Mat([0.6, 0.6, 0.6, 1.0]), Mat([0.1, 0.8, 0.3, 0.4])],
+    );
+    let path = path_toml(
+        60.0,
+        None,
+        &[
+            ([0.0, 0.0, 1.0], [0.0, 0.0, -2.0]),
+            ([0.5, 0.2, 0.5], [0.0, 0.0, -2.0]),
+        ],
+    );
+    let Some(b) = bake(dir.path(), "inside", &scene, &path, 32, 4) else {
+        return;
+    };
+    assert_verifies(dir.path(), "inside");
+    for f in &b.rec.frames {
+        assert!(!f.truncated);
+        let v = set(&f.visible);
+        assert!(
+            v.contains(&8) || v.contains(&9),
+            "frame {}: the wall ahead",
+            f.frame
+        );
+        assert!(
+            v.contains(&12) && v.contains(&13),
+            "frame {}: the pane",
+            f.frame
+        );
+        assert!(
+            !v.contains(&10) && !v.contains(&11),
+            "frame {}: the wall behind the camera",
+            f.frame
+        );
+    }
+}
+
+/// Zero-area triangles (a repeated vertex, three collinear vertices) are counted by
+/// `inspect`, rasterize no fragment, so never reach G, and do not disturb the bake.
+#[test]
+fn zero_area_triangles_never_reach_the_bake() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut tris = quad(-1.0, 1.0, -1.0, 1.0, -3.0); // ids 0, 1
+    tris.push([[-0.5, -0.5, -2.0], [-0.5, -0.5, -2.0], [0.5, 0.5, -2.0]]); // 2: repeated vertex
+    tris.push([[-0.5, 0.0, -2.0], [0.0, 0.0, -2.0], [0.5, 0.0, -2.0]]); // 3: collinear
+    tris.push([[0.0, -0.5, -2.0], [0.0, 0.5, -2.5], [0.0, 0.0, -2.25]]); // 4: collinear in depth
+    tris.extend(quad(-0.3, 0.3, -0.3, 0.3, -2.0)); // 5, 6
+    let scene = glb(&[part(0, tris)], &[Mat([0.5, 0.5, 0.5, 1.0])]);
+    std::fs::write(dir.path().join("zero.glb"), &scene).unwrap();
+    let v = run_json(dir.path(), &["inspect", "zero.glb"]);
+    assert_eq!(v["triangles"], 7);
+    assert_eq!(v["zero_area_triangles"], 3);
+    let path = path_toml(
+        60.0,
+        None,
+        &[(EYE0, AHEAD), ([0.8, 0.4, 0.0], [0.0, 0.0, -2.0])],
+    );
+    let Some(b) = bake(dir.path(), "zero", &scene, &path, 32, 4) else {
+        return;
+    };
+    assert_verifies(dir.path(), "zero");
+    assert_eq!(set(&b.rec.unique_visible), set(&[0, 1, 5, 6]));
+}
+
+/// 64 full-screen transparent layers (alpha 0.02: 1 − 0.98⁶⁴ ≈ 0.73, far from saturation):
+/// every layer is visible, phase 2 peels 64 layers, each layer is in front of the next, and
+/// the rules pass. With `--max-layers 32` the frame is marked truncated and `verify` fails
+/// (exit 3): an incomplete peel is never passed off as exact.
+#[test]
+fn a_64_layer_transparent_stack() {
+    let dir = tempfile::tempdir().unwrap();
+    let parts: Vec<Part> = (0..64)
+        .map(|k| part(0, quad(-3.0, 3.0, -3.0, 3.0, -1.0 - 0.05 * k as f32)))
+        .collect();
+    let scene = glb(&parts, &[Mat([0.9, 0.9, 0.9, 0.02])]);
+    let path = path_toml(60.0, Some((0.1, 10.0)), &[(EYE0, AHEAD)]);
+    let Some(b) = bake(dir.path(), "stack", &scene, &path, 32, 1) else {
+        return;
+    };
+    assert_verifies(dir.path(), "stack");
+    let f = &b.rec.frames[0];
+    assert_eq!(f.visible.len(), 128);
+    assert_eq!(f.layers, [64, 64]);
+    assert!(!f.truncated);
+    for k in 0..63u32 {
+        assert!(
+            edge_weight(&b.rec, 0, &[2 * k, 2 * k + 1], &[2 * k + 2, 2 * k + 3]) == 32 * 32,
+            "layer {k} → {}",
+            k + 1
+        );
+    }
+    assert_eq!(b.baked.copies.len(), 128);
+    let Some(t) = bake_with(
+        dir.path(),
+        "capped",
+        &scene,
+        &path,
+        32,
+        1,
+        &["--max-layers", "32"],
+    ) else {
+        return;
+    };
+    assert!(t.rec.frames[0].truncated);
+    let out = run(
+        dir.path(),
+        &["verify", "capped.baked", "--recording", "capped.baked.rec"],
+        false,
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "a truncated frame fails verification"
+    );
+}
+
+/// Two opaque quads crossing along x = 0 (z = −2 ± 0.5x): on one side A is in front, on
+/// the other B. The frame's graph has a cycle; the merger removes a minimum-weight set of
+/// edges, which are the only unordered samples (no more than the lighter direction's
+/// weight), the file records them, and the rules pass with them removed. Against the exact
+/// reference, the loss is confined to the unordered mask: no pixel without an unordered
+/// sample differs.
+#[test]
+fn an_interpenetrating_pair_is_unordered_only_where_it_crosses() {
+    let dir = tempfile::tempdir().unwrap();
+    let tilted = |slope: f32| -> Vec<[[f32; 3]; 3]> {
+        let p = |x: f32, y: f32| [x, y, -2.0 + slope * x];
+        vec![
+            [p(-1.0, -1.0), p(1.0, -1.0), p(1.0, 1.0)],
+            [p(-1.0, -1.0), p(1.0, 1.0), p(-1.0, 1.0)],
+        ]
+    };
+    let scene = glb(
+        &[part(0, tilted(0.5)), part(1, tilted(-0.5))],
+        &[Mat([0.9, 0.2, 0.2, 1.0]), Mat([0.2, 0.2, 0.9, 1.0])],
+    );
+    let path = path_toml(
+        60.0,
+        Some((0.1, 10.0)),
+        &[(EYE0, AHEAD), ([0.0, 0.6, 0.2], [0.0, 0.0, -2.0])],
+    );
+    let Some(b) = bake(dir.path(), "cross", &scene, &path, 32, 4) else {
+        return;
+    };
+    // Against the exact reference (blend): every differing pixel holds an unordered sample.
+    let report = assert_verifies(dir.path(), "cross");
+    for f in report["frames"].as_array().unwrap() {
+        let n = |k: &str| f[k].as_u64().unwrap();
+        assert!(n("unordered_pixels") > 0, "{f}");
+        assert_eq!(n("pixels_differing_ordered"), 0, "{f}");
+        assert!(n("pixels_differing") <= n("unordered_pixels"), "{f}");
+        assert_eq!(
+            n("unordered_samples"),
+            n("unordered_samples_recorded"),
+            "{f}"
+        );
+    }
+    let (a, bb) = ([0u32, 1], [2u32, 3]);
+    let mut total = 0u64;
+    for (f, removed) in b.baked.removed_edges.iter().enumerate() {
+        let ab = edge_weight(&b.rec, f, &a, &bb) as u64;
+        let ba = edge_weight(&b.rec, f, &bb, &a) as u64;
+        assert!(ab > 0 && ba > 0, "frame {f}: each in front on its own side");
+        let w: u64 = removed.iter().map(|e| e.weight as u64).sum();
+        assert!(
+            w > 0 && w <= ab.min(ba),
+            "frame {f}: removed {w} of {ab} / {ba}"
+        );
+        total += w;
+    }
+    assert_eq!(b.baked.stats.unordered_samples, total);
+}
