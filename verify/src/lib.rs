@@ -16,7 +16,8 @@
 //!    it. The removed weight is the frame's `unordered_samples`, and its sum must equal the
 //!    file's `stats.unordered_samples`.
 //!
-//! It also runs [`Baked::check_structure`] first and compares the hashes, settings and G.
+//! It also runs [`Baked::check_structure`] and every recording's
+//! [`Recording::check_structure`] first, and compares the hashes, settings and G.
 #![deny(missing_docs)]
 
 use serde::Serialize;
@@ -329,6 +330,12 @@ fn collect_frames<'a>(
     }
     let mut fatal = false;
     for (k, r) in recordings.iter().enumerate() {
+        if let Err(e) = r.check_structure() {
+            report
+                .problems
+                .push(format!("recording {k} is malformed: {e}"));
+            return None;
+        }
         let mut differs = |what: &str| {
             report.problems.push(format!(
                 "recording {k}: {what} differs from the baked file's"

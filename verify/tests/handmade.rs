@@ -240,3 +240,16 @@ fn removed_edges_must_exist_and_add_up() {
     b.removed_edges[1][0].weight = 5;
     assert!(!check_graph(recs, &b).ok);
 }
+
+#[test]
+fn malformed_recording_is_reported() {
+    let mut rec = recording();
+    let good = baked(&rec, "hidden", vec![0, 1, 2], &[(0, 3)], &[(0, 3)]);
+    rec.frames[0].visible = vec![B, A];
+    let r = check_graph(std::slice::from_ref(&rec), &good);
+    assert!(
+        !r.ok && r.problems[0].contains("malformed"),
+        "{:?}",
+        r.problems
+    );
+}
