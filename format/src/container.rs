@@ -224,7 +224,9 @@ pub fn read_file<T: DeserializeOwned>(kind: FileKind, path: &Path) -> Result<T, 
 }
 
 /// Writes `bytes` to `path` atomically: into a temporary file in the same directory, synced,
-/// then renamed over `path`. A crash leaves either the old file or the new one, never half.
+/// then renamed over `path`, and the directory synced so the rename itself survives a power
+/// loss (where the platform lets a directory be opened). A crash leaves either the old file or
+/// the new one, never half.
 pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
     let io = |source| FormatError::Io {
         path: path.to_path_buf(),
@@ -246,7 +248,12 @@ pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), FormatError> 
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
-        std::fs::rename(&tmp, path)
+        std::fs::rename(&tmp, path)?;
+        if let Ok(d) = std::fs::File::open(&dir) {
+            // Best effort: not every platform syncs a directory handle.
+            let _ = d.sync_all();
+        }
+        Ok(())
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);

@@ -251,3 +251,71 @@ impl Recording {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+
+    /// A phase-1 recording of frames 1..3 of a 4-frame path over a 10-triangle scene.
+    fn visibility() -> Recording {
+        let state = FrameState {
+            camera: Camera {
+                view: glam::DMat4::IDENTITY.to_cols_array(),
+                yfov: 1.0,
+                znear: 0.1,
+                zfar: Some(100.0),
+            },
+            poses: vec![],
+        };
+        let frame = |f: u32, visible: Vec<u32>| FrameRecord {
+            frame: f,
+            visible,
+            ..Default::default()
+        };
+        Recording {
+            tool_version: crate::TOOL_VERSION.into(),
+            scene_hash: [0; 32],
+            path_hash: [0; 32],
+            settings: RecordSettings::default(),
+            device: DeviceInfo::default(),
+            phase: Phase::Visibility,
+            scene_triangles: 10,
+            frame_states: vec![state; 4],
+            frames: vec![frame(1, vec![2, 5]), frame(2, vec![5, 9])],
+            unique_visible: vec![2, 5, 9],
+            geometry: Geometry::default(),
+        }
+    }
+
+    #[test]
+    fn check_structure_accepts_a_valid_recording_and_names_each_fault() {
+        visibility().check_structure().unwrap();
+        type Edit = fn(&mut Recording);
+        let faults: [(Edit, &str); 8] = [
+            (|r| r.unique_visible.push(10), "but the scene has 10"),
+            (|r| r.unique_visible.swap(0, 1), "not strictly ascending"),
+            (|r| r.frames[1].frame = 3, "contiguous"),
+            (|r| r.frames[1].visible = vec![4], "not in G"),
+            (|r| r.frame_states.truncate(2), "beyond the path"),
+            (|r| r.frame_states[3].camera.znear = f64::NAN, "znear NaN"),
+            (
+                |r| {
+                    r.frames[0].edges = vec![Edge {
+                        from: 2,
+                        to: 5,
+                        weight: 1,
+                    }]
+                },
+                "holds graphs",
+            ),
+            (|r| r.settings.saturation = f32::NAN, "saturation NaN"),
+        ];
+        for (edit, needle) in faults {
+            let mut r = visibility();
+            edit(&mut r);
+            let err = r.check_structure().unwrap_err();
+            assert!(err.contains(needle), "{err:?} lacks {needle:?}");
+        }
+    }
+}
