@@ -7,7 +7,7 @@
 use glam::{DMat4, DVec3};
 use trisort_format::{Camera, FrameState, Geometry, Material, Node, Vertex};
 use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
 
 use crate::peeler::Peeler;
 
@@ -138,46 +138,21 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
             trisort_shaders::compose(&["primitive_index"], &body).into(),
         ),
     });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: None,
-        bind_group_layouts: &[Some(&scene.layout)],
-        immediate_size: 0,
-    });
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("coverage"),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_player"),
-            compilation_options: Default::default(),
-            buffers: &[Some(vertex_layout())],
-        },
-        primitive: wgpu::PrimitiveState {
-            front_face: wgpu::FrontFace::Ccw,
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: wgpu::TextureFormat::Depth32Float,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: wgpu::MultisampleState {
-            count: 4,
-            mask: !0,
-            alpha_to_coverage_enabled: false,
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_coverage"),
-            compilation_options: Default::default(),
-            targets: &[Some(wgpu::TextureFormat::Rg32Uint.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
+    let pipeline = ScenePipeline {
+        label: "coverage",
+        layouts: &[&scene.layout],
+        module: &module,
+        vertex: "vs_player",
+        fragment: "fs_coverage",
+        target: wgpu::TextureFormat::Rg32Uint.into(),
+        depth: Some((
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::CompareFunction::Less,
+            true,
+        )),
+        samples: 4,
+    }
+    .build(device);
     let tex = |format| {
         device.create_texture(&wgpu::TextureDescriptor {
             label: None,

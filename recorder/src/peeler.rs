@@ -7,7 +7,7 @@ use std::ops::Range;
 
 use trisort_format::{FrameState, Geometry};
 use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
 use crate::RecordError;
@@ -124,46 +124,18 @@ impl<'g> Peeler<'g> {
                 },
             ],
         });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("peel"),
-            bind_group_layouts: &[Some(&scene.layout), Some(&peel_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("peel"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_peel"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
-            },
-            // One pipeline for all materials: single-sided ones discard back faces in the shader.
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState {
-                count: view.samples,
-                mask: !0,
-                alpha_to_coverage_enabled: false,
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_peel"),
-                compilation_options: Default::default(),
-                targets: &[Some(ID_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let depth_less = Some((DEPTH_FORMAT, wgpu::CompareFunction::Less, true));
+        let pipeline = ScenePipeline {
+            label: "peel",
+            layouts: &[&scene.layout, &peel_layout],
+            module: &module,
+            vertex: "vs_peel",
+            fragment: "fs_peel",
+            target: ID_FORMAT.into(),
+            depth: depth_less,
+            samples: view.samples,
+        }
+        .build(device);
 
         let gather_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("gather"),
@@ -289,45 +261,17 @@ impl<'g> Peeler<'g> {
             label: Some("plain"),
             source: wgpu::ShaderSource::Wgsl(trisort_shaders::plain_shader().into()),
         });
-        let plain_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("plain"),
-            bind_group_layouts: &[Some(&scene.layout)],
-            immediate_size: 0,
-        });
-        let plain = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("plain"),
-            layout: Some(&plain_layout),
-            vertex: wgpu::VertexState {
-                module: &plain_module,
-                entry_point: Some("vs_plain"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState {
-                count: view.samples,
-                mask: !0,
-                alpha_to_coverage_enabled: false,
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &plain_module,
-                entry_point: Some("fs_plain"),
-                compilation_options: Default::default(),
-                targets: &[Some(ID_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let plain = ScenePipeline {
+            label: "plain",
+            layouts: &[&scene.layout],
+            module: &plain_module,
+            vertex: "vs_plain",
+            fragment: "fs_plain",
+            target: ID_FORMAT.into(),
+            depth: depth_less,
+            samples: view.samples,
+        }
+        .build(device);
         Ok(Peeler {
             plain,
             gpu,

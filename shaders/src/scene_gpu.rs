@@ -388,3 +388,76 @@ pub fn frame_uniform(state: &FrameState, view: View) -> FrameUniform {
         ],
     }
 }
+
+/// A render pipeline over the scene's vertex buffer with the state every trisort pipeline
+/// shares: counter-clockwise front faces, no hardware culling (single-sided materials discard
+/// back faces in the shader, so one pipeline serves all materials), and the given depth test,
+/// MSAA count and colour target.
+pub struct ScenePipeline<'a> {
+    /// Label.
+    pub label: &'a str,
+    /// Bind group layouts (group 0 is [`SceneGpu::layout`]).
+    pub layouts: &'a [&'a wgpu::BindGroupLayout],
+    /// The composed shader module.
+    pub module: &'a wgpu::ShaderModule,
+    /// Vertex entry point.
+    pub vertex: &'a str,
+    /// Fragment entry point.
+    pub fragment: &'a str,
+    /// Colour target.
+    pub target: wgpu::ColorTargetState,
+    /// Depth format, compare function and whether depth is written; `None`: no depth test.
+    pub depth: Option<(wgpu::TextureFormat, wgpu::CompareFunction, bool)>,
+    /// MSAA samples.
+    pub samples: u32,
+}
+
+impl ScenePipeline<'_> {
+    /// Creates the pipeline.
+    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        let layouts: Vec<Option<&wgpu::BindGroupLayout>> =
+            self.layouts.iter().map(|l| Some(*l)).collect();
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(self.label),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        });
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(self.label),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: self.module,
+                entry_point: Some(self.vertex),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout())],
+            },
+            primitive: wgpu::PrimitiveState {
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: self
+                .depth
+                .map(|(format, compare, write)| wgpu::DepthStencilState {
+                    format,
+                    depth_write_enabled: Some(write),
+                    depth_compare: Some(compare),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+            multisample: wgpu::MultisampleState {
+                count: self.samples,
+                mask: !0,
+                alpha_to_coverage_enabled: false,
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: self.module,
+                entry_point: Some(self.fragment),
+                compilation_options: Default::default(),
+                targets: &[Some(self.target.clone())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+}
