@@ -455,3 +455,70 @@ fn sub_pixel_texture_alpha_verifies_in_every_mode() {
     let (_, baked) = bake(&gpu, &g, &frames, settings(64, 4));
     verify_all_modes(&gpu, "sub-pixel texture alpha", &baked, &g);
 }
+
+/// Ten stacked quads at opacity 0.6: seven with grey `front`, three bright ones behind. Seven
+/// layers leave 0.4⁷ ≈ 0.0016 < 0.002: the samples saturate and the bright quads are never
+/// visible (not in G) at the default threshold.
+fn saturated_stack(front: f32) -> Geometry {
+    let mut g = scene(vec![
+        material([front; 3], 0.6),
+        material([1.0, 1.0, 1.0], 0.6),
+    ]);
+    for k in 0..10 {
+        let m = if k < 7 { 0 } else { 1 };
+        let z = -2.0 - k as f32 * 0.3;
+        quad(&mut g, -0.7, 0.7, -0.7, 0.7, z, z, m);
+    }
+    g
+}
+
+/// Samples that saturate before their last fragment: the player leaves the hidden quads out,
+/// the reference composites them; the difference is the residual transmittance times their
+/// colour, within 1/255 behind a mid-grey stack.
+#[test]
+fn layers_behind_saturation_stay_within_tolerance() {
+    let Some(gpu) = Gpu::for_tests() else { return };
+    let g = saturated_stack(0.3);
+    let frames = [frame_at(DVec3::ZERO)];
+    let (rec, baked) = bake(&gpu, &g, &frames, settings(64, 4));
+    assert_eq!(
+        rec.unique_visible.len(),
+        14,
+        "the three back quads are hidden"
+    );
+    let reports = verify_all_modes(&gpu, "saturated stack", &baked, &g);
+    for (mode, rs) in &reports {
+        if *mode != Mode::Depth {
+            assert_eq!(rs[0].layers, 10, "the reference composites every layer");
+        }
+    }
+}
+
+/// The limit of the 0.998 threshold: its residual (≤ 0.002 of what lies behind) is small in
+/// linear light, but near black the sRGB encoding magnifies it (slope 12.92 at 0), so behind a
+/// near-black stack the hidden bright quads show as 2/255 in `blend` and `saturate`, and the
+/// frame fails the 1/255 gate. Recorded with threshold 1 (only opaque stops) the same scene
+/// keeps every quad and verifies.
+#[test]
+fn dark_stack_shows_the_saturation_residual() {
+    let Some(gpu) = Gpu::for_tests() else { return };
+    let g = saturated_stack(0.01);
+    let frames = [frame_at(DVec3::ZERO)];
+    let (rec, baked) = bake(&gpu, &g, &frames, settings(64, 4));
+    assert_eq!(rec.unique_visible.len(), 14);
+    let r = &verify(&gpu, &baked, &g, Mode::Blend)[0];
+    assert!(!r.ok, "{r:?}");
+    assert_eq!(r.unordered_samples, 0);
+    assert_eq!(r.comparison.max_channel_diff_ordered, 2, "{r:?}");
+    let (rec, baked) = bake(
+        &gpu,
+        &g,
+        &frames,
+        RecordSettings {
+            saturation: 1.0,
+            ..settings(64, 4)
+        },
+    );
+    assert_eq!(rec.unique_visible.len(), 20);
+    verify_all_modes(&gpu, "dark stack at threshold 1", &baked, &g);
+}
