@@ -144,7 +144,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         images.frames.iter().map(f).max().unwrap_or(0)
     };
     println!(
-        "images (verify, blend):  {}: {} frames against the exact reference, max channel diff {}/255 ({}/255 on ordered pixels), {} unordered samples",
+        "images (verify, blend): {}: {} frames against the exact reference, max channel diff {}/255 ({}/255 on ordered pixels), {} unordered samples",
         if images.ok { "all frames OK" } else { "FAILED" },
         images.frames.len(),
         worst(|f| f.comparison.max_channel_diff),
