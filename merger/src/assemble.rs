@@ -3,16 +3,17 @@
 //! `DrawIndexedIndirectArgs`, and compute the merge statistics.
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 use trisort_format::{
     Baked, DrawIndexedIndirectArgs, Edge, FrameWindow, MatrixCell, MergeInfo, MergeStats, Recording,
 };
 
-use crate::cells::{cell_edges, CellGraph, CellOrder, Copy, CopyLookup, NONE};
+use crate::cells::{cell_edges, CellGraph, CellOrder, Copy, CopyTable, NONE};
 use crate::graph::FrameGraph;
 use crate::serialize::serialize_cell;
-use crate::split::{seed_intervals, split_until_valid, Context};
+use crate::split::{seed_intervals, split_until_valid, Budget, Context};
 use crate::{paper, Layout, MergeOptions, Seeding, Strategy};
 
 /// One strategy × layout, merged.
@@ -106,7 +107,8 @@ struct SegmentCells {
     edges: (u64, u64),
 }
 
-/// Merges every segment with one strategy and layout and lays the result out.
+/// Merges every segment with one strategy and layout and lays the result out; `None` when
+/// the copies exceed `best` (another combination already did better, see [`Budget`]).
 pub(crate) fn build(
     cx: &Context<'_>,
     segments: &[Range<u32>],
@@ -114,8 +116,13 @@ pub(crate) fn build(
     layout: Layout,
     seeding: Seeding,
     triangles: &[[u32; 3]],
-) -> Assembled {
-    let per_segment: Vec<SegmentCells> = segments
+    best: &AtomicU64,
+) -> Option<Assembled> {
+    let budget = Budget {
+        best,
+        used: AtomicU64::new(0),
+    };
+    let per_segment: Option<Vec<SegmentCells>> = segments
         .par_iter()
         .map(|seg| {
             let order = CellOrder {
@@ -128,10 +135,17 @@ pub(crate) fn build(
                 Seeding::Interval => seed_intervals(cx, seg.clone()),
                 Seeding::Paper => paper::seed_diagonal_merge(cx, seg.clone(), order),
             };
-            let split = split_until_valid(cx, seg.clone(), order, seeds);
-            serialize_segment(cx, seg.clone(), order, &split.copies, triangles)
+            let split = split_until_valid(cx, seg.clone(), order, seeds, &budget)?;
+            Some(serialize_segment(
+                cx,
+                seg.clone(),
+                order,
+                &split.copies,
+                triangles,
+            ))
         })
         .collect();
+    let per_segment = per_segment?;
     let mut copies = Vec::new();
     let mut cells = Vec::new();
     let mut edges = (0, 0);
@@ -179,7 +193,8 @@ pub(crate) fn build(
             });
         }
     }
-    Assembled {
+    best.fetch_min(copies.len() as u64, Ordering::Relaxed);
+    Some(Assembled {
         strategy,
         layout,
         seeding,
@@ -188,7 +203,7 @@ pub(crate) fn build(
         draws,
         windows,
         edges,
-    }
+    })
 }
 
 fn draw(first_copy: u32, count: u32) -> DrawIndexedIndirectArgs {
@@ -224,8 +239,8 @@ fn serialize_segment(
             }
         }
     }
-    let lookup = CopyLookup::new(copies);
-    let edges = cell_edges(cx.graphs, seg, copies, &lookup, &cell_of);
+    let table = CopyTable::new(cx.graphs, seg.clone(), cx.visible_frames.len(), copies);
+    let edges = cell_edges(cx.graphs, seg, &table, &cell_of);
     let mut edge_groups: Vec<&[crate::cells::CellEdge]> = vec![&[]; groups.len()];
     for g in edges.chunk_by(|a, b| a.cell == b.cell) {
         edge_groups[g[0].cell as usize] = g;

@@ -43,36 +43,86 @@ impl CellOrder {
 /// Marks "no copy" / "no cell".
 pub(crate) const NONE: u32 = u32::MAX;
 
-/// Finds the copy of a triangle drawn at a frame.
-pub(crate) struct CopyLookup {
-    /// `(t, first, copy)` sorted.
-    entries: Vec<(u32, u32, u32)>,
+/// Which copy is drawn at every vertex of every frame graph of a segment: a dense table
+/// (one entry per vertex of each frame's graph), updated in place as copies are split, so
+/// that a round of the splitter reads it in O(1) per vertex and rewrites only what changed.
+pub(crate) struct CopyTable {
+    /// First frame of the segment.
+    start: u32,
+    /// Per frame of the segment (relative), the offset of its vertices in `at`.
+    frame_off: Vec<usize>,
+    /// Copy drawn at (frame, local vertex), or [`NONE`].
+    at: Vec<u32>,
+    /// Per G-local triangle, the range of `slots` holding its vertices.
+    tri_off: Vec<u32>,
+    /// `(frame, index into at)` of every vertex, grouped by triangle, by frame.
+    slots: Vec<(u32, u32)>,
 }
 
-impl CopyLookup {
-    /// Indexes `copies`. O(C log C).
-    pub fn new(copies: &[Copy]) -> CopyLookup {
-        let mut entries: Vec<(u32, u32, u32)> = copies
-            .iter()
-            .enumerate()
-            .map(|(k, c)| (c.t, c.first, k as u32))
-            .collect();
-        entries.sort_unstable();
-        CopyLookup { entries }
+impl CopyTable {
+    /// Indexes the vertices of the frames `seg` (triangles below `triangles`) and marks
+    /// where each of `copies` is drawn. O(Σ vertices + Σ copy spans).
+    pub fn new(
+        graphs: &[FrameGraph],
+        seg: std::ops::Range<u32>,
+        triangles: usize,
+        copies: &[Copy],
+    ) -> CopyTable {
+        let frames = &graphs[seg.start as usize..seg.end as usize];
+        let mut frame_off = Vec::with_capacity(frames.len() + 1);
+        let mut total = 0usize;
+        let mut count = vec![0u32; triangles + 1];
+        for fg in frames {
+            frame_off.push(total);
+            total += fg.nodes.len();
+            for &t in &fg.nodes {
+                count[t as usize + 1] += 1;
+            }
+        }
+        frame_off.push(total);
+        for k in 1..count.len() {
+            count[k] += count[k - 1];
+        }
+        let tri_off = count.clone();
+        let mut slots = vec![(0u32, 0u32); total];
+        for (r, fg) in frames.iter().enumerate() {
+            for (v, &t) in fg.nodes.iter().enumerate() {
+                let p = &mut count[t as usize];
+                slots[*p as usize] = (seg.start + r as u32, (frame_off[r] + v) as u32);
+                *p += 1;
+            }
+        }
+        let mut table = CopyTable {
+            start: seg.start,
+            frame_off,
+            at: vec![NONE; total],
+            tri_off,
+            slots,
+        };
+        for (k, c) in copies.iter().enumerate() {
+            table.set(c.t, c.first, c.last, k as u32);
+        }
+        table
     }
 
-    /// The copy of `t` that spans frame `f`, or [`NONE`]. O(log C).
-    pub fn at(&self, copies: &[Copy], t: u32, f: u32) -> u32 {
-        let p = self.entries.partition_point(|&(a, b, _)| (a, b) <= (t, f));
-        if p == 0 {
-            return NONE;
+    /// Marks `copy` (or [`NONE`]) as drawn at every vertex of triangle `t` in frames
+    /// `first..=last`. O(log + frames of t in the range).
+    pub fn set(&mut self, t: u32, first: u32, last: u32, copy: u32) {
+        let all =
+            &self.slots[self.tri_off[t as usize] as usize..self.tri_off[t as usize + 1] as usize];
+        let a = all.partition_point(|&(f, _)| f < first);
+        for &(f, i) in &all[a..] {
+            if f > last {
+                break;
+            }
+            self.at[i as usize] = copy;
         }
-        let (a, _, k) = self.entries[p - 1];
-        if a == t && copies[k as usize].last >= f {
-            k
-        } else {
-            NONE
-        }
+    }
+
+    /// The copy drawn at each vertex of frame `f`'s graph ([`NONE`] where none is).
+    pub fn frame(&self, f: u32) -> &[u32] {
+        let r = (f - self.start) as usize;
+        &self.at[self.frame_off[r]..self.frame_off[r + 1]]
     }
 }
 
@@ -118,8 +168,7 @@ pub(crate) struct CellEdge {
 pub(crate) fn cell_edges(
     graphs: &[FrameGraph],
     frames: std::ops::Range<u32>,
-    copies: &[Copy],
-    lookup: &CopyLookup,
+    table: &CopyTable,
     cell_of: &[u32],
 ) -> Vec<CellEdge> {
     let per_frame: Vec<Vec<CellEdge>> = frames
@@ -127,7 +176,7 @@ pub(crate) fn cell_edges(
         .map(|f| {
             let fg = &graphs[f as usize];
             let n = fg.nodes.len();
-            let cop: Vec<u32> = fg.nodes.iter().map(|&t| lookup.at(copies, t, f)).collect();
+            let cop = table.frame(f);
             let cell = |v: usize| {
                 if cop[v] == NONE {
                     NONE

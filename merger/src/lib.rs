@@ -38,11 +38,30 @@ pub mod strategy;
 pub mod synth;
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 use trisort_format::{Baked, MatrixCell, Recording};
 
 pub use strategy::{Layout, Strategy};
+
+/// The order in which `auto` runs the combinations: those that needed the fewest copies on
+/// the synthetic turntable and the demo car first (ILB and IBL), so that the bound they set
+/// stops the others early. Only the running time depends on it.
+const PRIORITY: [(Strategy, Layout); 12] = [
+    (Strategy::Ilb, Layout::Compact),
+    (Strategy::Ibl, Layout::Compact),
+    (Strategy::Ibl, Layout::Paper),
+    (Strategy::Ilb, Layout::Paper),
+    (Strategy::Bil, Layout::Compact),
+    (Strategy::Bli, Layout::Compact),
+    (Strategy::Lib, Layout::Paper),
+    (Strategy::Lbi, Layout::Paper),
+    (Strategy::Bli, Layout::Paper),
+    (Strategy::Lbi, Layout::Compact),
+    (Strategy::Bil, Layout::Paper),
+    (Strategy::Lib, Layout::Compact),
+];
 
 /// Which strategy to use (paper §5.1), or `Auto` to try all six.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -305,16 +324,35 @@ pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, Mer
         .flat_map(|s| opts.layout.layouts().into_iter().map(move |l| (s, l)))
         .collect();
     let triangles = &first.geometry.triangles;
-    let results: Vec<assemble::Assembled> = combos
-        .par_iter()
-        .map(|&(s, l)| assemble::build(&cx, &segments, s, l, opts.seeding, triangles))
+    // Combinations run in `PRIORITY` order (the ones that usually win first) and share the
+    // best copy count finished so far: splitting only adds copies, so a combination that
+    // exceeds it cannot win and stops early. Which ones stop depends on timing; the winner
+    // (always run to the end) does not.
+    let mut queue: Vec<usize> = (0..combos.len()).collect();
+    queue.sort_by_key(|&k| {
+        PRIORITY
+            .iter()
+            .position(|p| *p == combos[k])
+            .unwrap_or(PRIORITY.len())
+    });
+    let best = AtomicU64::new(u64::MAX);
+    let next = AtomicUsize::new(0);
+    let results: Vec<(usize, Option<assemble::Assembled>)> = (0..queue.len())
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|_| {
+            let k = queue[next.fetch_add(1, Ordering::Relaxed)];
+            let (s, l) = combos[k];
+            let a = assemble::build(&cx, &segments, s, l, opts.seeding, triangles, &best);
+            (k, a)
+        })
         .collect();
     let best = results
         .into_iter()
-        .enumerate()
+        .filter_map(|(k, a)| Some((k, a?)))
         .min_by_key(|(k, a)| (a.copies.len(), a.draws_per_frame_max(), *k))
         .map(|(_, a)| a)
-        .expect("at least one strategy and layout");
+        .expect("the best combination is never abandoned");
     let recording_hashes: Vec<trisort_format::Hash> = input
         .recordings
         .par_iter()

@@ -41,10 +41,11 @@
 //! each cost fill or time.
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-use crate::cells::{cell_edges, CellGraph, CellOrder, Copy, CopyLookup, NONE};
+use crate::cells::{cell_edges, CellGraph, CellOrder, Copy, CopyTable, NONE};
 use crate::cycles::csr;
 use crate::graph::FrameGraph;
 use crate::Bridge;
@@ -163,25 +164,67 @@ pub(crate) struct Splitting {
     pub copies: Vec<Copy>,
 }
 
+/// A bound on the copies of one strategy × layout, shared by its segments: splitting only
+/// adds copies, so once the copies of all segments together exceed the best finished result
+/// of another combination (`best`), this one cannot win and is abandoned.
+pub(crate) struct Budget<'a> {
+    /// Fewest copies of a finished combination so far (`u64::MAX` when none).
+    pub best: &'a AtomicU64,
+    /// Copies of this combination's segments so far.
+    pub used: AtomicU64,
+}
+
+impl Budget<'_> {
+    /// Adds `more` copies; false when the combination can no longer win.
+    fn spend(&self, more: u64) -> bool {
+        let used = self.used.fetch_add(more, Ordering::Relaxed) + more;
+        used <= self.best.load(Ordering::Relaxed)
+    }
+}
+
 /// Splits `copies` (of segment `seg`, ordered by `order`) until no conflict and no cell cycle
-/// is left. See the module documentation for the policy.
+/// is left, or returns `None` once `budget` says the result cannot win. See the module
+/// documentation for the policy.
 pub(crate) fn split_until_valid(
     cx: &Context<'_>,
     seg: Range<u32>,
     order: CellOrder,
     mut copies: Vec<Copy>,
-) -> Splitting {
+    budget: &Budget<'_>,
+) -> Option<Splitting> {
+    let mut spent = 0u64;
+    let mut table = CopyTable::new(cx.graphs, seg.clone(), cx.visible_frames.len(), &copies);
+    // Conflicts per frame of the segment. A frame's conflicts depend only on the copies drawn
+    // there, so only frames spanned by a copy that changed are searched again.
+    let mut per_frame: Vec<Vec<(u32, u32, u32)>> = vec![Vec::new(); seg.len()];
+    let mut dirty: Vec<bool> = vec![true; seg.len()];
     loop {
-        let lookup = CopyLookup::new(&copies);
-        let conflicts = find_conflicts(cx, seg.clone(), order, &copies, &lookup);
+        let more = copies.len() as u64 - spent;
+        spent = copies.len() as u64;
+        if !budget.spend(more) {
+            return None;
+        }
+        let stale: Vec<u32> = seg
+            .clone()
+            .filter(|f| dirty[(f - seg.start) as usize])
+            .collect();
+        let found: Vec<Vec<(u32, u32, u32)>> = stale
+            .par_iter()
+            .map(|&f| frame_conflicts(cx, f, order, &copies, table.frame(f)))
+            .collect();
+        for (f, c) in stale.into_iter().zip(found) {
+            per_frame[(f - seg.start) as usize] = c;
+            dirty[(f - seg.start) as usize] = false;
+        }
+        let conflicts: Vec<(u32, u32, u32)> = per_frame.iter().flatten().copied().collect();
         // Cell cycles are rare and costlier to find: look for them once no conflict is left.
         let cycles = if conflicts.is_empty() {
-            find_cell_cycles(cx, seg.clone(), &copies, &lookup)
+            find_cell_cycles(cx, seg.clone(), &copies, &table)
         } else {
             Vec::new()
         };
         if conflicts.is_empty() && cycles.is_empty() {
-            return Splitting { copies };
+            return Some(Splitting { copies });
         }
         let mut touched = vec![false; copies.len()];
         let mut plans: Vec<(u32, Vec<(u32, u32)>)> = Vec::new();
@@ -214,63 +257,68 @@ pub(crate) fn split_until_valid(
             plans.push((x, pieces.into_iter().flatten().collect()));
         }
         for (x, pieces) in plans {
-            let t = copies[x as usize].t;
+            let old = copies[x as usize];
             debug_assert!(!pieces.is_empty(), "a split keeps the visible frames");
+            if pieces == [(old.first, old.last)] {
+                continue;
+            }
+            // The pieces lie inside the old span: only its frames see other copies now.
+            table.set(old.t, old.first, old.last, NONE);
+            for f in old.first..=old.last {
+                dirty[(f - seg.start) as usize] = true;
+            }
             for (k, &(a, b)) in pieces.iter().enumerate() {
                 let c = Copy {
-                    t,
+                    t: old.t,
                     first: a,
                     last: b,
                 };
-                if k == 0 {
+                let id = if k == 0 {
                     copies[x as usize] = c;
+                    x
                 } else {
                     copies.push(c);
-                }
+                    copies.len() as u32 - 1
+                };
+                table.set(c.t, a, b, id);
             }
         }
     }
 }
 
-/// Inter-cell conflicts of every frame of the segment: `(f, x, y)` with x the drawn ancestor
-/// of drawn y whose cell is latest in the layout, later than y's. Ordered by frame, then by
-/// y's position in the topological order.
-fn find_conflicts(
+/// Inter-cell conflicts of frame `f` (`drawn[v]`: the copy drawn at local vertex v):
+/// `(f, x, y)` with x the drawn ancestor of drawn y whose cell is latest in the layout, later
+/// than y's; in y's topological order.
+fn frame_conflicts(
     cx: &Context<'_>,
-    seg: Range<u32>,
+    f: u32,
     order: CellOrder,
     copies: &[Copy],
-    lookup: &CopyLookup,
+    drawn: &[u32],
 ) -> Vec<(u32, u32, u32)> {
-    let per_frame: Vec<Vec<(u32, u32, u32)>> = seg
-        .into_par_iter()
-        .map(|f| {
-            let fg = &cx.graphs[f as usize];
-            let n = fg.nodes.len();
-            // (key + 1, copy) of the latest drawn ancestor; 0 = none.
-            let mut best = vec![(0u64, NONE); n];
-            let mut out = Vec::new();
-            for &v in &fg.topo {
-                let v = v as usize;
-                let k = lookup.at(copies, fg.nodes[v], f);
-                let mut carry = best[v];
-                if k != NONE {
-                    let c = copies[k as usize];
-                    let key = order.key(c.first, c.last) + 1;
-                    if best[v].0 > key {
-                        out.push((f, best[v].1, k));
-                    }
-                    carry = carry.max((key, k));
-                }
-                for &w in fg.successors(v as u32) {
-                    let b = &mut best[w as usize];
-                    *b = (*b).max(carry);
-                }
+    let fg = &cx.graphs[f as usize];
+    let n = fg.nodes.len();
+    // (key + 1, copy) of the latest drawn ancestor; 0 = none.
+    let mut best = vec![(0u64, NONE); n];
+    let mut out = Vec::new();
+    for &v in &fg.topo {
+        let v = v as usize;
+        let k = drawn[v];
+        let mut carry = best[v];
+        if k != NONE {
+            let c = copies[k as usize];
+            let key = order.key(c.first, c.last) + 1;
+            if best[v].0 > key {
+                out.push((f, best[v].1, k));
             }
-            out
-        })
-        .collect();
-    per_frame.into_iter().flatten().collect()
+            carry = carry.max((key, k));
+        }
+        for &w in fg.successors(v as u32) {
+            let b = &mut best[w as usize];
+            *b = (*b).max(carry);
+        }
+    }
+    out
 }
 
 /// The pieces the splits of copy `c` considered for a conflict at frames `lo..=hi` can leave,
@@ -370,7 +418,7 @@ fn find_cell_cycles(
     cx: &Context<'_>,
     seg: Range<u32>,
     copies: &[Copy],
-    lookup: &CopyLookup,
+    table: &CopyTable,
 ) -> Vec<(u32, u32)> {
     // Tracked cells: multi-frame cells with at least two copies.
     let mut cells: Vec<(u32, u32, u32)> = copies
@@ -393,7 +441,7 @@ fn find_cell_cycles(
     if members.is_empty() {
         return Vec::new();
     }
-    let edges = cell_edges(cx.graphs, seg, copies, lookup, &cell_of);
+    let edges = cell_edges(cx.graphs, seg, table, &cell_of);
     let groups: Vec<&[crate::cells::CellEdge]> = edges.chunk_by(|a, b| a.cell == b.cell).collect();
     let per_cell: Vec<Vec<(u32, u32)>> = groups
         .par_iter()
