@@ -7,6 +7,7 @@ pub mod merge;
 mod play;
 pub mod record;
 pub mod verify;
+mod window;
 
 use std::process::ExitCode;
 

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 use serde_json::json;
 use trisort_format::{Baked, FileKind};
@@ -36,9 +36,19 @@ pub struct PlayArgs {
     /// Glass opacity (default: the recorded one).
     #[arg(long)]
     glass_opacity: Option<f32>,
-    /// Open a window (needs a display).
+    /// Open a window (needs X11 or Wayland) to play, pause, step and scrub.
+    ///
+    /// Keys: Space play/pause, Right/Left step, Home/End first/last frame, drag with the left
+    /// button or 0-9 to scrub, Escape/Q quit.
     #[arg(long)]
     window: bool,
+    /// With --window: playback rate in frames per second (baked files store none).
+    #[arg(long, default_value_t = 30.0, requires = "window")]
+    fps: f64,
+    /// With --window, for tests and automation: quit after presenting N frames and print how
+    /// many were presented.
+    #[arg(long, value_name = "N", requires = "window")]
+    window_frames: Option<u64>,
     /// Print per-frame figures as JSON.
     #[arg(long)]
     json: bool,
@@ -104,7 +114,17 @@ pub fn play_frames(
 
 pub fn run(a: PlayArgs) -> Result<ExitCode> {
     if a.window {
-        bail!("--window needs a display and a windowing build; this build plays headless only (use --out-dir)");
+        return super::window::run(super::window::WindowArgs {
+            baked: &a.baked,
+            frames: a.frames,
+            size: a.size,
+            samples: a.samples,
+            mode: a.mode,
+            glass_opacity: a.glass_opacity,
+            fps: a.fps,
+            exit_after: a.window_frames,
+            json: a.json,
+        });
     }
     let baked: Baked = trisort_format::read_file(FileKind::Baked, &a.baked)?;
     baked
