@@ -482,6 +482,9 @@ fn mismatched_recordings_are_not_merged() {
     write_rec(d, "other.rec", &other[1]);
     let overlap = split_frames(&rec, &[0, 4]);
     write_rec(d, "overlap.rec", &overlap[1]);
+    let mut moved = parts[1].clone();
+    moved.path_hash[0] ^= 1;
+    write_rec(d, "moved.rec", &moved);
     let mut wide = parts[1].clone();
     wide.settings.width = 2;
     write_rec(d, "wide.rec", &wide);
@@ -508,6 +511,7 @@ fn mismatched_recordings_are_not_merged() {
             "b.rec",
             "covers frames 6..12, but frame 0 comes next",
         ),
+        (&["a.rec", "moved.rec"], "moved.rec", "path hash"),
         (&["a.rec", "wide.rec"], "wide.rec", "recording settings"),
         (&["a.rec", "phase1.rec"], "phase1.rec", "no graphs"),
     ];

@@ -3,6 +3,13 @@
 //! run ends with a message naming the file and keeps the finished frames; a device that
 //! cannot hold the recording ends with a clear message instead of a panic; identical inputs
 //! give byte-identical Recording and Baked files across runs and thread counts.
+//!
+//! Not tested, because lavapipe cannot lose its device or run out of memory on demand: a
+//! failed device wait in the recorder is `RecordError::Device` ("finished frames are kept;
+//! rerun to resume", exit 1); a wgpu validation or out-of-memory error outside an error scope
+//! goes to wgpu's default handler, which panics, ending the process (exit 101, wgpu's
+//! message) the way the kill below does — frames already stored in `OUT.partial/` stay, as
+//! the kill test shows, and a rerun resumes from them.
 
 mod support;
 
