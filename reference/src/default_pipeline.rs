@@ -11,7 +11,7 @@
 use trisort_format::{AlphaMode, FrameState, Geometry};
 use trisort_player::{blend_state, quantize_rgba16f, Mode};
 use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
 use crate::target::{clear_colour, halves, Target, DEPTH_FORMAT};
@@ -60,56 +60,26 @@ impl<'g> DefaultRenderer<'g> {
                 trisort_shaders::compose(&[], trisort_shaders::PLAYER).into(),
             ),
         });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("default pipeline"),
-            bind_group_layouts: &[Some(&scene.layout)],
-            immediate_size: 0,
-        });
         let pipeline = |write: bool| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(if write {
+            ScenePipeline {
+                label: if write {
                     "default pipeline (opaque)"
                 } else {
                     "default pipeline (transparent)"
-                }),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_player"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(vertex_layout())],
                 },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    front_face: wgpu::FrontFace::Ccw,
-                    cull_mode: None,
-                    ..Default::default()
+                layouts: &[&scene.layout],
+                module: &module,
+                vertex: "vs_player",
+                fragment: trisort_player::fragment_entry_point(Mode::Blend),
+                target: wgpu::ColorTargetState {
+                    format: trisort_player::headless::COLOR_FORMAT,
+                    blend: Some(blend_state(Mode::Blend)),
+                    write_mask: wgpu::ColorWrites::ALL,
                 },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(write),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: wgpu::MultisampleState {
-                    count: view.samples,
-                    mask: !0,
-                    alpha_to_coverage_enabled: false,
-                },
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(trisort_player::fragment_entry_point(Mode::Blend)),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: trisort_player::headless::COLOR_FORMAT,
-                        blend: Some(blend_state(Mode::Blend)),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+                depth: Some((DEPTH_FORMAT, wgpu::CompareFunction::Less, write)),
+                samples: view.samples,
+            }
+            .build(device)
         };
         let opaque_pipeline = pipeline(true);
         let transparent_pipeline = pipeline(false);

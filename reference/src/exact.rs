@@ -31,7 +31,7 @@ use trisort_format::{
 use trisort_player::{blend_state, quantize_rgba16f, Mode, BACKGROUND};
 use trisort_recorder::Peeler;
 use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
 use crate::target::{clear_colour, halves, Target};
@@ -254,52 +254,29 @@ impl<'g> ExactReference<'g> {
             label: Some("reference composite"),
             source: wgpu::ShaderSource::Wgsl(trisort_shaders::reference_shader().into()),
         });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("reference composite"),
-            bind_group_layouts: &[Some(&scene.layout), Some(&composite_layout)],
-            immediate_size: 0,
-        });
         // The fragment outputs of `trisort_player::fragment_entry_point(mode)`, masked.
         let entry = match config.mode {
             Mode::Saturate => "fs_reference_premultiplied",
             Mode::Blend | Mode::Depth => "fs_reference_straight",
         };
-        // The player's pipeline state (see `trisort_player`'s `create_pipeline`), with the
-        // reference's fragment entry point.
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("reference composite"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_player"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
+        // The player's pipeline state (shared `ScenePipeline`: CCW, no hardware culling, its
+        // MSAA count, no depth test in blend and saturate) with the reference's fragment
+        // entry point and the player's blend state.
+        let pipeline = ScenePipeline {
+            label: "reference composite",
+            layouts: &[&scene.layout, &composite_layout],
+            module: &module,
+            vertex: "vs_player",
+            fragment: entry,
+            target: wgpu::ColorTargetState {
+                format: trisort_player::headless::COLOR_FORMAT,
+                blend: Some(blend_state(config.mode)),
+                write_mask: wgpu::ColorWrites::ALL,
             },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                front_face: wgpu::FrontFace::Ccw,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState {
-                count: config.samples,
-                mask: !0,
-                alpha_to_coverage_enabled: false,
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: trisort_player::headless::COLOR_FORMAT,
-                    blend: Some(blend_state(config.mode)),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+            depth: None,
+            samples: config.samples,
+        }
+        .build(device);
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("reference composite params"),
             contents: bytemuck::cast_slice(&[config.size.0, config.samples, 0, 0]),
