@@ -70,10 +70,12 @@ fn read(dir: &Path, name: &str) -> Vec<u8> {
     std::fs::read(dir.join(name)).unwrap()
 }
 
-/// A bake killed after three finished frame results leaves no output file; a rerun hit by a
-/// storage error (every unfinished frame's file name taken by a directory) fails naming the
-/// file and keeps the finished frames; the next rerun resumes from them and writes the same
-/// bytes as a clean bake (recording and baked file), and removes its partial folder.
+/// A bake killed as soon as it has opened its partial folder leaves no output file. A rerun
+/// whose storage fails at phase-1 frame 3 (that frame's file name, and every later one's, is
+/// taken by a non-empty folder) ends with exit 1 naming the file, and keeps frames 0–2. The
+/// next rerun resumes from them and writes the same bytes as a clean bake (recording and
+/// baked file), removing its partial folder and leaving no temporary file. The failure point
+/// is set by the folder, not by timing, so the test holds on a device of any speed.
 #[test]
 fn an_interrupted_bake_resumes_to_identical_bytes() {
     if !gpu_available() {
@@ -90,24 +92,24 @@ fn an_interrupted_bake_resumes_to_identical_bytes() {
         .unwrap();
     let partial = d.join("resumed.baked.rec.partial");
     let t0 = Instant::now();
-    while finished(&partial).len() < 3 && t0.elapsed() < Duration::from_secs(120) {
+    while !partial.join("key").exists() && t0.elapsed() < Duration::from_secs(120) {
         if child.try_wait().unwrap().is_some() {
             panic!("the bake finished before it could be interrupted");
         }
-        std::thread::sleep(Duration::from_millis(5));
+        std::thread::sleep(Duration::from_millis(2));
     }
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(!d.join("resumed.baked").exists() && !d.join("resumed.baked.rec").exists());
-    let kept = finished(&partial);
-    assert!(kept.len() >= 3, "{kept:?}");
 
-    // Every frame result not yet written: its file name is taken by a non-empty folder.
+    // Every frame result not yet written, except phase-1 frames 0–2: its file name is taken.
+    let done = finished(&partial);
     let mut planted = vec![];
     for phase in ["visibility", "graph"] {
         for f in 0..8 {
             let name = format!("{phase}-{f:07}");
-            if !kept.contains(&name) {
+            let may_finish = phase == "visibility" && f < 3;
+            if !may_finish && !done.contains(&name) {
                 std::fs::create_dir_all(partial.join(&name).join("in-the-way")).unwrap();
                 planted.push(name);
             }
@@ -122,11 +124,15 @@ fn an_interrupted_bake_resumes_to_identical_bytes() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(
         err.contains(&planted[0]),
-        "the message names the file: {err}"
+        "the message names {}: {err}",
+        planted[0]
     );
     assert!(!d.join("resumed.baked").exists());
-    for name in &kept {
-        assert!(partial.join(name).is_file(), "finished frame {name} lost");
+    let kept = finished(&partial);
+    for f in 0..3 {
+        let name = format!("visibility-{f:07}");
+        assert!(kept.contains(&name), "finished frame {name} lost: {kept:?}");
+        assert!(partial.join(&name).is_file());
     }
     for name in &planted {
         std::fs::remove_dir_all(partial.join(name)).unwrap();
