@@ -123,3 +123,26 @@ pub fn progress_bar(total: u64, what: &str) -> indicatif::ProgressBar {
 pub fn print_json(v: &serde_json::Value) {
     println!("{}", serde_json::to_string_pretty(v).expect("json"));
 }
+
+/// Opens the GPU for a command. wgpu reports validation errors, out-of-memory and a lost
+/// device asynchronously, and its default handler panics; the CLI instead prints the error
+/// and exits with status 1. Work already finished is safe: recordings keep their finished
+/// frames in `OUT.partial/` (a rerun resumes) and every output file is written by rename.
+pub fn open_gpu() -> Result<trisort_shaders::gpu::Gpu> {
+    let gpu = trisort_shaders::gpu::Gpu::new()?;
+    let adapter = gpu.info.name.clone();
+    gpu.device
+        .on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+            eprintln!("trisort: error: GPU error on {adapter}: {e}");
+            eprintln!("trisort: finished frames are kept; rerun the command to resume");
+            std::process::exit(1);
+        }));
+    gpu.device.set_device_lost_callback(|reason, message| {
+        if reason != wgpu::DeviceLostReason::Destroyed {
+            eprintln!("trisort: error: GPU device lost ({reason:?}): {message}");
+            eprintln!("trisort: finished frames are kept; rerun the command to resume");
+            std::process::exit(1);
+        }
+    });
+    Ok(gpu)
+}

@@ -67,7 +67,7 @@ pub fn bake(
 pub fn run(a: BakeArgs) -> Result<ExitCode> {
     let scene = load_scene(&a.scene)?;
     let timeline = load_path(&a.path, &scene, a.record.fps)?;
-    let gpu = Gpu::new()?;
+    let gpu = crate::common::open_gpu()?;
     let (rec, baked, record_s, merge_s) =
         bake(&gpu, &scene, &timeline, &a.record, &a.merge, &a.output)?;
     if a.json {

@@ -7,7 +7,6 @@ use std::time::Instant;
 use anyhow::Result;
 use clap::Args;
 use trisort_player::headless::HeadlessConfig;
-use trisort_shaders::gpu::Gpu;
 
 use crate::cmd::bake::bake;
 use crate::cmd::merge::{BridgeArg, LayoutArg, MergeOpts, SeedingArg, StrategyArg};
@@ -71,7 +70,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         segment: None,
         seeding: SeedingArg::Interval,
     };
-    let gpu = Gpu::new()?;
+    let gpu = crate::common::open_gpu()?;
     println!("device: {}", gpu.describe());
     let baked_path = a.out_dir.join("demo.baked");
     let (rec, baked, record_s, merge_s) = bake(&gpu, &scene, &path, &record, &merge, &baked_path)?;

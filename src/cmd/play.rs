@@ -144,7 +144,7 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
     if let Some(s) = a.samples {
         config.samples = s;
     }
-    let gpu = Gpu::new()?;
+    let gpu = crate::common::open_gpu()?;
     let frames = play_frames(&gpu, &baked, &config, range, a.out_dir.as_deref())?;
     if a.json {
         let list: Vec<_> = frames

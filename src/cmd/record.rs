@@ -157,7 +157,7 @@ pub fn run(a: RecordArgs) -> Result<ExitCode> {
             union_of_visibility(&a.visibility, &scene, &timeline)?,
         ),
     };
-    let gpu = Gpu::new()?;
+    let gpu = crate::common::open_gpu()?;
     let rec = record_to_file(&gpu, &scene, &timeline, &a.opts, phase, known, &a.output)?;
     let secs = t0.elapsed().as_secs_f64();
     if a.json {

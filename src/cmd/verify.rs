@@ -175,7 +175,7 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             if check.samples != 1 && check.samples != 4 {
                 bail!("--samples {}: only 1 and 4 are supported", check.samples);
             }
-            let gpu = Gpu::new()?;
+            let gpu = crate::common::open_gpu()?;
             if !a.json {
                 println!("device: {}", gpu.describe());
             }
