@@ -1,14 +1,44 @@
 //! `trisort play --window` through the real binary: a clean error without a display, and, where
 //! `xvfb-run` is installed (`apt-get install xvfb`), the viewer playing in a virtual X server
-//! until `--window-frames` frames were presented.
+//! until `--window-frames` frames were presented; where `xwd` is installed too
+//! (`apt-get install x11-apps`), screenshots of the window equal the PNG of the same frame.
 
 mod support;
 
 use std::path::Path;
 use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 use support::*;
+
+/// `xvfb-run` on a display number of its own (`-a` could pick the number of a server that an
+/// earlier `xvfb-run` killed without waiting for it), with `-noreset`: by default the X server
+/// resets when its last client disconnects, and a client connecting during the reset fails
+/// ("unable to open display"), which happened to the viewer when an `xwd` ran first under load.
+fn xvfb_run(screen: &str) -> Command {
+    static NEXT: AtomicU32 = AtomicU32::new(0);
+    let base = 1000 + (std::process::id() % 3000) * 8;
+    let number = loop {
+        let n = base + NEXT.fetch_add(1, Ordering::Relaxed);
+        if !Path::new(&format!("/tmp/.X{n}-lock")).exists() {
+            break n;
+        }
+    };
+    let mut cmd = Command::new("xvfb-run");
+    cmd.args([
+        "-n",
+        &number.to_string(),
+        "-s",
+        &format!("-screen 0 {screen} -noreset"),
+    ])
+    .env_remove("WAYLAND_DISPLAY")
+    .env_remove("WAYLAND_SOCKET");
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    cmd
+}
 
 const NO_DISPLAY: &str = "no display: --window needs X11 or Wayland; use --out-dir for PNG frames";
 
@@ -76,19 +106,13 @@ fn on_path(name: &str) -> bool {
 /// code, stdout and stderr.
 fn under_xvfb(dir: &Path, args: &[&str], limit: Duration) -> (Option<i32>, String, String) {
     let (out_path, err_path) = (dir.join("xvfb.stdout"), dir.join("xvfb.stderr"));
-    let mut cmd = Command::new("xvfb-run");
+    let mut cmd = xvfb_run("640x480x24");
     cmd.current_dir(dir)
-        .args(["-a", "-s", "-screen 0 640x480x24"])
         .arg(bin())
         .args(args)
-        .env_remove("WAYLAND_DISPLAY")
-        .env_remove("WAYLAND_SOCKET")
         .stdin(Stdio::null())
         .stdout(std::fs::File::create(&out_path).unwrap())
         .stderr(std::fs::File::create(&err_path).unwrap());
-    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
-        cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
-    }
     let mut child = cmd.spawn().expect("spawn xvfb-run");
     let start = Instant::now();
     let status = loop {
@@ -178,6 +202,157 @@ fn window_plays_frames_under_xvfb() {
             stderr.contains("recorded with 4"),
             samples != "4",
             "warnings: {stderr}"
+        );
+    }
+}
+
+/// An `xwd` dump (X Window Dump, version 7, ZPixmap, 24/32-bit TrueColor) as RGB rows.
+struct Xwd {
+    width: usize,
+    height: usize,
+    rgb: Vec<[u8; 3]>,
+}
+
+fn parse_xwd(bytes: &[u8]) -> Xwd {
+    let field = |k: usize| u32::from_be_bytes(bytes[4 * k..4 * k + 4].try_into().unwrap());
+    let (header_size, version, format) = (field(0) as usize, field(1), field(2));
+    assert_eq!((version, format), (7, 2), "xwd version 7 ZPixmap");
+    let (width, height) = (field(4) as usize, field(5) as usize);
+    let little_endian = field(7) == 0;
+    let bits_per_pixel = field(11);
+    assert_eq!(
+        bits_per_pixel, 32,
+        "xwd of a 24-bit screen stores 32 bits per pixel"
+    );
+    let bytes_per_line = field(12) as usize;
+    let masks = [field(14), field(15), field(16)];
+    let colormap_entries = field(19) as usize;
+    let data = &bytes[header_size + 12 * colormap_entries..];
+    let mut rgb = Vec::with_capacity(width * height);
+    for y in 0..height {
+        for x in 0..width {
+            let b: [u8; 4] = data[y * bytes_per_line + 4 * x..][..4].try_into().unwrap();
+            let px = if little_endian {
+                u32::from_le_bytes(b)
+            } else {
+                u32::from_be_bytes(b)
+            };
+            rgb.push(masks.map(|m| ((px & m) >> m.trailing_zeros()) as u8));
+        }
+    }
+    Xwd { width, height, rgb }
+}
+
+#[test]
+fn window_shows_the_png_frames_pixels() {
+    if !on_path("xvfb-run") || !on_path("xwd") {
+        eprintln!(
+            "skipping the window screenshot test: it needs xvfb-run and xwd on PATH \
+             (apt-get install xvfb x11-apps)"
+        );
+        return;
+    }
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    run(
+        dir.path(),
+        &[
+            "bake",
+            "demo:3000",
+            "--path",
+            "orbit:frames=4",
+            "--size",
+            "64x48",
+            "-o",
+            "w.baked",
+        ],
+        true,
+    );
+    for mode in ["blend", "saturate"] {
+        let png_dir = format!("png-{mode}");
+        run(
+            dir.path(),
+            &[
+                "play",
+                "w.baked",
+                "--frames",
+                "2..3",
+                "--mode",
+                mode,
+                "--out-dir",
+                &png_dir,
+            ],
+            true,
+        );
+        let png = image::open(dir.path().join(&png_dir).join("frame-00002.png"))
+            .unwrap()
+            .to_rgb8();
+        // The viewer plays the one-frame range 2..3 for 120 presents at 60 fps while the script
+        // dumps the screen every 0.1 s. With no window manager the window sits at (0, 0).
+        let script = format!(
+            "\"$0\" play w.baked --window --frames 2..3 --mode {mode} --fps 60 \
+             --window-frames 120 >viewer.out 2>viewer.err & pid=$!; i=0; \
+             while kill -0 $pid 2>/dev/null; do i=$((i+1)); xwd -root -silent >shot-$i.xwd; \
+             sleep 0.1; done; wait $pid"
+        );
+        for old in std::fs::read_dir(dir.path()).unwrap() {
+            let p = old.unwrap().path();
+            if p.extension().is_some_and(|e| e == "xwd") {
+                std::fs::remove_file(p).unwrap();
+            }
+        }
+        let out = xvfb_run("320x240x24")
+            .current_dir(dir.path())
+            .args(["sh", "-c", &script])
+            .arg(bin())
+            .output()
+            .expect("spawn xvfb-run");
+        let viewer_err = std::fs::read_to_string(dir.path().join("viewer.err")).unwrap_or_default();
+        assert!(
+            out.status.success(),
+            "{mode}: xvfb-run exited with {:?}\n--- xvfb-run stderr\n{}\n--- viewer stderr\n{viewer_err}",
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let (mut matching, mut empty, mut shots) = (0, 0, 0);
+        for entry in std::fs::read_dir(dir.path()).unwrap() {
+            let p = entry.unwrap().path();
+            if p.extension().is_none_or(|e| e != "xwd") {
+                continue;
+            }
+            let bytes = std::fs::read(&p).unwrap();
+            if bytes.len() < 100 {
+                continue; // the server went away during the dump
+            }
+            shots += 1;
+            let shot = parse_xwd(&bytes);
+            assert!(shot.width >= 64 && shot.height >= 48);
+            let window: Vec<[u8; 3]> = (0..48)
+                .flat_map(|y| (0..64).map(move |x| (x, y)))
+                .map(|(x, y)| shot.rgb[y * shot.width + x])
+                .collect();
+            let expected: Vec<[u8; 3]> = png.pixels().map(|p| p.0).collect();
+            if window == expected {
+                matching += 1;
+            } else if window.iter().all(|&p| p == window[0]) {
+                empty += 1; // before the first present or after the window closed
+            } else {
+                let differing = window.iter().zip(&expected).filter(|(a, b)| a != b).count();
+                panic!(
+                    "{mode}: {} shows a frame differing from the PNG at {differing} of {} pixels\n{viewer_err}",
+                    p.display(),
+                    expected.len()
+                );
+            }
+        }
+        assert!(
+            matching > 0,
+            "{mode}: none of {shots} screenshots shows the frame ({empty} show no window)\n{viewer_err}"
+        );
+        eprintln!(
+            "{mode}: {matching} of {shots} screenshots equal the PNG, {empty} show no window"
         );
     }
 }

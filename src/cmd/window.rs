@@ -484,7 +484,7 @@ impl Viewer {
         // encoding and the rounding are the ones `play --out-dir` applies on the CPU, not the
         // hardware's approximation (lavapipe's sRGB stores differ from the exact transfer
         // function by one step on most pixels).
-        let view_format = surface_config.format.remove_srgb_suffix();
+        let mut view_format = surface_config.format.remove_srgb_suffix();
         if view_format != surface_config.format {
             surface_config.view_formats = vec![view_format];
         }
@@ -494,7 +494,23 @@ impl Viewer {
         if caps.alpha_modes.contains(&wgpu::CompositeAlphaMode::Opaque) {
             surface_config.alpha_mode = wgpu::CompositeAlphaMode::Opaque;
         }
-        surface.configure(&device, &surface_config);
+        let configure = |config: &wgpu::SurfaceConfiguration| {
+            let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+            surface.configure(&device, config);
+            pollster::block_on(scope.pop())
+        };
+        if let Some(e) = configure(&surface_config) {
+            if surface_config.view_formats.is_empty() {
+                bail!("configuring the window's surface: {e}");
+            }
+            // Some backends (GL) offer no other view of the surface: write through its own
+            // sRGB format and let the hardware encode.
+            surface_config.view_formats.clear();
+            view_format = surface_config.format;
+            if let Some(e) = configure(&surface_config) {
+                bail!("configuring the window's surface: {e}");
+            }
+        }
 
         let (blit_layout, blit_pipeline) = blit_pipeline(&device, view_format, self.mode);
         let targets = Targets::new(
@@ -510,7 +526,8 @@ impl Viewer {
         )
         .with_context(|| format!("playing {}", self.path.display()))?;
         eprintln!(
-            "trisort: window {width}x{height} on {} ({:?}), surface {:?}, {} sample(s), {} mode",
+            "trisort: window {width}x{height} on {} ({:?}), surface {:?} written as {view_format:?}, \
+             {} sample(s), {} mode",
             adapter_name, info.backend, surface_config.format, self.samples, self.mode
         );
         let gfx = Gfx {
