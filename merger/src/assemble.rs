@@ -3,7 +3,7 @@
 //! `DrawIndexedIndirectArgs`, and compute the merge statistics.
 
 use std::ops::Range;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 
 use rayon::prelude::*;
 use trisort_format::{
@@ -108,7 +108,7 @@ struct SegmentCells {
 }
 
 /// Merges every segment with one strategy and layout and lays the result out; `None` when
-/// the copies exceed `best` (another combination already did better, see [`Budget`]).
+/// its copies exceed `limit` while splitting (see [`Budget`]).
 pub(crate) fn build(
     cx: &Context<'_>,
     segments: &[Range<u32>],
@@ -116,10 +116,10 @@ pub(crate) fn build(
     layout: Layout,
     seeding: Seeding,
     triangles: &[[u32; 3]],
-    best: &AtomicU64,
+    limit: u64,
 ) -> Option<Assembled> {
     let budget = Budget {
-        best,
+        limit,
         used: AtomicU64::new(0),
     };
     let per_segment: Option<Vec<SegmentCells>> = segments
@@ -193,7 +193,6 @@ pub(crate) fn build(
             });
         }
     }
-    best.fetch_min(copies.len() as u64, Ordering::Relaxed);
     Some(Assembled {
         strategy,
         layout,

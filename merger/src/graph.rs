@@ -19,6 +19,10 @@ pub(crate) struct FrameGraph {
     pub off: Vec<u32>,
     /// Successor lists (local indices).
     pub succ: Vec<u32>,
+    /// E_f* reversed, compressed like `off`.
+    pub pred_off: Vec<u32>,
+    /// Predecessor lists (local indices).
+    pub pred: Vec<u32>,
     /// A topological order of E_f* (local indices).
     pub topo: Vec<u32>,
     /// The removed cycle edges (G-local ids), sorted.
@@ -34,6 +38,11 @@ impl FrameGraph {
     /// Successors of local vertex `v`.
     pub fn successors(&self, v: u32) -> &[u32] {
         &self.succ[self.off[v as usize] as usize..self.off[v as usize + 1] as usize]
+    }
+
+    /// Predecessors of local vertex `v`.
+    pub fn predecessors(&self, v: u32) -> &[u32] {
+        &self.pred[self.pred_off[v as usize] as usize..self.pred_off[v as usize + 1] as usize]
     }
 
     /// Whether G-local `t` is covered (has a fragment).
@@ -197,6 +206,7 @@ pub(crate) fn frame_graph(
     }
     kept.dedup();
     let (off, succ) = csr(nodes.len(), kept.iter().copied());
+    let (pred_off, pred) = csr(nodes.len(), kept.iter().map(|&(a, b)| (b, a)));
     let topo = topological_order(&off, &succ).expect("cycle breaking leaves an acyclic graph");
     Ok(FrameGraph {
         visible,
@@ -204,6 +214,8 @@ pub(crate) fn frame_graph(
         nodes,
         off,
         succ,
+        pred_off,
+        pred,
         topo,
         removed,
     })
