@@ -72,7 +72,7 @@ pub fn run(a: BakeArgs) -> Result<ExitCode> {
         bake(&gpu, &scene, &timeline, &a.record, &a.merge, &a.output)?;
     if a.json {
         let mut v = recording_json(&rec, Some(record_s));
-        let m = baked_json(&baked);
+        let m = baked_json(&baked, merge_s);
         for (k, val) in m.as_object().expect("object") {
             v[k] = val.clone();
         }
@@ -89,7 +89,7 @@ pub fn run(a: BakeArgs) -> Result<ExitCode> {
             rec.unique_visible.len(),
             rec.scene_triangles
         );
-        print_summary(&baked);
+        print_summary(&baked, merge_s);
         println!(
             "wrote {} (recording: {})",
             a.output.display(),
