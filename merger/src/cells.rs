@@ -161,8 +161,8 @@ pub(crate) struct CellEdge {
 
 /// For every frame of `frames`, the constraint edges inside every tracked cell: for drawn
 /// a, b in the same cell with b reachable from a in E_f* through undrawn triangles, the path
-/// (through undrawn vertices, one per triangle and frame). `cell_of[k]` is copy k's tracked
-/// cell or [`NONE`]. Paths through drawn triangles of other cells are not followed: when no
+/// (through undrawn vertices, one per triangle and frame; undrawn vertices that lead back to
+/// no copy of the cell are left out). `cell_of[k]` is copy k's tracked cell or [`NONE`]. Paths through drawn triangles of other cells are not followed: when no
 /// inter-cell conflict is left they cannot return to the cell (its key would have to both
 /// rise and fall). Sorted by cell, deterministic.
 pub(crate) fn cell_edges(
@@ -190,47 +190,76 @@ pub(crate) fn cell_edges(
                 .collect();
             groups.sort_unstable();
             let mut out = Vec::new();
+            // Per vertex: the last cell whose search reached it (undrawn), and the last cell
+            // it leads back to (undrawn vertices on a path between two of the cell's copies).
             let mut stamp = vec![NONE; n];
+            let mut useful = vec![NONE; n];
+            let mut pos = vec![0u32; n];
+            for (p, &v) in fg.topo.iter().enumerate() {
+                pos[v as usize] = p as u32;
+            }
             let mut stack: Vec<u32> = Vec::new();
+            let mut reached: Vec<u32> = Vec::new();
+            let mut pairs: Vec<(u32, u32)> = Vec::new();
             for group in groups.chunk_by(|a, b| a.0 == b.0) {
                 let c = group[0].0;
-                let mut visit =
-                    |from: NodeRef, v: u32, stack: &mut Vec<u32>, out: &mut Vec<CellEdge>| {
-                        for &w in fg.successors(v) {
-                            let wu = w as usize;
-                            if cop[wu] != NONE {
-                                if cell(wu) == c {
-                                    out.push(CellEdge {
-                                        cell: c,
-                                        from,
-                                        to: NodeRef::copy(cop[wu]),
-                                        frame: f,
-                                    });
-                                }
-                            } else {
-                                out.push(CellEdge {
-                                    cell: c,
-                                    from,
-                                    to: NodeRef::undrawn(fg.nodes[wu], f),
-                                    frame: f,
-                                });
-                                if stamp[wu] != c {
-                                    stamp[wu] = c;
-                                    stack.push(w);
-                                }
+                reached.clear();
+                pairs.clear();
+                let mut visit = |v: u32, stack: &mut Vec<u32>| {
+                    for &w in fg.successors(v) {
+                        let wu = w as usize;
+                        if cop[wu] != NONE {
+                            if cell(wu) == c {
+                                pairs.push((v, w));
+                            }
+                        } else {
+                            pairs.push((v, w));
+                            if stamp[wu] != c {
+                                stamp[wu] = c;
+                                stack.push(w);
+                                reached.push(w);
                             }
                         }
-                    };
+                    }
+                };
                 for &(_, v) in group {
-                    visit(NodeRef::copy(cop[v as usize]), v, &mut stack, &mut out);
+                    visit(v, &mut stack);
                 }
                 while let Some(h) = stack.pop() {
-                    visit(
-                        NodeRef::undrawn(fg.nodes[h as usize], f),
-                        h,
-                        &mut stack,
-                        &mut out,
-                    );
+                    visit(h, &mut stack);
+                }
+                // Keep only undrawn vertices that lead back to the cell: the others end
+                // outside it and constrain nothing in it (latest in topological order first).
+                reached.sort_unstable_by_key(|&h| std::cmp::Reverse(pos[h as usize]));
+                for &h in &reached {
+                    let back = fg.successors(h).iter().any(|&w| {
+                        let wu = w as usize;
+                        if cop[wu] != NONE {
+                            cell(wu) == c
+                        } else {
+                            useful[wu] == c
+                        }
+                    });
+                    if back {
+                        useful[h as usize] = c;
+                    }
+                }
+                let node = |v: u32| {
+                    if cop[v as usize] != NONE {
+                        NodeRef::copy(cop[v as usize])
+                    } else {
+                        NodeRef::undrawn(fg.nodes[v as usize], f)
+                    }
+                };
+                for &(v, w) in &pairs {
+                    if cop[w as usize] != NONE || useful[w as usize] == c {
+                        out.push(CellEdge {
+                            cell: c,
+                            from: node(v),
+                            to: node(w),
+                            frame: f,
+                        });
+                    }
                 }
             }
             out
