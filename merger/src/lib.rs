@@ -68,7 +68,7 @@ const LEADERS: usize = 2;
 
 /// `auto` abandons a combination once its copies, before adjacent copies are joined, exceed
 /// this multiple (numerator, denominator) of the leaders' best final count. Splitting only
-/// adds copies and joining removed at most 10 % of them on the demo car, CarConcept and the
+/// adds copies and joining removed at most 15 % of them on the demo car, CarConcept and the
 /// synthetic turntables, so the bound discards only combinations that end up worse.
 const PRUNE_FACTOR: (u64, u64) = (3, 2);
 
