@@ -1,9 +1,8 @@
 //! Bad input for every reader, through the real binary: glTF scenes, TOML paths, Recording and
 //! Baked files (truncated, wrong magic or version, checksum mismatch, header sizes that would
 //! allocate gigabytes, forged lengths inside the payload, NaN and infinities, broken
-//! structure) and mismatched recordings given to one merge. Each must end with exit 1 (or 3
-//! where `verify` reports a malformed file as a failed verification), a message naming the
-//! file and the problem, no panic, and no file left behind: no output, no temporary file, no
+//! structure) and mismatched recordings given to one merge. Each must end with exit 1, a
+//! message naming the file and the problem, no panic, and no file left behind: no output, no temporary file, no
 //! partial folder.
 
 mod support;
@@ -448,11 +447,12 @@ fn malformed_baked_files_are_named_not_played() {
         let file = format!("{name}.baked");
         trisort_format::write_file_atomic(FileKind::Baked, &d.join(&file), &b).unwrap();
         fails(d, &["inspect", &file], &[1], &file, problem);
-        // verify reports a malformed file as a failed verification (exit 3).
+        // A malformed file is an error (exit 1), not a failed verification (exit 3): verify
+        // checks the structure before it verifies anything.
         fails(
             d,
             &["verify", &file, "--recording", "good.rec"],
-            &[1, 3],
+            &[1],
             &file,
             problem,
         );
