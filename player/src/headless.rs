@@ -10,6 +10,7 @@ use trisort_shaders::gpu::Gpu;
 use crate::config::{DrawPath, Mode, PlayerConfig};
 use crate::error::PlayerError;
 use crate::player::{block_on_ready, Player};
+use crate::target::{clear_colour, FrameTarget};
 
 /// The background every headless frame is drawn over: a dark grey, linear RGB.
 pub const BACKGROUND: [f32; 3] = [0.03, 0.03, 0.03];
@@ -98,13 +99,7 @@ pub struct HeadlessRenderer<'g> {
     gpu: &'g Gpu,
     player: Player,
     mode: Mode,
-    size: (u32, u32),
-    msaa_view: Option<wgpu::TextureView>,
-    target: wgpu::Texture,
-    target_view: wgpu::TextureView,
-    depth_view: Option<wgpu::TextureView>,
-    row_bytes: u32,
-    staging: wgpu::Buffer,
+    target: FrameTarget,
     timer: Option<Timer>,
 }
 
@@ -118,16 +113,16 @@ impl<'g> HeadlessRenderer<'g> {
     ) -> Result<HeadlessRenderer<'g>, PlayerError> {
         let (w, h) = (config.size.0.max(1), config.size.1.max(1));
         let samples = config.samples.max(1);
-        let mut formats = vec![COLOR_FORMAT];
-        if config.mode == Mode::Depth {
-            formats.push(DEPTH_FORMAT);
-        }
-        for format in formats {
-            let flags = gpu.adapter.get_texture_format_features(format).flags;
-            if !flags.sample_count_supported(samples) {
-                return Err(PlayerError::SampleCount { format, samples });
-            }
-        }
+        // Before the player: a sample count the adapter lacks is the clearer error.
+        let target = FrameTarget::new(
+            &gpu.adapter,
+            &gpu.device,
+            (w, h),
+            samples,
+            COLOR_FORMAT,
+            config.mode == Mode::Depth,
+            true,
+        )?;
         let player_config = PlayerConfig {
             color_format: COLOR_FORMAT,
             depth_format: (config.mode == Mode::Depth).then_some(DEPTH_FORMAT),
@@ -148,56 +143,6 @@ impl<'g> HeadlessRenderer<'g> {
 
         let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let extent = wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        };
-        let texture = |label, format, sample_count, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: extent,
-                mip_level_count: 1,
-                sample_count,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let target = texture(
-            "trisort frame",
-            COLOR_FORMAT,
-            1,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        );
-        let target_view = target.create_view(&Default::default());
-        let msaa_view = (samples > 1).then(|| {
-            texture(
-                "trisort frame (MSAA)",
-                COLOR_FORMAT,
-                samples,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            )
-            .create_view(&Default::default())
-        });
-        let depth_view = (config.mode == Mode::Depth).then(|| {
-            texture(
-                "trisort depth",
-                DEPTH_FORMAT,
-                samples,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            )
-            .create_view(&Default::default())
-        });
-        let row_bytes = (w * 8).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("trisort frame readback"),
-            size: row_bytes as u64 * h as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let timer = device
             .features()
             .contains(wgpu::Features::TIMESTAMP_QUERY)
@@ -228,13 +173,7 @@ impl<'g> HeadlessRenderer<'g> {
             gpu,
             player,
             mode: config.mode,
-            size: (w, h),
-            msaa_view,
             target,
-            target_view,
-            depth_view,
-            row_bytes,
-            staging,
             timer,
         })
     }
@@ -248,55 +187,21 @@ impl<'g> HeadlessRenderer<'g> {
     pub fn render(&self, frame: u32) -> Result<RenderedFrame, PlayerError> {
         let device = &self.gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let clear = match self.mode {
-            // The background is composited under the accumulated colour after the pass.
-            Mode::Saturate => wgpu::Color::TRANSPARENT,
-            Mode::Blend | Mode::Depth => wgpu::Color {
-                r: BACKGROUND[0] as f64,
-                g: BACKGROUND[1] as f64,
-                b: BACKGROUND[2] as f64,
-                a: 1.0,
-            },
-        };
-        let (view, resolve_target, store) = match &self.msaa_view {
-            Some(msaa) => (msaa, Some(&self.target_view), wgpu::StoreOp::Discard),
-            None => (&self.target_view, None, wgpu::StoreOp::Store),
-        };
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("trisort frame"),
         });
         let drawn = {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("trisort frame"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(clear),
-                        store,
-                    },
-                })],
-                depth_stencil_attachment: self.depth_view.as_ref().map(|view| {
-                    wgpu::RenderPassDepthStencilAttachment {
-                        view,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Discard,
-                        }),
-                        stencil_ops: None,
-                    }
-                }),
-                timestamp_writes: self
-                    .timer
-                    .as_ref()
-                    .map(|t| wgpu::RenderPassTimestampWrites {
-                        query_set: &t.set,
-                        beginning_of_pass_write_index: Some(0),
-                        end_of_pass_write_index: Some(1),
-                    }),
-                ..Default::default()
-            });
+            let timestamps = self
+                .timer
+                .as_ref()
+                .map(|t| wgpu::RenderPassTimestampWrites {
+                    query_set: &t.set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                });
+            let mut pass = self
+                .target
+                .begin_pass(&mut enc, clear_colour(self.mode), timestamps);
             self.player.draw(&mut pass, frame)
         };
         if let Err(e) = drawn {
@@ -308,37 +213,23 @@ impl<'g> HeadlessRenderer<'g> {
             enc.resolve_query_set(&t.set, 0..2, &t.resolve, 0);
             enc.copy_buffer_to_buffer(&t.resolve, 0, &t.staging, 0, 16);
         }
-        let (w, h) = self.size;
-        enc.copy_texture_to_buffer(
-            self.target.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &self.staging,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(self.row_bytes),
-                    rows_per_image: Some(h),
-                },
-            },
-            self.target.size(),
-        );
+        self.target.copy_to_staging(&mut enc);
         self.gpu.queue.submit([enc.finish()]);
         if let Some(Some(e)) = block_on_ready(scope.pop()) {
             return Err(PlayerError::Wgpu(e.to_string()));
         }
 
-        let mut buffers = vec![&self.staging];
+        let mut buffers = vec![self.target.staging().expect("created with readback")];
         if let Some(t) = &self.timer {
             buffers.push(&t.staging);
         }
         let bytes = map_read_all(device, &buffers)?;
-        let mut halves = Vec::with_capacity((w * h * 4) as usize);
-        for y in 0..h as usize {
-            let row = &bytes[0][y * self.row_bytes as usize..][..(w * 8) as usize];
-            halves.extend(
-                row.chunks_exact(2)
-                    .map(|b| u16::from_le_bytes([b[0], b[1]])),
-            );
-        }
+        let halves: Vec<u16> = self
+            .target
+            .unpad(&bytes[0])
+            .chunks_exact(2)
+            .map(|b| u16::from_le_bytes([b[0], b[1]]))
+            .collect();
         let under = (self.mode == Mode::Saturate).then_some(BACKGROUND);
         let rgba8 = quantize_rgba16f(&halves, under);
         let gpu_ms = self.timer.as_ref().and_then(|t| {

@@ -30,6 +30,7 @@ pub mod draw_calls;
 mod error;
 pub mod headless;
 mod player;
+pub mod target;
 
 pub use config::{playback_warnings, DrawPath, Mode, ParseModeError, PlayerConfig};
 pub use draw_calls::{Call, CallLog, DrawCalls};
@@ -38,6 +39,7 @@ pub use headless::{
     quantize_rgba16f, render_frames, HeadlessConfig, HeadlessRenderer, RenderedFrame, BACKGROUND,
 };
 pub use player::{blend_state, fragment_entry_point, open_baked, Player};
+pub use target::{clear_colour, FrameTarget};
 
 /// Instance flags with wgpu's indirect-call validation (`VALIDATION_INDIRECT_CALL`) switched
 /// on or off, the other flags as wgpu chooses them (build type and `WGPU_*` environment).

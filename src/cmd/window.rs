@@ -28,7 +28,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use serde_json::json;
 use trisort_format::Baked;
 use trisort_player::headless::{COLOR_FORMAT, DEPTH_FORMAT};
-use trisort_player::{Mode, Player, PlayerConfig, BACKGROUND};
+use trisort_player::{clear_colour, FrameTarget, Mode, Player, PlayerConfig, BACKGROUND};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, KeyEvent, MouseButton, WindowEvent};
@@ -215,9 +215,7 @@ struct Gfx {
 struct Targets {
     size: (u32, u32),
     player: Player,
-    msaa: Option<wgpu::TextureView>,
-    resolved: wgpu::TextureView,
-    depth: Option<wgpu::TextureView>,
+    frame: FrameTarget,
     blit_group: wgpu::BindGroup,
 }
 
@@ -621,43 +619,8 @@ impl Viewer {
                 label: Some("trisort window frame"),
             });
         {
-            let clear = match self.mode {
-                // The background goes under the accumulated colour in the blit.
-                Mode::Saturate => wgpu::Color::TRANSPARENT,
-                Mode::Blend | Mode::Depth => wgpu::Color {
-                    r: BACKGROUND[0] as f64,
-                    g: BACKGROUND[1] as f64,
-                    b: BACKGROUND[2] as f64,
-                    a: 1.0,
-                },
-            };
-            let (view, resolve_target, store) = match &t.msaa {
-                Some(msaa) => (msaa, Some(&t.resolved), wgpu::StoreOp::Discard),
-                None => (&t.resolved, None, wgpu::StoreOp::Store),
-            };
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("trisort player"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(clear),
-                        store,
-                    },
-                })],
-                depth_stencil_attachment: t.depth.as_ref().map(|view| {
-                    wgpu::RenderPassDepthStencilAttachment {
-                        view,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Discard,
-                        }),
-                        stencil_ops: None,
-                    }
-                }),
-                ..Default::default()
-            });
+            // In saturate mode the background goes under the accumulated colour in the blit.
+            let mut pass = t.frame.begin_pass(&mut enc, clear_colour(self.mode), None);
             t.player.draw(&mut pass, self.frame)?;
         }
         {
@@ -717,12 +680,16 @@ impl Targets {
         glass_opacity: Option<f32>,
     ) -> Result<Targets> {
         let depth_format = (mode == Mode::Depth).then_some(DEPTH_FORMAT);
-        for format in std::iter::once(COLOR_FORMAT).chain(depth_format) {
-            let flags = adapter.get_texture_format_features(format).flags;
-            if !flags.sample_count_supported(samples) {
-                bail!("{format:?} does not support {samples}x multisampling on this adapter (--samples)");
-            }
-        }
+        let frame = FrameTarget::new(
+            adapter,
+            device,
+            size,
+            samples,
+            COLOR_FORMAT,
+            depth_format.is_some(),
+            false,
+        )
+        .map_err(|e| anyhow::anyhow!("{e} (--samples)"))?;
         let config = PlayerConfig {
             depth_format,
             sample_count: samples,
@@ -733,52 +700,12 @@ impl Targets {
         };
         let player = Player::new(device, queue, baked, config)?;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let texture = |label, format, sample_count, usage| {
-            device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d {
-                        width: size.0,
-                        height: size.1,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
-        };
-        let resolved = texture(
-            "trisort window frame",
-            COLOR_FORMAT,
-            1,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
-        let msaa = (samples > 1).then(|| {
-            texture(
-                "trisort window frame (MSAA)",
-                COLOR_FORMAT,
-                samples,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            )
-        });
-        let depth = depth_format.map(|format| {
-            texture(
-                "trisort window depth",
-                format,
-                samples,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            )
-        });
         let blit_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("trisort window blit"),
             layout: blit_layout,
             entries: &[wgpu::BindGroupEntry {
                 binding: 0,
-                resource: wgpu::BindingResource::TextureView(&resolved),
+                resource: wgpu::BindingResource::TextureView(frame.resolved_view()),
             }],
         });
         if let Some(e) = pollster::block_on(scope.pop()) {
@@ -787,9 +714,7 @@ impl Targets {
         Ok(Targets {
             size,
             player,
-            msaa,
-            resolved,
-            depth,
+            frame,
             blit_group,
         })
     }

@@ -1,0 +1,202 @@
+//! The offscreen frame target shared by every renderer that draws like the player: the
+//! headless player, the exact reference, the 8-bit deployment player and the window viewer.
+//! A colour attachment (multisampled and resolved to one sample by the render pass when
+//! `samples > 1`), an optional depth attachment, and an optional staging buffer to read the
+//! resolved frame back.
+
+use crate::config::Mode;
+use crate::error::PlayerError;
+use crate::headless::{BACKGROUND, DEPTH_FORMAT};
+
+/// The clear colour of a mode's target: the background with alpha 1 for `blend` and `depth`;
+/// transparent for `saturate`, whose background goes under the accumulated colour at the end.
+pub fn clear_colour(mode: Mode) -> wgpu::Color {
+    match mode {
+        Mode::Saturate => wgpu::Color::TRANSPARENT,
+        Mode::Blend | Mode::Depth => wgpu::Color {
+            r: BACKGROUND[0] as f64,
+            g: BACKGROUND[1] as f64,
+            b: BACKGROUND[2] as f64,
+            a: 1.0,
+        },
+    }
+}
+
+/// Colour (and optional depth) attachments at one size, sample count and format.
+pub struct FrameTarget {
+    size: (u32, u32),
+    bytes_per_pixel: u32,
+    msaa: Option<wgpu::TextureView>,
+    resolved: wgpu::Texture,
+    resolved_view: wgpu::TextureView,
+    depth: Option<wgpu::TextureView>,
+    row_bytes: u32,
+    staging: Option<wgpu::Buffer>,
+}
+
+impl FrameTarget {
+    /// Creates the attachments (`Depth32Float` when `depth`), and a staging buffer when
+    /// `readback`. The resolved texture can also be sampled (`TEXTURE_BINDING`). Errors where
+    /// the adapter cannot multisample `format` or the depth format at `samples`, or where
+    /// `format` has no fixed texel size.
+    pub fn new(
+        adapter: &wgpu::Adapter,
+        device: &wgpu::Device,
+        size: (u32, u32),
+        samples: u32,
+        format: wgpu::TextureFormat,
+        depth: bool,
+        readback: bool,
+    ) -> Result<FrameTarget, PlayerError> {
+        let size = (size.0.max(1), size.1.max(1));
+        let samples = samples.max(1);
+        for f in std::iter::once(format).chain(depth.then_some(DEPTH_FORMAT)) {
+            if !adapter
+                .get_texture_format_features(f)
+                .flags
+                .sample_count_supported(samples)
+            {
+                return Err(PlayerError::SampleCount { format: f, samples });
+            }
+        }
+        let bytes_per_pixel = format.block_copy_size(None).ok_or_else(|| {
+            PlayerError::Wgpu(format!("{format:?} has no fixed texel size to read back"))
+        })?;
+        let texture = |label, format, sample_count, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let resolved = texture(
+            "trisort frame",
+            format,
+            1,
+            attachment | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let resolved_view = resolved.create_view(&Default::default());
+        let msaa = (samples > 1).then(|| {
+            texture("trisort frame (MSAA)", format, samples, attachment)
+                .create_view(&Default::default())
+        });
+        let depth = depth.then(|| {
+            texture("trisort depth", DEPTH_FORMAT, samples, attachment)
+                .create_view(&Default::default())
+        });
+        let row_bytes = (size.0 * bytes_per_pixel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let staging = readback.then(|| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("trisort frame readback"),
+                size: row_bytes as u64 * size.1 as u64,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        });
+        Ok(FrameTarget {
+            size,
+            bytes_per_pixel,
+            msaa,
+            resolved,
+            resolved_view,
+            depth,
+            row_bytes,
+            staging,
+        })
+    }
+
+    /// The size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// The resolved single-sample colour view (for sampling it, e.g. a blit to a surface).
+    pub fn resolved_view(&self) -> &wgpu::TextureView {
+        &self.resolved_view
+    }
+
+    /// Begins the frame's render pass: colour cleared to `clear` (resolved at the end when
+    /// multisampled), depth cleared to 1 and discarded, with optional timestamp writes.
+    pub fn begin_pass<'e>(
+        &self,
+        enc: &'e mut wgpu::CommandEncoder,
+        clear: wgpu::Color,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) -> wgpu::RenderPass<'e> {
+        let (view, resolve_target, store) = match &self.msaa {
+            Some(msaa) => (msaa, Some(&self.resolved_view), wgpu::StoreOp::Discard),
+            None => (&self.resolved_view, None, wgpu::StoreOp::Store),
+        };
+        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("trisort frame"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store,
+                },
+            })],
+            depth_stencil_attachment: self.depth.as_ref().map(|view| {
+                wgpu::RenderPassDepthStencilAttachment {
+                    view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }
+            }),
+            timestamp_writes,
+            ..Default::default()
+        })
+    }
+
+    /// The staging buffer (present when created with `readback`).
+    pub fn staging(&self) -> Option<&wgpu::Buffer> {
+        self.staging.as_ref()
+    }
+
+    /// Records the copy of the resolved frame into the staging buffer. Panics if the target
+    /// was created without `readback`.
+    pub fn copy_to_staging(&self, enc: &mut wgpu::CommandEncoder) {
+        let staging = self
+            .staging
+            .as_ref()
+            .expect("FrameTarget created without readback");
+        enc.copy_texture_to_buffer(
+            self.resolved.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.row_bytes),
+                    rows_per_image: Some(self.size.1),
+                },
+            },
+            self.resolved.size(),
+        );
+    }
+
+    /// The staging buffer's mapped bytes as tightly packed rows (drops the row padding).
+    pub fn unpad(&self, padded: &[u8]) -> Vec<u8> {
+        let row = (self.size.0 * self.bytes_per_pixel) as usize;
+        let mut out = Vec::with_capacity(row * self.size.1 as usize);
+        for y in 0..self.size.1 as usize {
+            out.extend_from_slice(&padded[y * self.row_bytes as usize..][..row]);
+        }
+        out
+    }
+}
