@@ -1,0 +1,596 @@
+//! SVG charts of benchmark figures (plotters' SVG backend).
+//!
+//! Text is written as SVG `<text>` elements and laid out with plotters' built-in crude
+//! estimate of text width (no `ttf`/`ab_glyph`, so no font files and no system font
+//! libraries); the viewer picks the actual `sans-serif` font. The legend sits in a column
+//! of its own to the right of the plot, so it never hides data.
+//!
+//! Robust to degenerate input: empty series, non-finite points (skipped), a single point or
+//! all-equal values (the range is padded), and zero or negative values on a log axis
+//! (skipped, and the number of points left out is written under the chart).
+
+use std::ops::Range;
+use std::path::Path;
+
+use plotters::coord::ranged1d::{AsRangedCoord, Ranged, ValueFormatter};
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use crate::BenchError;
+
+/// One named series of (x, y) points.
+#[derive(Debug, Clone, Default)]
+pub struct Series {
+    /// Legend entry; an empty name gets no legend entry.
+    pub name: String,
+    /// The points, drawn in this order. Non-finite points are skipped.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A chart: title, axis labels and scales, series.
+#[derive(Debug, Clone, Default)]
+pub struct Chart {
+    /// Caption above the chart.
+    pub title: String,
+    /// Label of the horizontal axis.
+    pub x_label: String,
+    /// Label of the vertical axis.
+    pub y_label: String,
+    /// Logarithmic horizontal axis (points with x ≤ 0 are left out).
+    pub log_x: bool,
+    /// Logarithmic vertical axis (points with y ≤ 0 are left out).
+    pub log_y: bool,
+    /// The series, one colour and marker shape each.
+    pub series: Vec<Series>,
+}
+
+/// How series are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Style {
+    /// Lines through the points, with a marker at every point.
+    Lines,
+    /// Markers only (scatter).
+    Points,
+}
+
+/// Width and height of the SVG in pixels.
+const SIZE: (u32, u32) = (960, 600);
+
+/// Colours (Tableau 10), picked by series index.
+const COLOURS: [(u8, u8, u8); 10] = [
+    (31, 119, 180),
+    (255, 127, 14),
+    (44, 160, 44),
+    (214, 39, 40),
+    (148, 103, 189),
+    (140, 86, 75),
+    (227, 119, 194),
+    (127, 127, 127),
+    (188, 189, 34),
+    (23, 190, 207),
+];
+
+/// Number of distinct marker shapes; with 10 colours, 40 series are distinguishable.
+const SHAPES: usize = 4;
+
+fn colour(index: usize) -> RGBColor {
+    let (r, g, b) = COLOURS[index % COLOURS.len()];
+    RGBColor(r, g, b)
+}
+
+fn shape(index: usize) -> usize {
+    (index / COLOURS.len()) % SHAPES
+}
+
+/// Writes `chart` as an SVG file atomically (temp file + rename); errors name the file.
+pub fn write_svg(path: &Path, chart: &Chart, style: Style) -> Result<(), BenchError> {
+    let svg = render_svg(chart, style)
+        .map_err(|e| BenchError::Invalid(format!("{}: plotting failed: {e}", path.display())))?;
+    write_atomic(path, svg.as_bytes())
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory and a rename,
+/// so that a reader never sees a partial file.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), BenchError> {
+    let io = |source| BenchError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| BenchError::Invalid(format!("{}: not a file name", path.display())))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(name);
+    tmp_name.push(format!(".tmp{}", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    if let Err(e) = std::fs::write(&tmp, bytes) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io(e));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io(e)
+    })
+}
+
+/// The points of one series that can be drawn on the chart's axes.
+fn drawable(points: &[(f64, f64)], log_x: bool, log_y: bool) -> (Vec<(f64, f64)>, usize) {
+    let mut left_out_log = 0;
+    let kept = points
+        .iter()
+        .copied()
+        .filter(|&(x, y)| {
+            if !x.is_finite() || !y.is_finite() {
+                return false;
+            }
+            if (log_x && x <= 0.0) || (log_y && y <= 0.0) {
+                left_out_log += 1;
+                return false;
+            }
+            true
+        })
+        .collect();
+    (kept, left_out_log)
+}
+
+/// A padded linear range covering `values` (finite).
+fn linear_range(values: impl Iterator<Item = f64>) -> Range<f64> {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    if lo > hi {
+        return 0.0..1.0;
+    }
+    let span = hi - lo;
+    let scale = lo.abs().max(hi.abs());
+    if span <= scale * 1e-9 || !span.is_finite() {
+        let pad = if scale > 0.0 { scale * 0.1 } else { 1.0 };
+        return (lo - pad)..(hi + pad);
+    }
+    let pad = span * 0.05;
+    let (lo2, hi2) = (lo - pad, hi + pad);
+    // Keep a non-negative quantity's axis from starting just below zero.
+    let lo2 = if lo >= 0.0 && lo2 < 0.0 { 0.0 } else { lo2 };
+    if lo2.is_finite() && hi2.is_finite() {
+        lo2..hi2
+    } else {
+        lo..hi
+    }
+}
+
+/// A log range covering `values` (finite, positive), widened to whole decades so that
+/// plotters always finds tick marks.
+fn log_range(values: impl Iterator<Item = f64>) -> Range<f64> {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    if lo > hi {
+        return 1.0..10.0;
+    }
+    let lo_exp = lo.log10().floor().clamp(-300.0, 299.0);
+    let mut hi_exp = hi.log10().ceil().clamp(-299.0, 300.0);
+    if hi_exp <= lo_exp {
+        hi_exp = lo_exp + 1.0;
+    }
+    10f64.powf(lo_exp)..10f64.powf(hi_exp)
+}
+
+/// A short tick label: at most 4 significant digits, exponent form for very large or small.
+pub fn format_number(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    let a = v.abs();
+    if !(1e-3..1e6).contains(&a) {
+        let s = format!("{v:.2e}");
+        // 1.00e6 -> 1e6, 2.50e-4 -> 2.5e-4
+        if let Some((m, e)) = s.split_once('e') {
+            let m = m.trim_end_matches('0').trim_end_matches('.');
+            return format!("{m}e{e}");
+        }
+        return s;
+    }
+    let decimals = (3 - a.log10().floor() as i32).clamp(0, 6) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Renders the chart to an SVG string.
+fn render_svg(chart: &Chart, style: Style) -> Result<String, String> {
+    let mut left_out = 0;
+    let series: Vec<Series3<'_>> = chart
+        .series
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let (pts, n) = drawable(&s.points, chart.log_x, chart.log_y);
+            left_out += n;
+            (i, s.name.as_str(), pts)
+        })
+        .collect();
+    let xs = || series.iter().flat_map(|s| s.2.iter().map(|p| p.0));
+    let ys = || series.iter().flat_map(|s| s.2.iter().map(|p| p.1));
+    let note = (left_out > 0).then(|| {
+        format!(
+            "{left_out} point{} with a value ≤ 0 not shown on the log axis",
+            if left_out == 1 { "" } else { "s" }
+        )
+    });
+
+    let x_lin = linear_range(xs());
+    let y_lin = linear_range(ys());
+    let x_log = log_range(xs());
+    let y_log = log_range(ys());
+    let mut svg = String::new();
+    match (chart.log_x, chart.log_y) {
+        (false, false) => draw(&mut svg, chart, style, &series, note, x_lin, y_lin)?,
+        (true, false) => draw(
+            &mut svg,
+            chart,
+            style,
+            &series,
+            note,
+            x_log.log_scale(),
+            y_lin,
+        )?,
+        (false, true) => draw(
+            &mut svg,
+            chart,
+            style,
+            &series,
+            note,
+            x_lin,
+            y_log.log_scale(),
+        )?,
+        (true, true) => draw(
+            &mut svg,
+            chart,
+            style,
+            &series,
+            note,
+            x_log.log_scale(),
+            y_log.log_scale(),
+        )?,
+    }
+    Ok(svg)
+}
+
+/// A series ready to draw: index (colour, shape), name, drawable points.
+type Series3<'s> = (usize, &'s str, Vec<(f64, f64)>);
+
+fn draw<X, Y>(
+    svg: &mut String,
+    chart: &Chart,
+    style: Style,
+    series: &[Series3<'_>],
+    note: Option<String>,
+    x: X,
+    y: Y,
+) -> Result<(), String>
+where
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let e = |e: &dyn std::fmt::Display| e.to_string();
+    let root = SVGBackend::with_string(svg, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    // Own text is anchored at its baseline (VPos::Bottom), so that it stays inside the
+    // image also in renderers that ignore SVG's `dy` (ImageMagick's built-in one does).
+    let (header, root) = root.split_vertically(40);
+    header
+        .draw_text(
+            &chart.title,
+            &("sans-serif", 22)
+                .into_font()
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Center, VPos::Bottom)),
+            (SIZE.0 as i32 / 2, 30),
+        )
+        .map_err(|x| e(&x))?;
+    let (root, footer) = match &note {
+        Some(_) => root.split_vertically(root.dim_in_pixel().1 as i32 - 24),
+        None => root.split_vertically(root.dim_in_pixel().1 as i32),
+    };
+    if let Some(note) = &note {
+        footer
+            .draw_text(
+                note,
+                &("sans-serif", 14)
+                    .into_font()
+                    .color(&BLACK)
+                    .pos(Pos::new(HPos::Left, VPos::Bottom)),
+                (90, 18),
+            )
+            .map_err(|x| e(&x))?;
+    }
+    let names: Vec<&Series3<'_>> = series.iter().filter(|s| !s.1.is_empty()).collect();
+    // Legend column: wide enough for the longest name at 14 px (≈ 7.5 px a character).
+    let legend_w = if names.is_empty() {
+        0
+    } else {
+        let longest = names.iter().map(|s| s.1.chars().count()).max().unwrap_or(0);
+        (40 + longest as i32 * 15 / 2).clamp(100, 320)
+    };
+    let (plot_area, legend) = root.split_horizontally(root.dim_in_pixel().0 as i32 - legend_w);
+
+    let mut ctx = ChartBuilder::on(&plot_area)
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(78)
+        .build_cartesian_2d(x, y)
+        .map_err(|x| e(&x))?;
+    ctx.configure_mesh()
+        .x_desc(chart.x_label.as_str())
+        .y_desc(chart.y_label.as_str())
+        .x_label_formatter(&|v| format_number(*v))
+        .y_label_formatter(&|v| format_number(*v))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(200, 200, 200))
+        .draw()
+        .map_err(|x| e(&x))?;
+
+    for (i, _, pts) in series {
+        let c = colour(*i);
+        if style == Style::Lines && pts.len() > 1 {
+            ctx.draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
+                .map_err(|x| e(&x))?;
+        }
+        draw_markers(&mut ctx, *i, pts).map_err(|x| e(&x))?;
+    }
+
+    // Legend: one row per named series.
+    for (row, (i, name, _)) in names.iter().map(|s| (s.0, s.1, &s.2)).enumerate() {
+        let y = 40 + row as i32 * 22;
+        let c = colour(i);
+        if style == Style::Lines {
+            legend
+                .draw(&PathElement::new(vec![(4, y), (28, y)], c.stroke_width(2)))
+                .map_err(|x| e(&x))?;
+        }
+        legend_marker(&legend, i, (16, y)).map_err(|x| e(&x))?;
+        legend
+            .draw_text(
+                name,
+                &("sans-serif", 14)
+                    .into_font()
+                    .color(&BLACK)
+                    .pos(Pos::new(HPos::Left, VPos::Center)),
+                (36, y),
+            )
+            .map_err(|x| e(&x))?;
+    }
+    root.present().map_err(|x| e(&x))?;
+    Ok(())
+}
+
+fn marker_style(index: usize) -> ShapeStyle {
+    let c = colour(index);
+    match shape(index) {
+        0 => c.filled(),
+        1 => c.stroke_width(2),
+        2 => c.filled(),
+        _ => c.stroke_width(2),
+    }
+}
+
+/// Markers at data points: filled circle, open circle, filled triangle, cross.
+fn draw_markers<DB, X, Y>(
+    ctx: &mut ChartContext<'_, DB, plotters::coord::cartesian::Cartesian2d<X, Y>>,
+    index: usize,
+    pts: &[(f64, f64)],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let st = marker_style(index);
+    match shape(index) {
+        0 | 1 => {
+            ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 4, st)))?;
+        }
+        2 => {
+            ctx.draw_series(pts.iter().map(|&p| TriangleMarker::new(p, 5, st)))?;
+        }
+        _ => {
+            ctx.draw_series(pts.iter().map(|&p| Cross::new(p, 4, st)))?;
+        }
+    }
+    Ok(())
+}
+
+fn legend_marker<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    index: usize,
+    at: (i32, i32),
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let st = marker_style(index);
+    match shape(index) {
+        0 | 1 => area.draw(&Circle::new(at, 4, st)),
+        2 => area.draw(&TriangleMarker::new(at, 5, st)),
+        _ => area.draw(&Cross::new(at, 4, st)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chart(series: Vec<Series>, log_x: bool, log_y: bool) -> Chart {
+        Chart {
+            title: "Error vs bake time".into(),
+            x_label: "bake seconds".into(),
+            y_label: "pixels differing".into(),
+            log_x,
+            log_y,
+            series,
+        }
+    }
+
+    fn series(name: &str, points: &[(f64, f64)]) -> Series {
+        Series {
+            name: name.into(),
+            points: points.to_vec(),
+        }
+    }
+
+    fn write(c: &Chart, style: Style) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("chart.svg");
+        write_svg(&path, c, style).unwrap();
+        // No temporary file is left behind.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.starts_with("<svg"), "{}", &svg[..svg.len().min(200)]);
+        assert!(svg.trim_end().ends_with("</svg>"));
+        assert_balanced(&svg);
+        svg
+    }
+
+    /// Every opened tag is closed, in order (the backend writes no comments or CDATA).
+    fn assert_balanced(svg: &str) {
+        let mut stack = Vec::new();
+        let mut rest = svg;
+        while let Some(start) = rest.find('<') {
+            let end = rest[start..].find('>').expect("unterminated tag") + start;
+            let tag = &rest[start + 1..end];
+            if let Some(name) = tag.strip_prefix('/') {
+                assert_eq!(
+                    stack.pop(),
+                    Some(name.trim().to_string()),
+                    "mismatched </{name}>"
+                );
+            } else if !tag.ends_with('/') && !tag.starts_with('?') {
+                let name = tag.split_whitespace().next().unwrap().to_string();
+                stack.push(name);
+            }
+            rest = &rest[end + 1..];
+        }
+        assert!(stack.is_empty(), "unclosed tags {stack:?}");
+    }
+
+    #[test]
+    fn lines_with_title_axes_and_legend() {
+        let c = chart(
+            vec![
+                series("record size", &[(1.0, 10.0), (2.0, 4.0), (4.0, 1.0)]),
+                series("samples & <more>", &[(0.5, 3.0), (1.5, 2.0)]),
+            ],
+            false,
+            false,
+        );
+        let svg = write(&c, Style::Lines);
+        for text in ["Error vs bake time", "bake seconds", "pixels differing"] {
+            assert!(svg.contains(text), "missing {text}");
+        }
+        assert!(svg.contains("record size"));
+        assert!(svg.contains("samples &amp; &lt;more&gt;"));
+        assert!(svg.contains("<polyline") || svg.contains("<path"));
+        assert!(svg.contains("<circle"));
+    }
+
+    #[test]
+    fn degenerate_inputs_do_not_panic() {
+        let nan = f64::NAN;
+        let inf = f64::INFINITY;
+        let cases = vec![
+            vec![],
+            vec![series("empty", &[])],
+            vec![series("one", &[(3.0, 7.0)])],
+            vec![series("equal", &[(2.0, 2.0), (2.0, 2.0), (2.0, 2.0)])],
+            vec![series("zeros", &[(0.0, 0.0), (0.0, 0.0)])],
+            vec![series("non-finite", &[(nan, 1.0), (1.0, inf), (-inf, nan)])],
+            vec![series(
+                "mixed",
+                &[(nan, 1.0), (1.0, 2.0), (2.0, inf), (3.0, 1.0)],
+            )],
+            vec![series("huge", &[(1e300, -1e300), (-1e300, 1e300)])],
+            vec![series("tiny", &[(1e-300, 5e-324), (2e-300, 1e-320)])],
+            vec![series("", &[(1.0, 1.0), (2.0, 3.0)])],
+        ];
+        for s in cases {
+            for (lx, ly) in [(false, false), (true, false), (false, true), (true, true)] {
+                for style in [Style::Lines, Style::Points] {
+                    let c = chart(s.clone(), lx, ly);
+                    let svg = write(&c, style);
+                    assert!(svg.contains("Error vs bake time"));
+                    for s in &c.series {
+                        assert!(svg.contains(&s.name));
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn log_axes_leave_out_non_positive_values_and_say_so() {
+        let c = chart(
+            vec![series(
+                "error",
+                &[
+                    (0.0, 5.0),
+                    (1.0, 0.0),
+                    (2.0, -1.0),
+                    (10.0, 100.0),
+                    (100.0, 1000.0),
+                ],
+            )],
+            true,
+            true,
+        );
+        let svg = write(&c, Style::Points);
+        assert!(svg.contains("3 points with a value ≤ 0 not shown"), "{svg}");
+        // Decade ticks are labelled.
+        assert!(svg.contains(">\n100\n<") || svg.contains(">100<") || svg.contains("100\n"));
+        // Only the two positive points are drawn (plus the legend marker).
+        assert_eq!(svg.matches("<circle").count(), 3);
+        // A linear chart of the same data shows every point and has no note.
+        let lin = write(&chart(c.series.clone(), false, false), Style::Points);
+        assert!(!lin.contains("not shown"));
+        assert_eq!(lin.matches("<circle").count(), 6);
+    }
+
+    #[test]
+    fn many_series_get_distinct_styles() {
+        let s: Vec<Series> = (0..25)
+            .map(|i| series(&format!("s{i}"), &[(i as f64, 1.0 + i as f64)]))
+            .collect();
+        let svg = write(&chart(s, false, false), Style::Points);
+        for i in 0..25 {
+            assert!(svg.contains(&format!("s{i}")));
+        }
+        let styles: std::collections::HashSet<_> = (0..40).map(|i| (colour(i), shape(i))).collect();
+        assert_eq!(styles.len(), 40);
+    }
+
+    #[test]
+    fn errors_name_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("missing-dir").join("chart.svg");
+        let err = write_svg(&path, &chart(vec![], false, false), Style::Lines).unwrap_err();
+        assert!(err.to_string().contains("chart.svg"), "{err}");
+    }
+
+    #[test]
+    fn numbers_are_short() {
+        assert_eq!(format_number(0.0), "0");
+        assert_eq!(format_number(1.0), "1");
+        assert_eq!(format_number(0.5), "0.5");
+        assert_eq!(format_number(1234.5678), "1235");
+        assert_eq!(format_number(0.012345), "0.01235");
+        assert_eq!(format_number(2_500_000.0), "2.5e6");
+        assert_eq!(format_number(0.0001), "1e-4");
+        assert_eq!(format_number(-3.25), "-3.25");
+    }
+}
