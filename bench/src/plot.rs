@@ -84,7 +84,18 @@ fn shape(index: usize) -> usize {
 
 /// Writes `chart` as an SVG file atomically (temp file + rename); errors name the file.
 pub fn write_svg(path: &Path, chart: &Chart, style: Style) -> Result<(), BenchError> {
-    let svg = render_svg(chart, style)
+    write_svg_labelled(path, chart, style, &[])
+}
+
+/// [`write_svg`] with a short text label beside points: `labels[s][k]` labels point `k` of
+/// series `s` (missing or empty strings: no label).
+pub fn write_svg_labelled(
+    path: &Path,
+    chart: &Chart,
+    style: Style,
+    labels: &[Vec<String>],
+) -> Result<(), BenchError> {
+    let svg = render_svg(chart, style, labels)
         .map_err(|e| BenchError::Invalid(format!("{}: plotting failed: {e}", path.display())))?;
     write_atomic(path, svg.as_bytes())
 }
@@ -114,12 +125,18 @@ pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), BenchError> 
 }
 
 /// The points of one series that can be drawn on the chart's axes.
-fn drawable(points: &[(f64, f64)], log_x: bool, log_y: bool) -> (Vec<(f64, f64)>, usize) {
+fn drawable<'l>(
+    points: &[(f64, f64)],
+    labels: Option<&'l Vec<String>>,
+    log_x: bool,
+    log_y: bool,
+) -> (Vec<(f64, f64)>, Vec<&'l str>, usize) {
     let mut left_out_log = 0;
-    let kept = points
+    let (kept, kept_labels) = points
         .iter()
         .copied()
-        .filter(|&(x, y)| {
+        .enumerate()
+        .filter(|&(_, (x, y))| {
             if !x.is_finite() || !y.is_finite() {
                 return false;
             }
@@ -129,8 +146,12 @@ fn drawable(points: &[(f64, f64)], log_x: bool, log_y: bool) -> (Vec<(f64, f64)>
             }
             true
         })
-        .collect();
-    (kept, left_out_log)
+        .map(|(k, p)| {
+            let label = labels.and_then(|l| l.get(k)).map_or("", |l| l.as_str());
+            (p, label)
+        })
+        .unzip();
+    (kept, kept_labels, left_out_log)
 }
 
 /// A padded linear range covering `values` (finite).
@@ -203,16 +224,17 @@ pub fn format_number(v: f64) -> String {
 }
 
 /// Renders the chart to an SVG string.
-fn render_svg(chart: &Chart, style: Style) -> Result<String, String> {
+fn render_svg(chart: &Chart, style: Style, labels: &[Vec<String>]) -> Result<String, String> {
     let mut left_out = 0;
     let series: Vec<Series3<'_>> = chart
         .series
         .iter()
         .enumerate()
         .map(|(i, s)| {
-            let (pts, n) = drawable(&s.points, chart.log_x, chart.log_y);
+            let (pts, point_labels, n) =
+                drawable(&s.points, labels.get(i), chart.log_x, chart.log_y);
             left_out += n;
-            (i, s.name.as_str(), pts)
+            (i, s.name.as_str(), pts, point_labels)
         })
         .collect();
     let xs = || series.iter().flat_map(|s| s.2.iter().map(|p| p.0));
@@ -262,8 +284,8 @@ fn render_svg(chart: &Chart, style: Style) -> Result<String, String> {
     Ok(svg)
 }
 
-/// A series ready to draw: index (colour, shape), name, drawable points.
-type Series3<'s> = (usize, &'s str, Vec<(f64, f64)>);
+/// A series ready to draw: index (colour, shape), name, drawable points, their labels.
+type Series3<'s> = (usize, &'s str, Vec<(f64, f64)>, Vec<&'s str>);
 
 fn draw<X, Y>(
     svg: &mut String,
@@ -340,17 +362,30 @@ where
         .draw()
         .map_err(|x| e(&x))?;
 
-    for (i, _, pts) in series {
+    for (i, _, pts, point_labels) in series {
         let c = colour(*i);
         if style == Style::Lines && pts.len() > 1 {
             ctx.draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
                 .map_err(|x| e(&x))?;
         }
         draw_markers(&mut ctx, *i, pts).map_err(|x| e(&x))?;
+        let font = ("sans-serif", 12)
+            .into_font()
+            .color(&colour(*i))
+            .pos(Pos::new(HPos::Left, VPos::Bottom));
+        ctx.draw_series(
+            pts.iter()
+                .zip(point_labels)
+                .filter(|(_, l)| !l.is_empty())
+                .map(|(&p, &l)| {
+                    EmptyElement::at(p) + Text::new(l.to_string(), (6, -4), font.clone())
+                }),
+        )
+        .map_err(|x| e(&x))?;
     }
 
     // Legend: one row per named series.
-    for (row, (i, name, _)) in names.iter().map(|s| (s.0, s.1, &s.2)).enumerate() {
+    for (row, (i, name)) in names.iter().map(|s| (s.0, s.1)).enumerate() {
         let y = 40 + row as i32 * 22;
         let c = colour(i);
         if style == Style::Lines {
@@ -572,6 +607,26 @@ mod tests {
         }
         let styles: std::collections::HashSet<_> = (0..40).map(|i| (colour(i), shape(i))).collect();
         assert_eq!(styles.len(), 40);
+    }
+
+    #[test]
+    fn point_labels_are_drawn_beside_drawable_points() {
+        let c = chart(
+            vec![
+                series("size", &[(1.0, 1.0), (f64::NAN, 2.0), (3.0, 0.5)]),
+                series("other", &[(2.0, 2.0)]),
+            ],
+            false,
+            false,
+        );
+        let labels = vec![vec!["half".to_string(), "gone".into(), "double".into()]];
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("l.svg");
+        write_svg_labelled(&path, &c, Style::Points, &labels).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert_balanced(&svg);
+        assert!(svg.contains("half") && svg.contains("double"));
+        assert!(!svg.contains("gone"), "the NaN point's label is skipped");
     }
 
     #[test]
