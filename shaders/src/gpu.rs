@@ -35,6 +35,7 @@ pub struct Gpu {
 /// Features trisort uses when the adapter has them.
 pub fn wanted_features() -> wgpu::Features {
     wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+        | wgpu::Features::SHADER_EARLY_DEPTH_TEST
         | wgpu::Features::PRIMITIVE_INDEX
         | wgpu::Features::TIMESTAMP_QUERY
         | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS

@@ -1,0 +1,41 @@
+//! trisort's benchmarks (issue 7): what the speed/accuracy trade costs and buys.
+//!
+//! - [`methods`]: the renderers compared frame by frame (`default`, `source`, `merged`,
+//!   `oit`, `peeling`) behind one [`methods::Method`] trait.
+//! - [`harness`]: interleaved, repeated timing (GPU timestamps and wall time) and the
+//!   device-independent counts (triangles submitted, fragment-shader invocations, overdraw).
+#![deny(missing_docs)]
+
+pub mod harness;
+pub mod methods;
+
+/// Errors of the benchmarks.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// A reference renderer failed.
+    #[error(transparent)]
+    Reference(#[from] trisort_reference::ReferenceError),
+    /// The player failed.
+    #[error(transparent)]
+    Player(#[from] trisort_player::PlayerError),
+    /// Recording failed.
+    #[error(transparent)]
+    Record(#[from] trisort_recorder::RecordError),
+    /// Merging failed.
+    #[error(transparent)]
+    Merge(#[from] trisort_merger::MergeError),
+    /// wgpu reported an error.
+    #[error("wgpu: {0}")]
+    Wgpu(String),
+    /// Writing an output failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What failed.
+        source: std::io::Error,
+    },
+    /// The inputs do not fit together.
+    #[error("{0}")]
+    Invalid(String),
+}
