@@ -8,6 +8,7 @@
 
 pub mod harness;
 pub mod methods;
+pub mod plot;
 
 /// Errors of the benchmarks.
 #[derive(Debug, thiserror::Error)]
