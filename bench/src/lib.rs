@@ -9,6 +9,7 @@
 pub mod harness;
 pub mod methods;
 pub mod plot;
+pub mod sweep;
 
 /// Errors of the benchmarks.
 #[derive(Debug, thiserror::Error)]

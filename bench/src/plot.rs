@@ -362,24 +362,49 @@ where
         .draw()
         .map_err(|x| e(&x))?;
 
-    for (i, _, pts, point_labels) in series {
+    for (i, _, pts, _) in series {
         let c = colour(*i);
         if style == Style::Lines && pts.len() > 1 {
             ctx.draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
                 .map_err(|x| e(&x))?;
         }
         draw_markers(&mut ctx, *i, pts).map_err(|x| e(&x))?;
+    }
+    // Point labels after every series, each where it overlaps no earlier label (points that
+    // coincide would otherwise print their labels on top of each other): the first of a
+    // cluster is shown.
+    let mut taken: Vec<(i32, i32, i32, i32)> = Vec::new();
+    for (i, _, pts, point_labels) in series {
         let font = ("sans-serif", 12)
             .into_font()
             .color(&colour(*i))
             .pos(Pos::new(HPos::Left, VPos::Bottom));
+        let mut shown = Vec::new();
+        for (&p, &l) in pts.iter().zip(point_labels) {
+            if l.is_empty() {
+                continue;
+            }
+            let (px, py) = ctx.backend_coord(&p);
+            // Box of the label at (6, −4) from the point: ≈ 7 px a character, 12 px high.
+            let b = (
+                px + 5,
+                py - 17,
+                px + 7 + 7 * l.chars().count() as i32,
+                py - 3,
+            );
+            if taken
+                .iter()
+                .any(|t| b.0 < t.2 && t.0 < b.2 && b.1 < t.3 && t.1 < b.3)
+            {
+                continue;
+            }
+            taken.push(b);
+            shown.push((p, l));
+        }
         ctx.draw_series(
-            pts.iter()
-                .zip(point_labels)
-                .filter(|(_, l)| !l.is_empty())
-                .map(|(&p, &l)| {
-                    EmptyElement::at(p) + Text::new(l.to_string(), (6, -4), font.clone())
-                }),
+            shown.into_iter().map(|(p, l)| {
+                EmptyElement::at(p) + Text::new(l.to_string(), (6, -4), font.clone())
+            }),
         )
         .map_err(|x| e(&x))?;
     }
