@@ -22,6 +22,7 @@ pub mod compare;
 pub mod default_pipeline;
 pub mod deploy;
 pub mod exact;
+pub mod peeling;
 mod target;
 pub mod verify;
 
@@ -29,6 +30,7 @@ pub use compare::{compare, Comparison};
 pub use default_pipeline::DefaultRenderer;
 pub use deploy::Srgb8Player;
 pub use exact::{ExactReference, ReferenceConfig, ReferenceFrame, RemovedEdges};
+pub use peeling::{PeeledFrame, PeelingRenderer};
 pub use verify::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
 
 /// Errors of the reference renderers.

@@ -92,6 +92,45 @@ pub fn plain_shader() -> String {
     compose(&[], PLAIN)
 }
 
+/// The GPU-only depth peeling renderer's entry points (`fs_peeling`, which finds the next
+/// layer by the recorder's (depth, id) key, and `fs_peeling_composite`, which shades a layer's
+/// samples through the player's `player_colour`); compose with [`peeling_shader`].
+pub const PEELING: &str = include_str!("wgsl/peeling.wgsl");
+
+/// The complete depth peeling shader for a sample count: [`COMMON`], the player's [`PLAYER`]
+/// entry points (`vs_player`, `player_colour`) and [`PEELING`] with its texture types and
+/// per-sample loads filled in (needs `Features::PRIMITIVE_INDEX`).
+pub fn peeling_shader(samples: u32) -> String {
+    let samples = samples.max(1);
+    let (ids, depth, at, at_s) = if samples > 1 {
+        (
+            "texture_multisampled_2d<u32>",
+            "texture_depth_multisampled_2d",
+            "i32(sample)",
+            "i32(s)",
+        )
+    } else {
+        ("texture_2d<u32>", "texture_depth_2d", "0", "0")
+    };
+    let body = PEELING
+        .replace("PREV_DEPTH_TYPE", depth)
+        .replace("IDS_TYPE", ids)
+        .replace(
+            "LOAD_PREV_DEPTH",
+            &format!("textureLoad(prev_depth, coord, {at})"),
+        )
+        .replace(
+            "LOAD_PREV_ID",
+            &format!("textureLoad(prev_ids, coord, {at}).x"),
+        )
+        .replace(
+            "LOAD_LAYER_ID",
+            &format!("textureLoad(layer_ids, coord, {at_s}).x"),
+        )
+        .replace("SAMPLE_COUNT", &samples.to_string());
+    compose(&["primitive_index"], &format!("{PLAYER}\n{body}"))
+}
+
 /// Every shader of the crate by name, composed and ready to compile (used by the naga test).
 pub fn all() -> Vec<(&'static str, String)> {
     vec![
@@ -103,6 +142,8 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("gather 1x", gather_shader(1)),
         ("gather 4x", gather_shader(4)),
         ("plain", plain_shader()),
+        ("peeling 1x", peeling_shader(1)),
+        ("peeling 4x", peeling_shader(4)),
     ]
 }
 

@@ -1,0 +1,731 @@
+//! Classic exact depth peeling run entirely on the GPU: the run-time rival that `trisort bench`
+//! times against the merged player (DESIGN.md § Frame accuracy).
+//!
+//! [`ExactReference`](crate::ExactReference) peels with the recorder's peeler and reads every
+//! layer back to build per-layer index lists; [`PeelingRenderer`] records a frame as a fixed
+//! sequence of GPU passes with no readback and no CPU sync inside it. It produces the exact
+//! reference's image bit for bit (`blend` and `depth`), because it keeps the reference's keys,
+//! shading, compositing order and blend:
+//!
+//! - **Keys.** Fragments are ordered per sample by the recorder's (depth, triangle id) key: the
+//!   depth is `position.z`, written explicitly, the lower id in front on a tie. Every pass
+//!   draws every triangle in one draw in ascending id order (`primitive_index` = id).
+//! - **Order.** The reference composites a sample's fragments back to front with the player's
+//!   straight-alpha *over* blend into `Rgba16Float`. Rounding to f16 after every blend makes
+//!   that order part of the result, so this renderer peels **back to front** (reverse depth
+//!   peeling): pass `j` keeps, per sample, the farthest key in front of pass `j − 1`'s (depth
+//!   test `GreaterEqual`, so the higher id wins a tie) and is composited over the accumulation
+//!   at once. A frame of `L` layers takes `L` peel passes and `L` compositing passes.
+//! - **Shading.** The peel pass writes only ids and depth (it shades per sample: it reads the
+//!   previous key at `sample_index`). Each layer is then composited by drawing every triangle
+//!   again through `vs_player` and the player's `player_colour`, evaluated once per pixel, each
+//!   triangle writing only the samples where it is the layer's fragment (`sample_mask`): the
+//!   reference's own compositing pass, with the layer's ids read from the peel's texture.
+//! - **Truncation.** When a frame needs more layers than it is given, the front `layers` layers
+//!   are kept (as the reference keeps them): `layers` front-to-back passes (ids and depth only)
+//!   first find, per sample, the key of its last kept fragment; the back-to-front peel then
+//!   starts at that key. Only frames [`PeelingRenderer::layers`] found truncated pay for it.
+//! - **`depth`.** One front-to-back pass (`Less`: the nearest fragment, the lowest id on a tie)
+//!   composited over the background: the reference's first layer.
+//!
+//! The layer count of a frame is found once, outside the timed path, by front-to-back peeling
+//! with an occlusion query per pass until a pass writes no sample ([`PeelingRenderer::layers`]).
+//!
+//! Cost per layer: two full-scene geometry passes (peel, then composite) and no full-screen
+//! pass. Targets: ids `R32Uint` and depth `Depth32Float` (two of each, ping-ponged) and the
+//! `Rgba16Float` accumulation at the frame's sample count, resolved by the last compositing
+//! pass.
+
+use std::sync::Mutex;
+
+use trisort_format::{FrameState, Geometry};
+use trisort_player::headless::COLOR_FORMAT;
+use trisort_player::{blend_state, clear_colour, quantize_rgba16f, Mode};
+use trisort_shaders::gpu::Gpu;
+use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
+use wgpu::util::DeviceExt;
+
+use crate::ReferenceError;
+
+/// Format of the peel passes' id target (triangle id + 1, 0 = no fragment).
+const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// Format of the peel passes' depth target (read back as the previous key).
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Which fragments a peel pass keeps (the `mode` uniform of `fs_peeling`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Keep {
+    /// Every fragment (the first pass).
+    All = 0,
+    /// Keys behind the previous pass's (front to back).
+    Behind = 1,
+    /// Keys in front of the previous pass's (back to front).
+    InFront = 2,
+    /// Keys at or in front of the previous pass's (back to front under a limit).
+    AtOrInFront = 3,
+}
+
+/// Peel direction: which pipeline and clear depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Direction {
+    /// Nearest first: depth test `Less`, cleared to 1.
+    FrontToBack,
+    /// Farthest first: depth test `GreaterEqual`, cleared to 0.
+    BackToFront,
+}
+
+/// One frame of the peeling renderer, read back.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PeeledFrame {
+    /// `width × height` pixels, RGBA8, sRGB-encoded, alpha 255: the resolved `Rgba16Float`
+    /// frame through [`quantize_rgba16f`], like the player's and the exact reference's frames.
+    pub rgba8: Vec<u8>,
+    /// Layers peeled and composited (`depth`: 1, or 0 where nothing is drawn).
+    pub layers: u32,
+    /// Whether the frame needs more than `max_layers` layers (the front `max_layers` are
+    /// composited).
+    pub truncated: bool,
+}
+
+/// GPU-only exact depth peeling of one scene at one size, sample count and mode.
+pub struct PeelingRenderer<'g> {
+    gpu: &'g Gpu,
+    size: (u32, u32),
+    samples: u32,
+    mode: Mode,
+    max_layers: u32,
+    triangles: u32,
+    scene: SceneGpu,
+    index: wgpu::Buffer,
+    front: wgpu::RenderPipeline,
+    back: wgpu::RenderPipeline,
+    composite: wgpu::RenderPipeline,
+    /// Per keep mode, at `params_stride`: the `Peeling` uniform.
+    params_stride: u64,
+    /// `peel_groups[p]`: the peel bind group reading target `p` as the previous key.
+    peel_groups: [wgpu::BindGroup; 2],
+    /// `composite_groups[p]`: the compositing bind group reading target `p`'s ids.
+    composite_groups: [wgpu::BindGroup; 2],
+    ids: [wgpu::TextureView; 2],
+    depth: [wgpu::TextureView; 2],
+    /// The multisampled accumulation (`None` at one sample: `resolved` is drawn directly).
+    msaa: Option<wgpu::TextureView>,
+    resolved: wgpu::Texture,
+    resolved_view: wgpu::TextureView,
+    row_bytes: u32,
+    staging: wgpu::Buffer,
+    occlusion: wgpu::QuerySet,
+    occlusion_resolve: wgpu::Buffer,
+    occlusion_staging: wgpu::Buffer,
+    /// Per frame: (layers, truncated) once counted.
+    counted: Mutex<Vec<Option<(u32, bool)>>>,
+}
+
+impl<'g> PeelingRenderer<'g> {
+    /// Uploads `geometry` with the path's `frames` for rendering at `size` with `samples`
+    /// (1 or 4) in `mode` (`Blend` or `Depth`), with at most `max_layers` layers a frame.
+    ///
+    /// Errors: [`ReferenceError::Invalid`] for `Saturate`, an empty size or another sample
+    /// count; [`ReferenceError::Unsupported`] where the device lacks `PRIMITIVE_INDEX` or
+    /// cannot multisample the id, depth or colour targets at `samples`.
+    pub fn new(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        size: (u32, u32),
+        samples: u32,
+        mode: Mode,
+        max_layers: u32,
+    ) -> Result<Self, ReferenceError> {
+        if size.0 == 0 || size.1 == 0 || !(samples == 1 || samples == 4) {
+            return Err(ReferenceError::Invalid(format!(
+                "{}x{} at {samples} samples: sizes must be positive and samples 1 or 4",
+                size.0, size.1
+            )));
+        }
+        if mode == Mode::Saturate {
+            return Err(ReferenceError::Invalid(
+                "depth peeling renders blend and depth; saturate has no peeling renderer".into(),
+            ));
+        }
+        let device = &gpu.device;
+        if !device.features().contains(wgpu::Features::PRIMITIVE_INDEX) {
+            return Err(ReferenceError::Unsupported(format!(
+                "{} lacks PRIMITIVE_INDEX (triangle ids in the fragment shader)",
+                gpu.describe()
+            )));
+        }
+        for format in [ID_FORMAT, DEPTH_FORMAT, COLOR_FORMAT] {
+            let supported = gpu
+                .adapter
+                .get_texture_format_features(format)
+                .flags
+                .sample_count_supported(samples);
+            let adapter_specific = device
+                .features()
+                .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+            if !supported || (samples > 1 && format == ID_FORMAT && !adapter_specific) {
+                return Err(ReferenceError::Unsupported(format!(
+                    "{} cannot render {format:?} at {samples}x MSAA",
+                    gpu.describe()
+                )));
+            }
+        }
+        let triangles = u32::try_from(geometry.triangles.len())
+            .map_err(|_| ReferenceError::Invalid("more than 2^32 triangles".into()))?;
+        let view = View {
+            width: size.0,
+            height: size.1,
+            samples,
+            glass_opacity: 0.0,
+        };
+        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let mut index_data: Vec<u32> = geometry.triangles.iter().flatten().copied().collect();
+        if index_data.is_empty() {
+            index_data.extend_from_slice(&[0, 0, 0]);
+        }
+        let index = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("peeling indices"),
+            contents: bytemuck::cast_slice(&index_data),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("peeling"),
+            source: wgpu::ShaderSource::Wgsl(trisort_shaders::peeling_shader(samples).into()),
+        });
+        let multisampled = samples > 1;
+        let texture_entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled,
+            },
+            count: None,
+        };
+        let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("peeling peel"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(16),
+                    },
+                    count: None,
+                },
+                texture_entry(1, wgpu::TextureSampleType::Depth),
+                texture_entry(2, wgpu::TextureSampleType::Uint),
+            ],
+        });
+        let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("peeling composite"),
+            entries: &[texture_entry(3, wgpu::TextureSampleType::Uint)],
+        });
+        let peel_pipeline = |label, compare| {
+            ScenePipeline {
+                label,
+                layouts: &[&scene.layout, &peel_layout],
+                module: &module,
+                vertex: "vs_player",
+                fragment: "fs_peeling",
+                target: ID_FORMAT.into(),
+                depth: Some((DEPTH_FORMAT, compare, true)),
+                samples,
+            }
+            .build(device)
+        };
+        let front = peel_pipeline("peeling front to back", wgpu::CompareFunction::Less);
+        let back = peel_pipeline("peeling back to front", wgpu::CompareFunction::GreaterEqual);
+        // The player's pipeline state and blend with the masked compositing entry point, as
+        // the exact reference's compositing pipeline.
+        let composite = ScenePipeline {
+            label: "peeling composite",
+            layouts: &[&scene.layout, &composite_layout],
+            module: &module,
+            vertex: "vs_player",
+            fragment: "fs_peeling_composite",
+            target: wgpu::ColorTargetState {
+                format: COLOR_FORMAT,
+                blend: Some(blend_state(mode)),
+                write_mask: wgpu::ColorWrites::ALL,
+            },
+            depth: None,
+            samples,
+        }
+        .build(device);
+
+        let params_stride = 256u64.max(device.limits().min_uniform_buffer_offset_alignment as u64);
+        let mut params = vec![0u8; params_stride as usize * 4];
+        for keep in [Keep::All, Keep::Behind, Keep::InFront, Keep::AtOrInFront] {
+            let at = keep as usize * params_stride as usize;
+            params[at..at + 16].copy_from_slice(bytemuck::cast_slice(&[keep as u32, 0, 0, 0]));
+        }
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("peeling params"),
+            contents: &params,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let extent = wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        };
+        let texture = |label, format, sample_count, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: extent,
+                mip_level_count: 1,
+                sample_count,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let peel_usage = attachment | wgpu::TextureUsages::TEXTURE_BINDING;
+        let make_view = |t: wgpu::Texture| t.create_view(&Default::default());
+        let ids = [
+            make_view(texture("peeling ids a", ID_FORMAT, samples, peel_usage)),
+            make_view(texture("peeling ids b", ID_FORMAT, samples, peel_usage)),
+        ];
+        let depth = [
+            make_view(texture(
+                "peeling depth a",
+                DEPTH_FORMAT,
+                samples,
+                peel_usage,
+            )),
+            make_view(texture(
+                "peeling depth b",
+                DEPTH_FORMAT,
+                samples,
+                peel_usage,
+            )),
+        ];
+        let peel_group = |p: usize| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("peeling peel"),
+                layout: &peel_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &params,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(16),
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&depth[p]),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&ids[p]),
+                    },
+                ],
+            })
+        };
+        let composite_group = |p: usize| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("peeling composite"),
+                layout: &composite_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&ids[p]),
+                }],
+            })
+        };
+        let peel_groups = [peel_group(0), peel_group(1)];
+        let composite_groups = [composite_group(0), composite_group(1)];
+        let msaa = multisampled.then(|| {
+            make_view(texture(
+                "peeling frame (MSAA)",
+                COLOR_FORMAT,
+                samples,
+                attachment,
+            ))
+        });
+        let resolved = texture(
+            "peeling frame",
+            COLOR_FORMAT,
+            1,
+            attachment | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let resolved_view = resolved.create_view(&Default::default());
+        let bytes_per_pixel = COLOR_FORMAT
+            .block_copy_size(None)
+            .expect("Rgba16Float has a texel size");
+        let row_bytes = (size.0 * bytes_per_pixel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("peeling frame readback"),
+            size: row_bytes as u64 * size.1 as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let occlusion = device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("peeling layer count"),
+            ty: wgpu::QueryType::Occlusion,
+            count: 1,
+        });
+        let occlusion_resolve = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("peeling layer count resolve"),
+            size: 8,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let occlusion_staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("peeling layer count readback"),
+            size: 8,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(PeelingRenderer {
+            gpu,
+            size,
+            samples,
+            mode,
+            max_layers,
+            triangles,
+            scene,
+            index,
+            front,
+            back,
+            composite,
+            params_stride,
+            peel_groups,
+            composite_groups,
+            ids,
+            depth,
+            msaa,
+            resolved,
+            resolved_view,
+            row_bytes,
+            staging,
+            occlusion,
+            occlusion_resolve,
+            occlusion_staging,
+            counted: Mutex::new(vec![None; frames.len()]),
+        })
+    }
+
+    /// Triangles submitted per peel pass: every triangle of the scene. Each compositing pass
+    /// submits them again, so a frame of `L` layers submits `2 · L` times this (and `L` more
+    /// when truncated).
+    pub fn triangles(&self) -> u64 {
+        self.triangles as u64
+    }
+
+    /// The resolved single-sample `Rgba16Float` frame [`PeelingRenderer::encode`] leaves.
+    pub fn target(&self) -> &wgpu::Texture {
+        &self.resolved
+    }
+
+    /// The number of layers frame `frame` needs: peels front to back with an occlusion query
+    /// per pass, reading each back, until a pass writes no sample; capped at `max_layers`
+    /// (`depth` mode: 1, or 0 where nothing is drawn). Counted once per frame, then cached.
+    /// Errors for a frame beyond the path or a wgpu validation error.
+    pub fn layers(&self, frame: u32) -> Result<u32, ReferenceError> {
+        Ok(self.count(frame)?.0)
+    }
+
+    /// Whether frame `frame` needs more than `max_layers` layers (counted as in
+    /// [`PeelingRenderer::layers`]; always false in `depth` mode).
+    pub fn truncated(&self, frame: u32) -> Result<bool, ReferenceError> {
+        Ok(self.count(frame)?.1)
+    }
+
+    fn count(&self, frame: u32) -> Result<(u32, bool), ReferenceError> {
+        let frames = self.scene.frames();
+        if frame >= frames {
+            return Err(ReferenceError::Invalid(format!(
+                "frame {frame} of a path of {frames} frames"
+            )));
+        }
+        if let Some(c) = self.lock_counted()[frame as usize] {
+            return Ok(c);
+        }
+        let cap = if self.mode == Mode::Depth {
+            1
+        } else {
+            self.max_layers
+        };
+        let device = &self.gpu.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut layers = 0u32;
+        let truncated = loop {
+            let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("peeling layer count"),
+            });
+            let keep = if layers == 0 { Keep::All } else { Keep::Behind };
+            self.peel_pass(
+                &mut enc,
+                frame,
+                Direction::FrontToBack,
+                keep,
+                (layers % 2) as usize,
+                None,
+                true,
+            );
+            enc.resolve_query_set(&self.occlusion, 0..1, &self.occlusion_resolve, 0);
+            enc.copy_buffer_to_buffer(&self.occlusion_resolve, 0, &self.occlusion_staging, 0, 8);
+            self.gpu.queue.submit([enc.finish()]);
+            let bytes = self.gpu.map_read(&self.occlusion_staging);
+            let passed = u64::from_le_bytes(bytes[..8].try_into().expect("8 bytes"));
+            if passed == 0 {
+                break false;
+            }
+            if layers == cap {
+                // The pass after the last allowed one still wrote samples.
+                break self.mode != Mode::Depth;
+            }
+            layers += 1;
+        };
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(ReferenceError::Wgpu(e.to_string()));
+        }
+        let c = (layers, truncated);
+        self.lock_counted()[frame as usize] = Some(c);
+        Ok(c)
+    }
+
+    fn lock_counted(&self) -> std::sync::MutexGuard<'_, Vec<Option<(u32, bool)>>> {
+        self.counted.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Records every GPU command of frame `frame` with `layers` peel passes and their
+    /// compositing passes into `enc`, leaving the resolved single-sample `Rgba16Float` frame in
+    /// [`PeelingRenderer::target`]. With `stats`, back-to-front peel pass `k` (`depth` mode:
+    /// the one front-to-back pass) is bracketed by pipeline-statistics query `k`, so the set
+    /// needs `layers` slots; the compositing passes (and a truncated frame's limit passes) are
+    /// not counted. No readback, no CPU sync.
+    ///
+    /// `layers` is normally [`PeelingRenderer::layers`]`(frame)`. Where that call found the
+    /// frame truncated or needing more than `layers`, the front `layers` layers are kept
+    /// (`layers` more front-to-back passes find where they end); a frame not counted yet is
+    /// taken to need no more than `layers`. In `depth` mode any `layers` ≥ 1 draws the one
+    /// layer. Panics if `frame` is beyond the path.
+    pub fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        frame: u32,
+        layers: u32,
+        stats: Option<&wgpu::QuerySet>,
+    ) {
+        assert!(
+            frame < self.scene.frames(),
+            "frame {frame} of a path of {} frames",
+            self.scene.frames()
+        );
+        let clear = clear_colour(self.mode);
+        if layers == 0 {
+            drop(self.composite_pass(enc, frame, None, Some(clear), true));
+            return;
+        }
+        if self.mode == Mode::Depth {
+            self.peel_pass(
+                enc,
+                frame,
+                Direction::FrontToBack,
+                Keep::All,
+                0,
+                stats.map(|s| (s, 0)),
+                false,
+            );
+            drop(self.composite_pass(enc, frame, Some(0), Some(clear), true));
+            return;
+        }
+        let limited = self
+            .lock_counted()
+            .get(frame as usize)
+            .copied()
+            .flatten()
+            .is_some_and(|(needed, truncated)| layers < needed || truncated);
+        // `next`: the target the next peel pass writes (the other one holds the previous key).
+        let mut next = 0usize;
+        let mut keep = Keep::All;
+        if limited {
+            for k in 0..layers {
+                let keep = if k == 0 { Keep::All } else { Keep::Behind };
+                self.peel_pass(enc, frame, Direction::FrontToBack, keep, next, None, false);
+                next = 1 - next;
+            }
+            keep = Keep::AtOrInFront;
+        }
+        for k in 0..layers {
+            self.peel_pass(
+                enc,
+                frame,
+                Direction::BackToFront,
+                keep,
+                next,
+                stats.map(|s| (s, k)),
+                false,
+            );
+            let (load, resolve) = (if k == 0 { Some(clear) } else { None }, k + 1 == layers);
+            drop(self.composite_pass(enc, frame, Some(next), load, resolve));
+            next = 1 - next;
+            keep = Keep::InFront;
+        }
+    }
+
+    /// One peel pass writing ids and depth into target `write`, reading the previous key from
+    /// the other target.
+    #[allow(clippy::too_many_arguments)]
+    fn peel_pass(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        frame: u32,
+        direction: Direction,
+        keep: Keep,
+        write: usize,
+        stats: Option<(&wgpu::QuerySet, u32)>,
+        occlusion: bool,
+    ) {
+        let clear_depth = match direction {
+            Direction::FrontToBack => 1.0,
+            Direction::BackToFront => 0.0,
+        };
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("peeling peel"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.ids[write],
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth[write],
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear_depth),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            occlusion_query_set: occlusion.then_some(&self.occlusion),
+            ..Default::default()
+        });
+        pass.set_pipeline(match direction {
+            Direction::FrontToBack => &self.front,
+            Direction::BackToFront => &self.back,
+        });
+        pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+        pass.set_bind_group(
+            1,
+            &self.peel_groups[1 - write],
+            &[(keep as u64 * self.params_stride) as u32],
+        );
+        pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
+        pass.set_index_buffer(self.index.slice(..), wgpu::IndexFormat::Uint32);
+        if occlusion {
+            pass.begin_occlusion_query(0);
+        }
+        if let Some((set, k)) = stats {
+            pass.begin_pipeline_statistics_query(set, k);
+        }
+        if self.triangles > 0 {
+            pass.draw_indexed(0..self.triangles * 3, 0, 0..1);
+        }
+        if stats.is_some() {
+            pass.end_pipeline_statistics_query();
+        }
+        if occlusion {
+            pass.end_occlusion_query();
+        }
+    }
+
+    /// One compositing pass over the accumulation: the layer in target `layer` (none: only
+    /// the clear), cleared first when `clear` is given, resolved when `resolve`.
+    fn composite_pass<'e>(
+        &self,
+        enc: &'e mut wgpu::CommandEncoder,
+        frame: u32,
+        layer: Option<usize>,
+        clear: Option<wgpu::Color>,
+        resolve: bool,
+    ) -> wgpu::RenderPass<'e> {
+        let (view, resolve_target, store) = match &self.msaa {
+            Some(msaa) if resolve => (msaa, Some(&self.resolved_view), wgpu::StoreOp::Discard),
+            Some(msaa) => (msaa, None, wgpu::StoreOp::Store),
+            None => (&self.resolved_view, None, wgpu::StoreOp::Store),
+        };
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("peeling composite"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target,
+                ops: wgpu::Operations {
+                    load: clear.map_or(wgpu::LoadOp::Load, wgpu::LoadOp::Clear),
+                    store,
+                },
+            })],
+            ..Default::default()
+        });
+        if let Some(p) = layer {
+            if self.triangles > 0 {
+                pass.set_pipeline(&self.composite);
+                pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+                pass.set_bind_group(1, &self.composite_groups[p], &[]);
+                pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
+                pass.set_index_buffer(self.index.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..self.triangles * 3, 0, 0..1);
+            }
+        }
+        pass
+    }
+
+    /// [`PeelingRenderer::layers`], then [`PeelingRenderer::encode`] with that many layers,
+    /// submitted and read back as 8-bit sRGB.
+    pub fn render(&self, frame: u32) -> Result<PeeledFrame, ReferenceError> {
+        let (layers, truncated) = self.count(frame)?;
+        let device = &self.gpu.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("peeling frame"),
+        });
+        self.encode(&mut enc, frame, layers, None);
+        enc.copy_texture_to_buffer(
+            self.resolved.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.row_bytes),
+                    rows_per_image: Some(self.size.1),
+                },
+            },
+            self.resolved.size(),
+        );
+        self.gpu.queue.submit([enc.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(ReferenceError::Wgpu(e.to_string()));
+        }
+        let padded = self.gpu.map_read(&self.staging);
+        let row = self.size.0 as usize * 8;
+        let halves: Vec<u16> = (0..self.size.1 as usize)
+            .flat_map(|y| padded[y * self.row_bytes as usize..][..row].chunks_exact(2))
+            .map(|b| u16::from_le_bytes([b[0], b[1]]))
+            .collect();
+        Ok(PeeledFrame {
+            rgba8: quantize_rgba16f(&halves, None),
+            layers,
+            truncated,
+        })
+    }
+
+    /// The sample count.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+}
