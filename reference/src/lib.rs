@@ -22,6 +22,7 @@ pub mod compare;
 pub mod default_pipeline;
 pub mod deploy;
 pub mod exact;
+pub mod oit;
 pub mod peeling;
 mod target;
 pub mod verify;
@@ -30,6 +31,7 @@ pub use compare::{compare, Comparison};
 pub use default_pipeline::DefaultRenderer;
 pub use deploy::Srgb8Player;
 pub use exact::{ExactReference, ReferenceConfig, ReferenceFrame, RemovedEdges};
+pub use oit::{OitConfig, OitFrame, OitRenderer};
 pub use peeling::{PeeledFrame, PeelingRenderer};
 pub use verify::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
 

@@ -92,6 +92,23 @@ pub fn plain_shader() -> String {
     compose(&[], PLAIN)
 }
 
+/// The per-sample linked-list OIT renderer's entry points (`fs_oit_list`,
+/// `vs_oit_fullscreen`, `fs_oit_resolve`); compose with [`oit_shader`].
+pub const OIT: &str = include_str!("wgsl/oit.wgsl");
+
+/// The complete OIT shader: [`COMMON`], the player's [`PLAYER`] entry points (`vs_player`,
+/// `player_colour`) and [`OIT`] with a per-sample sort array of `max_sorted` entries (needs
+/// `Features::PRIMITIVE_INDEX`).
+pub fn oit_shader(max_sorted: u32) -> String {
+    compose(
+        &["primitive_index"],
+        &format!(
+            "{PLAYER}\n{}",
+            OIT.replace("OIT_MAX_SORTED", &max_sorted.max(1).to_string())
+        ),
+    )
+}
+
 /// The GPU-only depth peeling renderer's entry points (`fs_peeling`, which finds the next
 /// layer by the recorder's (depth, id) key, and `fs_peeling_composite`, which shades a layer's
 /// samples through the player's `player_colour`); compose with [`peeling_shader`].
@@ -144,6 +161,7 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("plain", plain_shader()),
         ("peeling 1x", peeling_shader(1)),
         ("peeling 4x", peeling_shader(4)),
+        ("oit", oit_shader(32)),
     ]
 }
 
