@@ -499,7 +499,8 @@ impl<'g> OitRenderer<'g> {
     /// counters, the list-building pass and the resolve pass, leaving the resolved
     /// single-sample `Rgba16Float` frame in the renderer's own target. With `stats`, scene
     /// geometry pass `k` (`k < passes()`) is bracketed by
-    /// `begin/end_pipeline_statistics_query(stats, k)`. No readback, no CPU sync.
+    /// `begin/end_pipeline_statistics_query(stats, k)`. No readback, no CPU sync. Panics if
+    /// `frame` is not a frame of the path (as [`SceneGpu::offsets`]).
     pub fn encode(
         &self,
         enc: &mut wgpu::CommandEncoder,
