@@ -10,6 +10,7 @@ pub mod harness;
 pub mod methods;
 pub mod plot;
 pub mod sweep;
+pub mod scaling;
 
 /// Errors of the benchmarks.
 #[derive(Debug, thiserror::Error)]
