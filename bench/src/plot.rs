@@ -365,8 +365,13 @@ where
     for (i, _, pts, _) in series {
         let c = colour(*i);
         if style == Style::Lines && pts.len() > 1 {
-            ctx.draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
-                .map_err(|x| e(&x))?;
+            // Segment by segment: some SVG renderers (ImageMagick's built-in one) fill a
+            // polyline of more than two points despite `fill="none"`.
+            ctx.draw_series(
+                pts.windows(2)
+                    .map(|w| PathElement::new(vec![w[0], w[1]], c.stroke_width(2))),
+            )
+            .map_err(|x| e(&x))?;
         }
         draw_markers(&mut ctx, *i, pts).map_err(|x| e(&x))?;
     }

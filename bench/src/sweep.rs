@@ -47,8 +47,9 @@ use trisort_shaders::gpu::Gpu;
 use crate::plot::{write_atomic, write_svg, write_svg_labelled, Chart, Series, Style};
 use crate::BenchError;
 
-/// Timed renders of each compared frame per point (after one untimed warm-up render).
-pub const PLAY_REPEATS: u32 = 3;
+/// Timed renders of each compared frame per point (after one untimed warm-up render of each);
+/// a frame's time is their median.
+pub const PLAY_REPEATS: u32 = 5;
 
 /// Layer bound of the sweep's recordings and references (the CLI's `--max-layers` default).
 pub const MAX_LAYERS: u32 = 256;
@@ -212,12 +213,12 @@ pub struct SweepPoint {
     pub draws_per_frame_mean: f64,
     /// Most indirect draws in one frame.
     pub draws_per_frame_max: u32,
-    /// Mean GPU time of a played frame (timestamp queries), ms; NaN (null in JSON) where the
-    /// device has no timestamps.
+    /// Mean over the compared frames of a frame's GPU time (timestamp queries; the median of
+    /// [`PLAY_REPEATS`] renders), ms; NaN (null in JSON) where the device has no timestamps.
     pub play_ms_mean: f64,
-    /// Largest GPU time of a played frame, ms (NaN without timestamps).
+    /// Largest frame GPU time (each the median of its repeats), ms (NaN without timestamps).
     pub play_ms_max: f64,
-    /// Mean wall time of a played frame (submit, wait, read back), ms.
+    /// Mean wall time of a played frame (submit, wait, read back; median of its repeats), ms.
     pub wall_ms_mean: f64,
     /// Pixels differing from the reference, summed over the compared frames.
     pub pixels_differing: u64,
@@ -774,15 +775,21 @@ fn measure(
     }
     for (&f, reference) in frames.iter().zip(reference) {
         let mut image = None;
+        let (mut gpu_times, mut wall_times) = (Vec::new(), Vec::new());
         for _ in 0..PLAY_REPEATS.max(1) {
             let t = Instant::now();
             let r = renderer.render(f)?;
-            wall_ms.push(t.elapsed().as_secs_f64() * 1e3);
+            wall_times.push(t.elapsed().as_secs_f64() * 1e3);
             if let Some(ms) = r.gpu_ms {
-                play_ms.push(ms);
+                gpu_times.push(ms);
             }
             image.get_or_insert(r.rgba8);
         }
+        // The frame's time: the median of its repeats (robust to a busy machine's bursts).
+        if !gpu_times.is_empty() {
+            play_ms.push(median(&mut gpu_times));
+        }
+        wall_ms.push(median(&mut wall_times));
         let image = image.expect("rendered at least once");
         let c = compare(&image, reference, w, h, &[]);
         pixels_differing += c.pixels_differing;
@@ -802,6 +809,18 @@ fn measure(
         max_channel_diff,
         flip,
     })
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        (v[n / 2 - 1] + v[n / 2]) / 2.0
+    }
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -1016,6 +1035,15 @@ fn write_outputs(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn median_mean_max() {
+        assert!(median(&mut []).is_nan());
+        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(mean(&[]).is_nan() && max(&[]).is_nan());
+        assert_eq!((mean(&[1.0, 2.0]), max(&[1.0, 2.0])), (1.5, 2.0));
+    }
 
     #[test]
     fn factors_parse_and_name() {
