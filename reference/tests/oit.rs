@@ -383,7 +383,11 @@ fn a_pool_split_over_several_buffers() {
     let Some(gpu) = gpu() else { return };
     let g = full_screen_layers(9);
     let frames = vec![frame_at(DVec3::ZERO)];
-    let config = OitConfig::new((512, 512), 4);
+    // 10 nodes per sample: 280 MiB, room for the 9 layers.
+    let config = OitConfig {
+        nodes_per_sample: 10,
+        ..OitConfig::new((512, 512), 4)
+    };
     let o = match OitRenderer::new(&gpu, &g, &frames, config) {
         Ok(oit) => oit.render(0).expect("frame"),
         Err(e @ ReferenceError::Unsupported(_)) => {
