@@ -9,8 +9,10 @@
 pub mod harness;
 pub mod methods;
 pub mod plot;
-pub mod sweep;
+mod rivals;
 pub mod scaling;
+pub mod sweep;
+pub mod table;
 
 /// Errors of the benchmarks.
 #[derive(Debug, thiserror::Error)]

@@ -9,7 +9,7 @@ use clap::Args;
 use trisort_player::headless::HeadlessConfig;
 
 use crate::cmd::bake::bake;
-use crate::cmd::merge::{BridgeArg, LayoutArg, MergeOpts, SeedingArg, StrategyArg};
+use crate::cmd::merge::MergeOpts;
 use crate::cmd::play::play_frames;
 use crate::cmd::RecordOpts;
 use crate::common::parse_size;
@@ -62,14 +62,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         frames: None,
         fps: path.fps,
     };
-    let merge = MergeOpts {
-        strategy: StrategyArg::Auto,
-        layout: LayoutArg::Auto,
-        bridge: BridgeArg::Hidden,
-        depth_only: false,
-        segment: None,
-        seeding: SeedingArg::Interval,
-    };
+    let merge = MergeOpts::defaults();
     let gpu = crate::common::open_gpu()?;
     println!("device: {}", gpu.describe());
     let baked_path = a.out_dir.join("demo.baked");

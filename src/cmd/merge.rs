@@ -83,6 +83,19 @@ pub struct MergeOpts {
 }
 
 impl MergeOpts {
+    /// The command line's defaults (auto strategy and layout, bridge hidden, interval seeding,
+    /// one matrix).
+    pub fn defaults() -> MergeOpts {
+        MergeOpts {
+            strategy: StrategyArg::Auto,
+            layout: LayoutArg::Auto,
+            bridge: BridgeArg::Hidden,
+            depth_only: false,
+            segment: None,
+            seeding: SeedingArg::Interval,
+        }
+    }
+
     /// The merger's options.
     pub fn options(&self) -> MergeOptions {
         MergeOptions {

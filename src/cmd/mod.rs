@@ -1,6 +1,7 @@
 //! The subcommands (DESIGN.md § CLI contract).
 
 mod bake;
+mod bench;
 mod demo;
 mod inspect;
 pub mod merge;
@@ -11,7 +12,7 @@ mod window;
 
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 
 use crate::common::{parse_range, parse_size, FrameRange};
@@ -40,7 +41,7 @@ enum Command {
     /// Check a baked file: graph rules against its recording, images against the exact reference.
     Verify(verify::VerifyArgs),
     /// Measure frame times and accuracy of the merged player against its rivals.
-    Bench(BenchArgs),
+    Bench(bench::BenchArgs),
     /// Bake and play the built-in procedural car and print its figures.
     Demo(demo::DemoArgs),
 }
@@ -85,15 +86,6 @@ impl RecordOpts {
     }
 }
 
-#[derive(Args, Debug)]
-struct BenchArgs {
-    /// Scene.
-    scene: String,
-    /// Path.
-    #[arg(long)]
-    path: String,
-}
-
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
@@ -103,11 +95,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Bake(a) => bake::run(a),
         Command::Play(a) => play::run(a),
         Command::Verify(a) => verify::run(a),
-        Command::Bench(_) => not_built("bench", 7),
+        Command::Bench(a) => bench::run(a),
         Command::Demo(a) => demo::run(a),
     }
-}
-
-fn not_built(name: &str, issue: u32) -> Result<ExitCode> {
-    bail!("`trisort {name}` is not built yet (issue {issue})")
 }

@@ -1,0 +1,448 @@
+//! One row of the method comparison per (samples, mode, method): the paper's Table 1 with
+//! device-independent counts and the error against the exact reference added.
+//!
+//! [`run_group`] builds every method that applies to one sample count and mode, renders the
+//! exact reference of each measured frame once, compares every method's image with it, counts
+//! triangles, draws, pipeline statistics and overdraw, then times all methods interleaved
+//! ([`crate::harness::time_methods`]) so the ratios within a group come from one run.
+
+use serde::Serialize;
+use trisort_format::{Baked, FrameState, Geometry, Recording};
+use trisort_player::Mode;
+use trisort_reference::{compare, ExactReference, ReferenceConfig, RemovedEdges};
+use trisort_shaders::gpu::Gpu;
+
+use crate::harness::{pipeline_statistics, time_methods, FragmentCounter, Summary, Timing};
+use crate::methods::{default_depth, source_baked, BenchView, DefaultMethod, Method, PlayerMethod};
+use crate::BenchError;
+
+/// The methods a group may run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MethodKind {
+    /// Every triangle with the depth test (unsorted transparency).
+    Default,
+    /// Each frame's own sorted visible set, one draw.
+    Source,
+    /// The baked sliding window, one multi-draw-indirect.
+    Merged,
+    /// Per-sample linked-list OIT.
+    Oit,
+    /// Exact GPU depth peeling.
+    Peeling,
+}
+
+impl MethodKind {
+    /// All methods, in table order.
+    pub const ALL: [MethodKind; 5] = [
+        MethodKind::Default,
+        MethodKind::Source,
+        MethodKind::Merged,
+        MethodKind::Oit,
+        MethodKind::Peeling,
+    ];
+
+    /// The name used on the command line and in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodKind::Default => "default",
+            MethodKind::Source => "source",
+            MethodKind::Merged => "merged",
+            MethodKind::Oit => "oit",
+            MethodKind::Peeling => "peeling",
+        }
+    }
+
+    /// Parses a name.
+    pub fn parse(s: &str) -> Option<MethodKind> {
+        MethodKind::ALL.into_iter().find(|m| m.name() == s)
+    }
+
+    /// Whether the method renders `mode` (OIT: blend only; default and peeling: no saturate).
+    pub fn supports(self, mode: Mode) -> bool {
+        match self {
+            MethodKind::Source | MethodKind::Merged => true,
+            MethodKind::Oit => mode == Mode::Blend,
+            MethodKind::Default | MethodKind::Peeling => mode != Mode::Saturate,
+        }
+    }
+}
+
+/// What one group measures.
+pub struct GroupInput<'a> {
+    /// The scene's full geometry.
+    pub geometry: &'a Geometry,
+    /// Every frame of the path.
+    pub frame_states: &'a [FrameState],
+    /// The bake played by `merged`, recorded at this group's sample count.
+    pub baked: &'a Baked,
+    /// The recording it was merged from (for `source`).
+    pub recording: &'a Recording,
+    /// Size, samples and glass opacity of playback.
+    pub view: BenchView,
+    /// Compositing mode.
+    pub mode: Mode,
+    /// Methods to run (those that do not support `mode` are left out).
+    pub methods: &'a [MethodKind],
+    /// Frames to measure.
+    pub frames: &'a [u32],
+    /// Timed repetitions per frame and method.
+    pub repeats: u32,
+    /// Also time `merged` on a device with wgpu's indirect-call validation off.
+    pub unvalidated: Option<&'a Gpu>,
+}
+
+/// Error of one method's frames against the exact reference.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ErrorSummary {
+    /// Frames identical to the reference on every ordered pixel.
+    pub frames_exact: u32,
+    /// Frames compared.
+    pub frames: u32,
+    /// Mean over frames of the fraction of pixels with any channel different.
+    pub pixels_differing_fraction: f64,
+    /// Mean over frames of the fraction of *ordered* pixels (no unordered sample of the
+    /// merged bake) with any channel different.
+    pub pixels_differing_ordered_fraction: f64,
+    /// Largest channel difference over all frames, in 1/255.
+    pub max_channel_diff: u8,
+    /// Mean LDR-FLIP over frames.
+    pub flip_mean: f64,
+    /// Smallest PSNR over frames (dB; 100 for identical).
+    pub psnr_min: f64,
+}
+
+/// One method in one group.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MethodRow {
+    /// Method name; `merged_unvalidated` for the merged player with indirect validation off.
+    pub method: String,
+    /// What configuration it ran (e.g. OIT's budget).
+    pub variant: String,
+    /// Mode.
+    pub mode: String,
+    /// MSAA samples.
+    pub samples: u32,
+    /// The headline time per frame (ms): GPU timestamps where the device has them, else wall.
+    pub ms_per_frame: f64,
+    /// 95th percentile of the headline time.
+    pub ms_p95: f64,
+    /// Maximum of the headline time.
+    pub ms_max: f64,
+    /// GPU timestamp times.
+    pub gpu_ms: Option<Summary>,
+    /// Wall times (encode, submit, wait).
+    pub wall_ms: Summary,
+    /// Per measured frame: mean headline ms.
+    pub ms_along_path: Vec<(u32, f64)>,
+    /// Mean triangles submitted per frame.
+    pub triangles_per_frame: f64,
+    /// Mean draw commands per frame.
+    pub draws_per_frame_mean: f64,
+    /// Largest draw commands in a frame.
+    pub draws_per_frame_max: u32,
+    /// Mean fragment-shader invocations per frame as the device counts them (pipeline
+    /// statistics; lavapipe counts rasterized fragments).
+    pub fragment_invocations_per_frame: Option<f64>,
+    /// Mean vertex-shader invocations per frame (pipeline statistics).
+    pub vertex_invocations_per_frame: Option<f64>,
+    /// Mean fragments shaded per frame: the method's own count (OIT) or the counting pass's.
+    pub fragments_shaded_per_frame: f64,
+    /// Mean pixels covered per frame (counting pass).
+    pub pixels_covered_per_frame: f64,
+    /// `fragments_shaded / pixels_covered` (mean over frames).
+    pub overdraw: f64,
+    /// Error against the exact reference.
+    pub error: ErrorSummary,
+}
+
+/// A group's rows, methods in table order.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GroupReport {
+    /// MSAA samples.
+    pub samples: u32,
+    /// Mode.
+    pub mode: String,
+    /// Rows.
+    pub rows: Vec<MethodRow>,
+}
+
+impl GroupReport {
+    /// The row of `method`.
+    pub fn row(&self, method: &str) -> Option<&MethodRow> {
+        self.rows.iter().find(|r| r.method == method)
+    }
+
+    /// `merged` over `source` headline time (the paper reports 1.35–2.7).
+    pub fn merged_over_source(&self) -> Option<f64> {
+        Some(self.row("merged")?.ms_per_frame / self.row("source")?.ms_per_frame)
+    }
+}
+
+/// Runs one group. `progress(message)` reports each step.
+pub fn run_group(
+    gpu: &Gpu,
+    input: &GroupInput<'_>,
+    progress: &dyn Fn(&str),
+) -> Result<GroupReport, BenchError> {
+    let view = input.view;
+    let mode = input.mode;
+    let mut methods: Vec<(String, Box<dyn Method + '_>)> = Vec::new();
+    let source = source_baked(input.baked, input.recording)?;
+    for &kind in input.methods {
+        if !kind.supports(mode) {
+            continue;
+        }
+        progress(&format!("building {}", kind.name()));
+        match kind {
+            MethodKind::Default => {
+                let m: Box<dyn Method> = if mode == Mode::Depth {
+                    Box::new(default_depth(
+                        gpu,
+                        input.geometry,
+                        input.frame_states,
+                        input.baked.settings,
+                        view,
+                    )?)
+                } else {
+                    Box::new(DefaultMethod::new(
+                        gpu,
+                        input.geometry,
+                        input.frame_states,
+                        view,
+                    )?)
+                };
+                methods.push(("default".into(), m));
+            }
+            MethodKind::Source => methods.push((
+                "source".into(),
+                Box::new(PlayerMethod::new(
+                    "source",
+                    "V_f only, one draw".into(),
+                    gpu,
+                    &source,
+                    mode,
+                    view,
+                )?),
+            )),
+            MethodKind::Merged => {
+                methods.push((
+                    "merged".into(),
+                    Box::new(PlayerMethod::new(
+                        "merged",
+                        "indirect validation on (wgpu default)".into(),
+                        gpu,
+                        input.baked,
+                        mode,
+                        view,
+                    )?),
+                ));
+                if let Some(g) = input.unvalidated {
+                    methods.push((
+                        "merged_unvalidated".into(),
+                        Box::new(PlayerMethod::new(
+                            "merged_unvalidated",
+                            "indirect validation off".into(),
+                            g,
+                            input.baked,
+                            mode,
+                            view,
+                        )?),
+                    ));
+                }
+            }
+            MethodKind::Oit | MethodKind::Peeling => {
+                if let Some(m) = crate::rivals::build(kind, gpu, input, progress)? {
+                    methods.push((kind.name().into(), m));
+                }
+            }
+        }
+    }
+
+    // The exact reference of each frame, with the merged bake's unordered samples.
+    progress("exact reference");
+    let reference = ExactReference::new(
+        gpu,
+        input.geometry,
+        input.frame_states,
+        ReferenceConfig {
+            size: view.size,
+            samples: view.samples,
+            mode,
+            glass_opacity: view.glass_opacity,
+            max_layers: 4096,
+        },
+    )?;
+    let removed = RemovedEdges::of_baked(input.baked, input.geometry.triangles.len())?;
+    let counter = FragmentCounter::new(
+        gpu,
+        input.geometry,
+        input.frame_states,
+        view.size,
+        view.glass_opacity,
+    )?;
+
+    struct Acc {
+        errors: ErrorSummary,
+        triangles: f64,
+        draws: f64,
+        draws_max: u32,
+        fragments_dev: Option<f64>,
+        vertices_dev: Option<f64>,
+        shaded: f64,
+        covered: f64,
+        overdraw: f64,
+    }
+    let mut acc: Vec<Acc> = methods
+        .iter()
+        .map(|_| Acc {
+            errors: ErrorSummary {
+                psnr_min: f64::INFINITY,
+                ..Default::default()
+            },
+            triangles: 0.0,
+            draws: 0.0,
+            draws_max: 0,
+            fragments_dev: Some(0.0),
+            vertices_dev: Some(0.0),
+            shaded: 0.0,
+            covered: 0.0,
+            overdraw: 0.0,
+        })
+        .collect();
+    let (w, h) = view.size;
+    let pixels = (w as f64) * (h as f64);
+    for (i, &f) in input.frames.iter().enumerate() {
+        progress(&format!(
+            "frame {f} ({}/{}): reference, images and counts",
+            i + 1,
+            input.frames.len()
+        ));
+        let reference_frame = reference.render(f, Some(&removed))?;
+        for ((_, m), a) in methods.iter().zip(&mut acc) {
+            m.prepare(f)?;
+            let image = m.image(f)?;
+            let c = compare(
+                &image,
+                &reference_frame.rgba8,
+                w,
+                h,
+                &reference_frame.unordered,
+            );
+            let e = &mut a.errors;
+            e.frames += 1;
+            e.frames_exact += (c.pixels_differing_ordered == 0) as u32;
+            e.pixels_differing_fraction += c.pixels_differing as f64 / pixels;
+            let ordered = pixels - reference_frame.unordered.iter().filter(|&&u| u).count() as f64;
+            e.pixels_differing_ordered_fraction +=
+                c.pixels_differing_ordered as f64 / ordered.max(1.0);
+            e.max_channel_diff = e.max_channel_diff.max(c.max_channel_diff);
+            e.flip_mean += c.flip_mean;
+            e.psnr_min = e.psnr_min.min(c.psnr);
+            a.triangles += m.triangles(f) as f64;
+            let d = m.draws(f);
+            a.draws += d as f64;
+            a.draws_max = a.draws_max.max(d);
+            match pipeline_statistics(m.as_ref(), f)? {
+                Some(p) => {
+                    a.fragments_dev = a.fragments_dev.map(|x| x + p.fragment_invocations as f64);
+                    a.vertices_dev = a.vertices_dev.map(|x| x + p.vertex_invocations as f64);
+                }
+                None => {
+                    a.fragments_dev = None;
+                    a.vertices_dev = None;
+                }
+            }
+            let counted = counter.count(f, &m.streams(f), view.samples)?;
+            let shaded = match m.shaded_fragments(f)? {
+                Some(n) => n,
+                None => counted.fragments,
+            };
+            a.shaded += shaded as f64;
+            a.covered += counted.pixels_covered as f64;
+            a.overdraw += if counted.pixels_covered > 0 {
+                shaded as f64 / counted.pixels_covered as f64
+            } else {
+                0.0
+            };
+        }
+    }
+
+    progress("timing");
+    let refs: Vec<&dyn Method> = methods.iter().map(|(_, m)| m.as_ref()).collect();
+    let total_calls = std::cell::Cell::new(0usize);
+    let timings = time_methods(&refs, input.frames, input.repeats, &|done, total| {
+        total_calls.set(total);
+        if done % methods.len().max(1) == 0 {
+            progress(&format!("timing: {done}/{total} calls"));
+        }
+    })?;
+
+    let n = input.frames.len().max(1) as f64;
+    let rows = methods
+        .iter()
+        .zip(acc)
+        .zip(timings)
+        .map(|(((name, m), a), t)| {
+            let gpu: Vec<f64> = t.iter().filter_map(|x| x.gpu_ms).collect();
+            let gpu_ms = (gpu.len() == t.len() && !t.is_empty()).then(|| Summary::of(&gpu));
+            let wall_ms = Summary::of(&t.iter().map(|x| x.wall_ms).collect::<Vec<_>>());
+            let headline = gpu_ms.unwrap_or(wall_ms);
+            let mut errors = a.errors;
+            if errors.frames > 0 {
+                errors.pixels_differing_fraction /= errors.frames as f64;
+                errors.pixels_differing_ordered_fraction /= errors.frames as f64;
+                errors.flip_mean /= errors.frames as f64;
+            } else {
+                errors.psnr_min = 0.0;
+            }
+            MethodRow {
+                method: name.clone(),
+                variant: m.variant(),
+                mode: mode.name().into(),
+                samples: view.samples,
+                ms_per_frame: headline.mean,
+                ms_p95: headline.p95,
+                ms_max: headline.max,
+                gpu_ms,
+                wall_ms,
+                ms_along_path: along_path(input.frames, &t, gpu_ms.is_some()),
+                triangles_per_frame: a.triangles / n,
+                draws_per_frame_mean: a.draws / n,
+                draws_per_frame_max: a.draws_max,
+                fragment_invocations_per_frame: a.fragments_dev.map(|x| x / n),
+                vertex_invocations_per_frame: a.vertices_dev.map(|x| x / n),
+                fragments_shaded_per_frame: a.shaded / n,
+                pixels_covered_per_frame: a.covered / n,
+                overdraw: a.overdraw / n,
+                error: errors,
+            }
+        })
+        .collect();
+    Ok(GroupReport {
+        samples: view.samples,
+        mode: mode.name().into(),
+        rows,
+    })
+}
+
+/// Mean headline time per measured frame, in frame order.
+fn along_path(frames: &[u32], timings: &[Timing], gpu: bool) -> Vec<(u32, f64)> {
+    frames
+        .iter()
+        .map(|&f| {
+            let v: Vec<f64> = timings
+                .iter()
+                .filter(|t| t.frame == f)
+                .map(|t| {
+                    if gpu {
+                        t.gpu_ms.unwrap_or(0.0)
+                    } else {
+                        t.wall_ms
+                    }
+                })
+                .collect();
+            (f, v.iter().sum::<f64>() / v.len().max(1) as f64)
+        })
+        .collect()
+}

@@ -1,0 +1,280 @@
+//! `trisort bench` through the real binary: the method table on the demo car with half-opaque
+//! glass (where the default pipeline's unsorted transparency is visibly wrong), its JSON
+//! contract (DESIGN § CLI contract), its files, the reuse of its bakes, and its errors.
+
+mod support;
+
+use std::path::Path;
+
+use support::*;
+
+const PATH: &str = "orbit:frames=4,degrees=90,elevation=20,distance=6";
+
+fn row<'a>(group: &'a serde_json::Value, method: &str) -> &'a serde_json::Value {
+    group["rows"]
+        .as_array()
+        .expect("rows")
+        .iter()
+        .find(|r| r["method"] == method)
+        .unwrap_or_else(|| panic!("no {method} row in {group}"))
+}
+
+fn f(v: &serde_json::Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+#[test]
+fn bench_table_on_the_demo_car() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let out_s = out.display().to_string();
+    let args = [
+        "bench",
+        "demo:10000",
+        "--path",
+        PATH,
+        "--size",
+        "64x64",
+        "--samples",
+        "4,1",
+        "--mode",
+        "blend,depth,saturate",
+        "--repeats",
+        "2",
+        "--glass-opacity",
+        "0.5",
+        "--out",
+        &out_s,
+    ];
+    let v = run_json(dir.path(), &args);
+
+    // The contract's keys, for every method, at the headline group (4×, blend).
+    assert!(v["device"].as_str().is_some_and(|d| !d.is_empty()));
+    for m in ["default", "source", "merged", "oit", "peeling"] {
+        let r = &v["methods"][m];
+        for k in ["ms_per_frame", "ms_p95", "ms_max", "triangles_per_frame"] {
+            let x = f(&r[k]);
+            assert!(x.is_finite() && x > 0.0, "{m}.{k} = {x}");
+        }
+        assert!(
+            f(&r["ms_per_frame"]) <= f(&r["ms_max"]) + 1e-9,
+            "{m}: mean above max"
+        );
+        assert!(
+            f(&r["ms_p95"]) <= f(&r["ms_max"]) + 1e-9,
+            "{m}: p95 above max"
+        );
+    }
+    let triangles = f(&v["triangles"]);
+    let m = &v["methods"];
+    assert_eq!(f(&m["default"]["triangles_per_frame"]), triangles);
+    assert_eq!(f(&m["oit"]["triangles_per_frame"]), triangles);
+    assert!(
+        f(&m["peeling"]["triangles_per_frame"]) >= 2.0 * triangles,
+        "glass: ≥ 2 layers"
+    );
+    assert!(f(&m["source"]["triangles_per_frame"]) <= f(&m["merged"]["triangles_per_frame"]));
+    assert!(f(&m["merged"]["triangles_per_frame"]) < triangles);
+
+    // Six groups; saturate has only the player's methods.
+    let groups = v["groups"].as_array().expect("groups");
+    assert_eq!(groups.len(), 6);
+    let frames = v["frames"].as_array().unwrap().len() as u64;
+    assert_eq!(frames, 4);
+    for g in groups {
+        let mode = g["mode"].as_str().unwrap();
+        let names: Vec<&str> = g["rows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["method"].as_str().unwrap())
+            .collect();
+        let expected: &[&str] = match mode {
+            "blend" => &[
+                "default",
+                "source",
+                "merged",
+                "merged_unvalidated",
+                "oit",
+                "peeling",
+            ],
+            "depth" => &[
+                "default",
+                "source",
+                "merged",
+                "merged_unvalidated",
+                "peeling",
+            ],
+            _ => &["source", "merged", "merged_unvalidated"],
+        };
+        assert_eq!(names, expected, "{mode}");
+        // Every sorted method is exact at its recorded pattern on every ordered pixel, and so
+        // is exact peeling; one draw per frame for source.
+        for name in ["source", "merged", "merged_unvalidated", "peeling"] {
+            if !names.contains(&name) {
+                continue;
+            }
+            let r = row(g, name);
+            assert_eq!(
+                r["error"]["frames_exact"].as_u64(),
+                Some(frames),
+                "{name} {mode} {}x: {}",
+                g["samples"],
+                r["error"]
+            );
+        }
+        assert_eq!(f(&row(g, "source")["draws_per_frame_max"]), 1.0);
+        assert!(f(&row(g, "merged")["overdraw"]) >= 1.0);
+    }
+    // Half-opaque glass blended in id order: the default pipeline is wrong where sorting is
+    // exact.
+    let blend4 = &groups[0];
+    assert_eq!(blend4["mode"], "blend");
+    assert!(
+        f(&row(blend4, "default")["error"]["pixels_differing_fraction"]) > 0.0,
+        "unsorted glass should differ: {}",
+        row(blend4, "default")["error"]
+    );
+
+    // Files.
+    for name in [
+        "bench.json",
+        "bench.csv",
+        "bench.md",
+        "bench-draws-along-path.svg",
+        "bench-ms-per-frame-4x-blend.svg",
+        "bench-ms-per-frame-1x-saturate.svg",
+        "bake-64x64-4x.baked",
+        "bake-64x64-1x.baked.rec",
+    ] {
+        assert!(out.join(name).is_file(), "{name} missing");
+    }
+    let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 6 + 5 + 3 + 6 + 5 + 3);
+    let svg = std::fs::read_to_string(out.join("bench-ms-per-frame-4x-blend.svg")).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("merged"));
+    no_temp_files(&out);
+
+    // A second run reuses both bakes.
+    let again = run(dir.path(), &args[..args.len()], true);
+    let stderr = String::from_utf8_lossy(&again.stderr);
+    assert_eq!(stderr.matches("reusing").count(), 2, "{stderr}");
+}
+
+fn no_temp_files(dir: &Path) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(!name.contains(".tmp"), "left behind: {name}");
+    }
+}
+
+#[test]
+fn bench_rejects_bad_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(
+        dir.path(),
+        &["bench", "demo:10000", "--path", PATH, "--samples", "2"],
+        false,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--samples takes 1 and/or 4"), "{err}");
+    let out = run(
+        dir.path(),
+        &[
+            "bench",
+            "demo:10000",
+            "--path",
+            PATH,
+            "--methods",
+            "zbuffer",
+        ],
+        false,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown method `zbuffer`"));
+    let out = run(dir.path(), &["bench", "nowhere.glb", "--path", PATH], false);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nowhere.glb"));
+}
+
+#[test]
+fn bench_sweep_through_the_cli() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    let out_s = out.display().to_string();
+    let v = run_json(
+        dir.path(),
+        &[
+            "bench",
+            "demo:10000",
+            "--path",
+            PATH,
+            "--size",
+            "48x48",
+            "--samples",
+            "4",
+            "--max-frames",
+            "2",
+            "--sweep",
+            "--sweep-factors",
+            "bridge,segment",
+            "--out",
+            &out_s,
+        ],
+    );
+    let points = v["points"].as_array().expect("points");
+    let factors: std::collections::BTreeSet<&str> = points
+        .iter()
+        .map(|p| p["factor"].as_str().unwrap())
+        .collect();
+    assert_eq!(factors, ["bridge", "segment"].into_iter().collect());
+    assert!(points.iter().any(|p| p["is_default"] == true));
+    for p in points {
+        assert!(f(&p["index_triangles"]) >= f(&p["unique_visible"]), "{p}");
+        assert!(f(&p["baked_bytes"]) > 0.0);
+    }
+    for name in ["sweep.csv", "sweep.json", "sweep-error-vs-bake-time.svg"] {
+        assert!(out.join(name).is_file(), "{name} missing");
+    }
+    no_temp_files(&out);
+}
+
+#[test]
+fn bench_scaling_through_the_cli() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("scaling");
+    let out_s = out.display().to_string();
+    let v = run_json(
+        dir.path(),
+        &[
+            "bench",
+            "demo",
+            "--path",
+            "demo",
+            "--scaling",
+            "frames",
+            "--quick",
+            "--out",
+            &out_s,
+        ],
+    );
+    assert_eq!(v["axis"], "frames");
+    let rows = v["rows"].as_array().expect("rows");
+    assert!(rows.len() >= 3, "{v}");
+    for r in rows {
+        assert!(f(&r["merge_seconds"]) >= 0.0);
+        assert!(f(&r["index_triangles"]) >= f(&r["unique_visible"]), "{r}");
+    }
+    assert!(out.join("scaling-frames.csv").is_file());
+    assert!(out.join("scaling-frames.json").is_file());
+    no_temp_files(&out);
+}
