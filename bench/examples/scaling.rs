@@ -90,9 +90,10 @@ fn main() -> ExitCode {
 
 fn print_table(rows: &[ScalingRow]) {
     println!(
-        "| axis | triangles | frames | \\|G\\| | record s | record s/frame | merge s | index/\\|G\\| | draws mean / max | layers | peak RSS MiB |"
+        "| axis | triangles | frames | \\|G\\| | record s (CPU s) | record s/frame | merge s (CPU s) | index/\\|G\\| | draws mean / max | layers | peak RSS MiB |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    let cpu = |c: Option<f64>| c.map_or(String::new(), |c| format!(" ({c:.1})"));
     let num = |x: f64, d: usize| {
         if x.is_finite() {
             format!("{x:.d$}")
@@ -102,14 +103,16 @@ fn print_table(rows: &[ScalingRow]) {
     };
     for r in rows {
         println!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} / {} | {:.1} | {} |",
+            "| {} | {} | {} | {} | {}{} | {} | {}{} | {:.2} | {:.1} / {} | {:.1} | {} |",
             r.axis,
             r.triangles,
             r.frames,
             r.unique_visible,
             num(r.record_seconds, 2),
+            cpu(r.record_cpu_seconds),
             num(r.record_seconds_per_frame, 3),
             num(r.merge_seconds, 2),
+            cpu(r.merge_cpu_seconds),
             r.index_ratio(),
             r.draws_per_frame_mean,
             r.draws_per_frame_max,

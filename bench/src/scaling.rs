@@ -143,6 +143,13 @@ pub struct ScalingRow {
     pub peak_rss_mib: Option<f64>,
     /// Mean layers peeled per frame (both phases together); 2 for synthetic recordings.
     pub layers_mean: f64,
+    /// CPU time (user + system, every thread of the process: lavapipe's too) spent during
+    /// the record call, in seconds; `None` for synthetic recordings and where
+    /// `/proc/self/stat` cannot be read. Less sensitive than wall time to other processes
+    /// sharing the machine.
+    pub record_cpu_seconds: Option<f64>,
+    /// CPU time spent during the merge call (as [`Self::record_cpu_seconds`]).
+    pub merge_cpu_seconds: Option<f64>,
 }
 
 impl ScalingRow {
@@ -216,6 +223,12 @@ pub fn growth(rows: &[ScalingRow]) -> Vec<Growth> {
             ("record_seconds", |r| r.record_seconds),
             ("record_seconds_per_frame", |r| r.record_seconds_per_frame),
             ("merge_seconds", |r| r.merge_seconds),
+            ("record_cpu_seconds", |r| {
+                r.record_cpu_seconds.unwrap_or(f64::NAN)
+            }),
+            ("merge_cpu_seconds", |r| {
+                r.merge_cpu_seconds.unwrap_or(f64::NAN)
+            }),
             ("unique_visible", |r| r.unique_visible as f64),
             ("index_triangles", |r| r.index_triangles as f64),
             ("index_per_unique_visible", ScalingRow::index_ratio),
@@ -323,6 +336,23 @@ fn peak_rss_mib() -> Option<f64> {
     Some(kb / 1024.0)
 }
 
+/// CPU time (user + system) of this process so far, in seconds, from `/proc/self/stat`
+/// (clock ticks of the Linux ABI's fixed `USER_HZ` = 100).
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) start with the state (field 3);
+    // utime and stime are fields 14 and 15.
+    let rest = &stat[stat.rfind(')')? + 1..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |k: usize| fields.get(k - 3)?.parse::<u64>().ok();
+    Some((ticks(14)? + ticks(15)?) as f64 / 100.0)
+}
+
+/// CPU seconds since `start` (a [`cpu_seconds`] reading).
+fn cpu_since(start: Option<f64>) -> Option<f64> {
+    Some(cpu_seconds()? - start?)
+}
+
 /// Starts a peak-memory window: the peak is attributable to the run only if it was reset.
 struct PeakWindow(bool);
 
@@ -375,6 +405,7 @@ fn run_real(
         config.size.0, config.size.1, config.samples
     ));
     let window = PeakWindow::start();
+    let cpu0 = cpu_seconds();
     let t0 = Instant::now();
     let step = (n / 10).max(1);
     let rec: Recording = record(gpu, &job, None, |p| {
@@ -389,8 +420,10 @@ fn run_real(
         }
     })?;
     let record_seconds = t0.elapsed().as_secs_f64();
+    let record_cpu_seconds = cpu_since(cpu0);
     progress(&format!(
-        "{axis}: recorded in {record_seconds:.2} s, |G| = {}; merging",
+        "{axis}: recorded in {record_seconds:.2} s ({} CPU), |G| = {}; merging",
+        record_cpu_seconds.map_or("?".into(), |c| format!("{c:.1} s")),
         rec.unique_visible.len()
     ));
     let layers: u64 = rec
@@ -399,9 +432,11 @@ fn run_real(
         .map(|f| u64::from(f.layers[0]) + u64::from(f.layers[1]))
         .sum();
     let measure = |axis: &str, opts: &MergeOptions, window: PeakWindow| {
+        let cpu1 = cpu_seconds();
         let t1 = Instant::now();
         let baked = trisort_merger::merge(std::slice::from_ref(&rec), opts)?;
         let merge_seconds = t1.elapsed().as_secs_f64();
+        let merge_cpu_seconds = cpu_since(cpu1);
         let peak = window.peak();
         let s = &baked.stats;
         let row = ScalingRow {
@@ -417,9 +452,12 @@ fn run_real(
             draws_per_frame_max: s.draws_per_frame_max,
             peak_rss_mib: peak,
             layers_mean: layers as f64 / rec.frames.len().max(1) as f64,
+            record_cpu_seconds,
+            merge_cpu_seconds,
         };
         progress(&format!(
-            "{axis}: merged in {merge_seconds:.2} s: {} copies ({:.2} x |G|), draws {:.1} / {}",
+            "{axis}: merged in {merge_seconds:.2} s ({} CPU): {} copies ({:.2} x |G|), draws {:.1} / {}",
+            merge_cpu_seconds.map_or("?".into(), |c| format!("{c:.1} s")),
             s.index_triangles,
             row.index_ratio(),
             s.draws_per_frame_mean,
@@ -543,6 +581,7 @@ fn synthetic(frames: u32, segment: u32, progress: &dyn Fn(&str)) -> Result<Scali
         parts.len()
     ));
     let window = PeakWindow::start();
+    let cpu0 = cpu_seconds();
     let t0 = Instant::now();
     let baked = trisort_merger::merge(
         &parts,
@@ -552,6 +591,7 @@ fn synthetic(frames: u32, segment: u32, progress: &dyn Fn(&str)) -> Result<Scali
         },
     )?;
     let merge_seconds = t0.elapsed().as_secs_f64();
+    let merge_cpu_seconds = cpu_since(cpu0);
     let peak = window.peak();
     let s = &baked.stats;
     progress(&format!(
@@ -571,13 +611,16 @@ fn synthetic(frames: u32, segment: u32, progress: &dyn Fn(&str)) -> Result<Scali
         draws_per_frame_max: s.draws_per_frame_max,
         peak_rss_mib: peak,
         layers_mean: layers as f64 / f64::from(frames),
+        record_cpu_seconds: None,
+        merge_cpu_seconds,
     })
 }
 
 /// The CSV columns, in [`ScalingRow`]'s field order.
 const CSV_HEADER: &str = "axis,triangles,frames,unique_visible,record_seconds,\
 record_seconds_per_frame,merge_seconds,index_triangles,index_per_unique_visible,\
-draws_per_frame_mean,draws_per_frame_max,peak_rss_mib,layers_mean";
+draws_per_frame_mean,draws_per_frame_max,peak_rss_mib,layers_mean,record_cpu_seconds,\
+merge_cpu_seconds";
 
 /// A number for the CSV: empty when not finite.
 fn csv_number(x: f64) -> String {
@@ -607,6 +650,8 @@ pub fn to_csv(rows: &[ScalingRow]) -> String {
             r.draws_per_frame_max.to_string(),
             r.peak_rss_mib.map_or(String::new(), csv_number),
             csv_number(r.layers_mean),
+            r.record_cpu_seconds.map_or(String::new(), csv_number),
+            r.merge_cpu_seconds.map_or(String::new(), csv_number),
         ];
         out.push_str(&fields.join(","));
         out.push('\n');
@@ -677,6 +722,12 @@ pub fn write_outputs(rows: &[ScalingRow], out_dir: &Path, name: &str) -> Result<
                 series(
                     "record",
                     points(rows, AXIS_TRIANGLES, tri, |r| r.record_seconds),
+                ),
+                series(
+                    "record (CPU time)",
+                    points(rows, AXIS_TRIANGLES, tri, |r| {
+                        r.record_cpu_seconds.unwrap_or(f64::NAN)
+                    }),
                 ),
                 series(
                     "merge",

@@ -47,9 +47,16 @@ fn check_row(r: &ScalingRow) {
         "{r:?}"
     );
     assert!(r.layers_mean >= 2.0, "{r:?}");
+    if let Some(c) = r.merge_cpu_seconds {
+        assert!(c >= 0.0, "{r:?}");
+    }
     if r.axis == AXIS_SYNTHETIC {
         assert!(r.record_seconds.is_nan() && r.record_seconds_per_frame.is_nan());
+        assert_eq!(r.record_cpu_seconds, None);
     } else {
+        if cfg!(target_os = "linux") {
+            assert!(r.record_cpu_seconds.unwrap() >= 0.0, "{r:?}");
+        }
         assert!(r.record_seconds > 0.0, "{r:?}");
         let per_frame = r.record_seconds / f64::from(r.frames);
         assert!(
