@@ -55,11 +55,6 @@ pub trait Method {
     fn encode(&self, enc: &mut wgpu::CommandEncoder, frame: u32, stats: Option<&wgpu::QuerySet>);
     /// Renders frame `frame` and reads it back as 8-bit sRGB RGBA.
     fn image(&self, frame: u32) -> Result<Vec<u8>, BenchError>;
-    /// Fragments shaded for frame `frame`, where the method counts them itself (OIT's node
-    /// counter); `None`: the harness counts them with its counting pass ([`Method::streams`]).
-    fn shaded_fragments(&self, _frame: u32) -> Result<Option<u64>, BenchError> {
-        Ok(None)
-    }
     /// The triangle streams the method rasterizes for frame `frame`, in submission order, for
     /// the harness's fragment count (see [`crate::harness::FragmentCounter`]).
     fn streams(&self, frame: u32) -> Vec<Stream>;

@@ -67,9 +67,6 @@ impl Method for OitMethod<'_> {
     fn image(&self, frame: u32) -> Result<Vec<u8>, BenchError> {
         Ok(self.renderer.render(frame)?.rgba8)
     }
-    fn shaded_fragments(&self, frame: u32) -> Result<Option<u64>, BenchError> {
-        Ok(Some(self.renderer.render(frame)?.fragments))
-    }
     fn streams(&self, _frame: u32) -> Vec<Stream> {
         vec![Stream {
             indices: self.all.clone(),
@@ -99,7 +96,7 @@ impl<'g> PeelingMethod<'g> {
         mode: Mode,
         max_layers: u32,
     ) -> Result<PeelingMethod<'g>, BenchError> {
-        let renderer = PeelingRenderer::new(
+        let renderer = PeelingRenderer::with_glass_opacity(
             gpu,
             geometry,
             frames,
@@ -107,6 +104,7 @@ impl<'g> PeelingMethod<'g> {
             view.samples,
             mode,
             max_layers,
+            view.glass_opacity,
         )?;
         Ok(PeelingMethod {
             gpu,
@@ -132,17 +130,19 @@ impl Method for PeelingMethod<'_> {
         self.gpu
     }
     fn variant(&self) -> String {
-        "per-sample (depth, id) peel, layer count found before timing".into()
+        "back-to-front per-sample (depth, id) peel + per-pixel composite per layer; layer count found before timing".into()
     }
     fn prepare(&self, frame: u32) -> Result<(), BenchError> {
         self.renderer.layers(frame)?;
         Ok(())
     }
+    // Each layer is two geometry passes over every triangle: the per-sample peel pass (ids
+    // and depths) and the per-pixel compositing pass.
     fn triangles(&self, frame: u32) -> u64 {
-        self.renderer.triangles() * self.layers(frame) as u64
+        2 * self.renderer.triangles() * self.layers(frame) as u64
     }
     fn draws(&self, frame: u32) -> u32 {
-        self.layers(frame)
+        2 * self.layers(frame)
     }
     fn stat_slots(&self, frame: u32) -> u32 {
         self.layers(frame)
@@ -154,12 +154,21 @@ impl Method for PeelingMethod<'_> {
         Ok(self.renderer.render(frame)?.rgba8)
     }
     fn streams(&self, frame: u32) -> Vec<Stream> {
-        vec![Stream {
-            indices: self.all.clone(),
-            depth: None,
-            repeat: self.layers(frame),
-            per_sample: true,
-        }]
+        let layers = self.layers(frame);
+        vec![
+            Stream {
+                indices: self.all.clone(),
+                depth: None,
+                repeat: layers,
+                per_sample: true,
+            },
+            Stream {
+                indices: self.all.clone(),
+                depth: None,
+                repeat: layers,
+                per_sample: false,
+            },
+        ]
     }
 }
 

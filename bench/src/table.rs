@@ -146,7 +146,8 @@ pub struct MethodRow {
     pub fragment_invocations_per_frame: Option<f64>,
     /// Mean vertex-shader invocations per frame (pipeline statistics).
     pub vertex_invocations_per_frame: Option<f64>,
-    /// Mean fragments shaded per frame: the method's own count (OIT) or the counting pass's.
+    /// Mean fragments shaded per frame (the counting pass: fragments passing the depth test
+    /// in submission order, times layers and, for per-sample shading, samples).
     pub fragments_shaded_per_frame: f64,
     /// Mean pixels covered per frame (counting pass).
     pub pixels_covered_per_frame: f64,
@@ -354,10 +355,7 @@ pub fn run_group(
                 }
             }
             let counted = counter.count(f, &m.streams(f), view.samples)?;
-            let shaded = match m.shaded_fragments(f)? {
-                Some(n) => n,
-                None => counted.fragments,
-            };
+            let shaded = counted.fragments;
             a.shaded += shaded as f64;
             a.covered += counted.pixels_covered as f64;
             a.overdraw += if counted.pixels_covered > 0 {

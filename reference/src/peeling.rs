@@ -128,6 +128,9 @@ impl<'g> PeelingRenderer<'g> {
     /// Errors: [`ReferenceError::Invalid`] for `Saturate`, an empty size or another sample
     /// count; [`ReferenceError::Unsupported`] where the device lacks `PRIMITIVE_INDEX` or
     /// cannot multisample the id, depth or colour targets at `samples`.
+    ///
+    /// Transmissive glass is drawn at opacity 0 (the recorder's default); see
+    /// [`PeelingRenderer::with_glass_opacity`].
     pub fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
@@ -136,6 +139,25 @@ impl<'g> PeelingRenderer<'g> {
         samples: u32,
         mode: Mode,
         max_layers: u32,
+    ) -> Result<Self, ReferenceError> {
+        let glass = trisort_format::RecordSettings::default().glass_opacity;
+        PeelingRenderer::with_glass_opacity(
+            gpu, geometry, frames, size, samples, mode, max_layers, glass,
+        )
+    }
+
+    /// [`PeelingRenderer::new`] with transmissive glass drawn at `glass_opacity` (a baked
+    /// file's recorded opacity, or the one it is played at).
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_glass_opacity(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        size: (u32, u32),
+        samples: u32,
+        mode: Mode,
+        max_layers: u32,
+        glass_opacity: f32,
     ) -> Result<Self, ReferenceError> {
         if size.0 == 0 || size.1 == 0 || !(samples == 1 || samples == 4) {
             return Err(ReferenceError::Invalid(format!(
@@ -177,7 +199,7 @@ impl<'g> PeelingRenderer<'g> {
             width: size.0,
             height: size.1,
             samples,
-            glass_opacity: 0.0,
+            glass_opacity,
         };
         let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
         let mut index_data: Vec<u32> = geometry.triangles.iter().flatten().copied().collect();
