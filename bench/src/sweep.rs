@@ -497,7 +497,8 @@ pub fn run(
         height: h,
         samples: config.samples,
         saturation: config.saturation,
-        glass_opacity: config.glass_opacity,
+        // + 0.0: −0 is 0 here, so that it matches the listed value 0 bit for bit.
+        glass_opacity: config.glass_opacity + 0.0,
         max_layers: MAX_LAYERS,
     };
     let variants = variants(config, base);
