@@ -7,7 +7,9 @@
 //!
 //! Robust to degenerate input: empty series, non-finite points (skipped), a single point or
 //! all-equal values (the range is padded), and zero or negative values on a log axis
-//! (skipped, and the number of points left out is written under the chart).
+//! (skipped, and the number of points left out is written under the chart). A log axis whose
+//! positive values span less than a factor of 10 is drawn linear: plotters labels only powers
+//! of ten, which would leave it with one label or none.
 
 use std::ops::Range;
 use std::path::Path;
@@ -36,9 +38,10 @@ pub struct Chart {
     pub x_label: String,
     /// Label of the vertical axis.
     pub y_label: String,
-    /// Logarithmic horizontal axis (points with x ≤ 0 are left out).
+    /// Logarithmic horizontal axis (points with x ≤ 0 are left out). Drawn linear, with every
+    /// point, where the positive values span less than a factor of 10.
     pub log_x: bool,
-    /// Logarithmic vertical axis (points with y ≤ 0 are left out).
+    /// Logarithmic vertical axis (points with y ≤ 0 are left out); linear as for `log_x`.
     pub log_y: bool,
     /// The series, one colour and marker shape each.
     pub series: Vec<Series>,
@@ -193,7 +196,20 @@ fn log_range(values: impl Iterator<Item = f64>) -> Range<f64> {
     if hi_exp <= lo_exp {
         hi_exp = lo_exp + 1.0;
     }
-    10f64.powf(lo_exp)..10f64.powf(hi_exp)
+    // A hair below the lower decade, so that rounding in plotters' tick search keeps it.
+    10f64.powf(lo_exp) * (1.0 - 1e-9)..10f64.powf(hi_exp)
+}
+
+/// Whether a log axis is worth drawing: the positive finite values span at least a factor of
+/// 10. Below that plotters' log axis labels at most one tick (it labels powers of ten only),
+/// so the axis is drawn linear.
+fn spans_a_decade(values: impl Iterator<Item = f64>) -> bool {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    lo <= hi && hi / lo >= 10.0
 }
 
 /// A short tick label: at most 4 significant digits, exponent form for very large or small.
@@ -225,14 +241,16 @@ pub fn format_number(v: f64) -> String {
 
 /// Renders the chart to an SVG string.
 fn render_svg(chart: &Chart, style: Style, labels: &[Vec<String>]) -> Result<String, String> {
+    let all = || chart.series.iter().flat_map(|s| s.points.iter().copied());
+    let log_x = chart.log_x && spans_a_decade(all().map(|p| p.0));
+    let log_y = chart.log_y && spans_a_decade(all().map(|p| p.1));
     let mut left_out = 0;
     let series: Vec<Series3<'_>> = chart
         .series
         .iter()
         .enumerate()
         .map(|(i, s)| {
-            let (pts, point_labels, n) =
-                drawable(&s.points, labels.get(i), chart.log_x, chart.log_y);
+            let (pts, point_labels, n) = drawable(&s.points, labels.get(i), log_x, log_y);
             left_out += n;
             (i, s.name.as_str(), pts, point_labels)
         })
@@ -251,7 +269,7 @@ fn render_svg(chart: &Chart, style: Style, labels: &[Vec<String>]) -> Result<Str
     let x_log = log_range(xs());
     let y_log = log_range(ys());
     let mut svg = String::new();
-    match (chart.log_x, chart.log_y) {
+    match (log_x, log_y) {
         (false, false) => draw(&mut svg, chart, style, &series, note, x_lin, y_lin)?,
         (true, false) => draw(
             &mut svg,
@@ -624,6 +642,26 @@ mod tests {
         let lin = write(&chart(c.series.clone(), false, false), Style::Points);
         assert!(!lin.contains("not shown"));
         assert_eq!(lin.matches("<circle").count(), 6);
+    }
+
+    #[test]
+    fn narrow_log_ranges_are_drawn_linear_and_decades_are_labelled() {
+        // 0.28 … 0.37: under a decade, so linear, every point shown, several labels.
+        let narrow = chart(
+            vec![series("size", &[(0.28, 1.0), (0.37, 2.0), (0.0, 3.0)])],
+            true,
+            false,
+        );
+        let svg = write(&narrow, Style::Points);
+        assert!(!svg.contains("not shown"));
+        assert_eq!(svg.matches("<circle").count(), 4);
+        // 0.002 … 0.9 on a log axis: the decades 0.001, 0.01, 0.1 and 1 are all labelled.
+        let wide = chart(vec![series("t", &[(0.002, 1.0), (0.9, 2.0)])], true, false);
+        let svg = write(&wide, Style::Points);
+        for label in ["0.001", "0.01", "0.1", "1"] {
+            let text = format!(">\n{label}\n</text>");
+            assert!(svg.contains(&text), "missing tick {label}");
+        }
     }
 
     #[test]
