@@ -9,7 +9,7 @@
 use serde::Serialize;
 use trisort_format::{Baked, FrameState, Geometry, Recording};
 use trisort_player::Mode;
-use trisort_reference::{compare, ExactReference, ReferenceConfig, RemovedEdges};
+use trisort_reference::{compare, ExactReference, ReferenceConfig, ReferenceError, RemovedEdges};
 use trisort_shaders::gpu::Gpu;
 
 use crate::harness::{pipeline_statistics, time_methods, FragmentCounter, Summary, Timing};
@@ -166,6 +166,17 @@ pub struct GroupReport {
     pub mode: String,
     /// Rows.
     pub rows: Vec<MethodRow>,
+    /// Methods left out because the device cannot run them at this configuration.
+    pub skipped: Vec<Skipped>,
+}
+
+/// A method left out of a group.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Skipped {
+    /// Method name.
+    pub method: String,
+    /// Why (the renderer's message).
+    pub why: String,
 }
 
 impl GroupReport {
@@ -189,6 +200,7 @@ pub fn run_group(
     let view = input.view;
     let mode = input.mode;
     let mut methods: Vec<(String, Box<dyn Method + '_>)> = Vec::new();
+    let mut skipped = Vec::new();
     let source = source_baked(input.baked, input.recording)?;
     for &kind in input.methods {
         if !kind.supports(mode) {
@@ -253,8 +265,20 @@ pub fn run_group(
                 }
             }
             MethodKind::Oit | MethodKind::Peeling => {
-                if let Some(m) = crate::rivals::build(kind, gpu, input, progress)? {
-                    methods.push((kind.name().into(), m));
+                match crate::rivals::build(kind, gpu, input, progress) {
+                    Ok(Some(m)) => methods.push((kind.name().into(), m)),
+                    Ok(None) => {}
+                    // A rival the device cannot run at this size (OIT's node pool over the
+                    // storage-buffer limit) is left out of the table, saying why, rather
+                    // than losing the other methods' figures.
+                    Err(BenchError::Reference(ReferenceError::Unsupported(why))) => {
+                        progress(&format!("leaving out {}: {why}", kind.name()));
+                        skipped.push(Skipped {
+                            method: kind.name().into(),
+                            why,
+                        });
+                    }
+                    Err(e) => return Err(e),
                 }
             }
         }
@@ -421,6 +445,7 @@ pub fn run_group(
         samples: view.samples,
         mode: mode.name().into(),
         rows,
+        skipped,
     })
 }
 

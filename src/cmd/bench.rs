@@ -174,6 +174,13 @@ fn bake_for(
     let merge = MergeOpts::defaults();
     let (recording, baked, record_s, merge_s) = bake(gpu, scene, timeline, &record, &merge, &path)?;
     let bytes = std::fs::metadata(&path)?.len();
+    say(&format!(
+        "baked {} in {:.1} s (record {record_s:.1} s, merge {merge_s:.1} s): {} index triangles, |G| = {}",
+        path.display(),
+        record_s + merge_s,
+        baked.stats.index_triangles,
+        baked.stats.unique_visible
+    ));
     Ok(BakeRun {
         samples,
         baked,
@@ -523,6 +530,9 @@ fn markdown(value: &serde_json::Value, groups: &[GroupReport], bakes: &[BakeRun]
                 r.error.max_channel_diff,
                 r.error.flip_mean,
             );
+        }
+        for k in &g.skipped {
+            let _ = writeln!(s, "- {} left out: {}", k.method, k.why);
         }
         for r in g.rows.iter().filter(|r| !r.variant.is_empty()) {
             let _ = writeln!(s, "- {}: {}", r.method, r.variant);
