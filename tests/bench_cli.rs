@@ -278,3 +278,51 @@ fn bench_scaling_through_the_cli() {
     assert!(out.join("scaling-frames.json").is_file());
     no_temp_files(&out);
 }
+
+/// At 1100×1100 with 4 samples OIT's default pool (16 fragments per sample) exceeds the
+/// storage-buffer binding limit of lavapipe and most GPUs: the bench leaves OIT out, says why,
+/// and still reports the other methods.
+#[test]
+fn bench_leaves_out_a_rival_the_device_cannot_run() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out_s = dir.path().join("big").display().to_string();
+    let v = run_json(
+        dir.path(),
+        &[
+            "bench",
+            "demo:10000",
+            "--path",
+            "orbit:frames=1,degrees=0,elevation=20,distance=6",
+            "--size",
+            "1100x1100",
+            "--samples",
+            "4",
+            "--mode",
+            "blend",
+            "--methods",
+            "merged,oit",
+            "--repeats",
+            "1",
+            "--no-unvalidated",
+            "--out",
+            &out_s,
+        ],
+    );
+    let g = &v["groups"][0];
+    let limit = g["skipped"].as_array().expect("skipped");
+    if limit.is_empty() {
+        // A device that binds 2 GiB storage buffers runs it.
+        assert!(v["methods"]["oit"].is_object());
+        return;
+    }
+    assert_eq!(limit[0]["method"], "oit");
+    assert!(
+        limit[0]["why"].as_str().unwrap().contains("storage buffer"),
+        "{g}"
+    );
+    assert!(v["methods"]["oit"].is_null());
+    assert!(f(&v["methods"]["merged"]["ms_per_frame"]) > 0.0);
+}
