@@ -112,3 +112,28 @@ fn ten_thousand_frames_from_four_recordings_merge_in_segments() {
     assert_eq!(report["ok"], true, "{}", report["problems"]);
     assert_eq!(report["frames"].as_array().unwrap().len() as u32, FRAMES);
 }
+
+/// `merge` cuts paths into segments of 64 frames by default, so a path that turns the scene
+/// around several times still draws at most 64 commands per frame; `--segment 0` asks for one
+/// matrix over the whole path.
+#[test]
+fn merge_bounds_draws_per_frame_by_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let rec = turntable(&Turntable {
+        objects: 12,
+        sides: 16,
+        frames: 300,
+        samples: 64,
+        degrees: 1080.0,
+        ..Turntable::default()
+    });
+    trisort_format::write_file_atomic(FileKind::Recording, &d.join("t.rec"), &rec).unwrap();
+    let v = run_json(d, &["merge", "t.rec", "-o", "default.baked"]);
+    assert_eq!(v["segment"], 64, "{v}");
+    assert!(v["draws_per_frame_max"].as_u64().unwrap() <= 64, "{v}");
+    let one = run_json(d, &["merge", "t.rec", "-o", "one.baked", "--segment", "0"]);
+    assert!(one["segment"].is_null(), "{one}");
+    // On this path one matrix needs no more copies than its segments (the price of the bound).
+    assert!(one["index_triangles"].as_u64() <= v["index_triangles"].as_u64());
+}
