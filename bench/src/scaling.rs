@@ -200,7 +200,8 @@ pub fn growth_exponent(points: &[(f64, f64)]) -> Option<f64> {
 /// The series [`write_outputs`] fits, per axis present in `rows`: on the triangle axis
 /// record seconds, merge seconds, |G| and index triangles against triangles; on both frame
 /// axes record seconds per frame (real frames only), merge seconds, index triangles and
-/// index/|G| against frames; peak RSS against the axis' x where it was measured.
+/// index/|G| against frames; peak RSS against the axis' x where it was measured; and on the
+/// triangle axis also merge seconds against |G|.
 pub fn growth(rows: &[ScalingRow]) -> Vec<Growth> {
     type Column = (&'static str, fn(&ScalingRow) -> f64);
     let mut out = Vec::new();
@@ -237,7 +238,19 @@ pub fn growth(rows: &[ScalingRow]) -> Vec<Growth> {
         if axis == AXIS_SYNTHETIC {
             ys.retain(|(name, _)| !name.starts_with("record_"));
         }
-        for (name, y) in ys {
+        let mut fits: Vec<(Column, Column)> = ys.into_iter().map(|y| (x, y)).collect();
+        if axis == AXIS_TRIANGLES {
+            // The merger works on G, not on the scene: its cost against |G|.
+            let g: Column = ("unique_visible", |r| r.unique_visible as f64);
+            fits.push((g, ("merge_seconds", |r| r.merge_seconds)));
+            fits.push((
+                g,
+                ("merge_cpu_seconds", |r| {
+                    r.merge_cpu_seconds.unwrap_or(f64::NAN)
+                }),
+            ));
+        }
+        for (x, (name, y)) in fits {
             let mut pts: Vec<(f64, f64)> = of_axis
                 .iter()
                 .map(|r| (x.1(r), y(r)))
@@ -704,7 +717,7 @@ pub fn write_outputs(rows: &[ScalingRow], out_dir: &Path, name: &str) -> Result<
 
     let has = |axis: &str| rows.iter().any(|r| r.axis == axis);
     let exp = |pts: &[(f64, f64)]| {
-        growth_exponent(pts).map_or(String::new(), |e| format!(" (slope {e:.2})"))
+        growth_exponent(pts).map_or(String::new(), |e| format!(" (log-log slope {e:.2})"))
     };
     let series = |label: &str, pts: Vec<(f64, f64)>| Series {
         name: format!("{label}{}", exp(&pts)),
