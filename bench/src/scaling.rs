@@ -83,8 +83,9 @@ impl ScalingConfig {
 
     /// The BENCHMARKS run: 10 k … 5 M triangles (4 frames of a full orbit each) and 10 … 1,000
     /// frames of the 20 k demo car (3.6° per frame: 100 frames make one turn, 1,000 ten), both
-    /// at 128×128 with 4 samples; synthetic long paths of 100 … 10,000 frames in segments of
-    /// 100 (24 objects × 16 sides, 128 samples, 0.36° per frame, as `tests/long_paths.rs`).
+    /// at 128×128 with 4 samples; synthetic long paths of 100 … 10,000 frames (24 objects × 16
+    /// sides, 128 samples, 0.36° per frame, as `tests/long_paths.rs`). Segments of 64 frames,
+    /// `trisort merge`'s default.
     pub fn full() -> Self {
         ScalingConfig {
             size: (128, 128),
@@ -94,7 +95,7 @@ impl ScalingConfig {
             ],
             frame_counts: vec![10, 30, 100, 300, 1_000],
             synthetic_frames: vec![100, 300, 1_000, 3_000, 10_000],
-            segment: 100,
+            segment: 64,
             path: "orbit:frames={frames},degrees={frames*3.6},elevation=15,distance=2.75".into(),
             triangle_axis_frames: 4,
             triangle_path: "orbit:frames={frames},degrees=360,elevation=15,distance=2.75".into(),
