@@ -10,6 +10,7 @@ use std::path::Path;
 
 use serde_json::json;
 use support::*;
+use trisort_format::fixtures::quad_triangles;
 use trisort_format::{Baked, FileKind, Recording};
 
 // ---------------------------------------------------------------------------------------------
@@ -34,12 +35,10 @@ fn part(material: usize, triangles: Vec<[[f32; 3]; 3]>) -> Part {
     }
 }
 
-/// Two triangles spanning [x0,x1]×[y0,y1] at depth z, ids in this order.
+/// Two triangles spanning [x0,x1]×[y0,y1] at depth z, ids in this order (the corners of
+/// [`trisort_format::fixtures::quad`]).
 fn quad(x0: f32, x1: f32, y0: f32, y1: f32, z: f32) -> Vec<[[f32; 3]; 3]> {
-    vec![
-        [[x0, y0, z], [x1, y0, z], [x1, y1, z]],
-        [[x0, y0, z], [x1, y1, z], [x0, y1, z]],
-    ]
+    quad_triangles(x0, x1, y0, y1, z, z).to_vec()
 }
 
 /// A glTF 2.0 binary of `parts` (one root node each, in order: triangle ids follow it).

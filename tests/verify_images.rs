@@ -3,10 +3,10 @@
 //! known answers and on real scenes; and the mutation check (a file whose order was corrupted
 //! on purpose fails).
 
-use glam::{DMat4, DVec3};
+use glam::DVec3;
+use trisort_format::fixtures::{frame_at, material, quad, scene, settings};
 use trisort_format::{
-    AlphaMode, Baked, Camera, FrameState, Geometry, Material, Node, Phase, RecordSettings,
-    Recording, Vertex,
+    AlphaMode, Baked, FrameState, Geometry, Material, Phase, RecordSettings, Recording,
 };
 use trisort_player::Mode;
 use trisort_recorder::{record, RecordJob};
@@ -14,71 +14,6 @@ use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier};
 use trisort_shaders::gpu::Gpu;
 
 // ---- scenes built here: camera at the origin looking down −Z ----
-
-/// Adds a quad with corners (x0, y0, z0), (x1, y0, z1), (x1, y1, z1), (x0, y1, z0), facing +Z.
-#[allow(clippy::too_many_arguments)]
-fn quad(g: &mut Geometry, x0: f32, x1: f32, y0: f32, y1: f32, z0: f32, z1: f32, material: u32) {
-    let base = g.vertices.len() as u32;
-    for (x, y, z) in [(x0, y0, z0), (x1, y0, z1), (x1, y1, z1), (x0, y1, z0)] {
-        g.vertices.push(Vertex {
-            position: [x, y, z],
-            normal: [0.0, 0.0, 1.0],
-            uv: [0.0; 2],
-            material,
-            node: 0,
-        });
-    }
-    g.triangles.push([base, base + 1, base + 2]);
-    g.triangles.push([base, base + 2, base + 3]);
-}
-
-fn material(rgb: [f32; 3], alpha: f32) -> Material {
-    Material {
-        base_color: [rgb[0], rgb[1], rgb[2], alpha],
-        alpha_mode: if alpha < 1.0 {
-            AlphaMode::Blend
-        } else {
-            AlphaMode::Opaque
-        },
-        double_sided: true,
-        ..Default::default()
-    }
-}
-
-fn scene(materials: Vec<Material>) -> Geometry {
-    Geometry {
-        materials,
-        nodes: vec![Node {
-            name: "root".into(),
-            parent: None,
-            rest: DMat4::IDENTITY.to_cols_array(),
-        }],
-        ..Default::default()
-    }
-}
-
-/// Looks from `eye` towards `eye − Z`; y ∈ [−1, 1] fills the view at distance 1.
-fn frame_at(eye: DVec3) -> FrameState {
-    let view = DMat4::look_at_rh(eye, eye - DVec3::Z, DVec3::Y);
-    FrameState {
-        camera: Camera {
-            view: view.to_cols_array(),
-            yfov: 2.0 * 1f64.atan(),
-            znear: 0.01,
-            zfar: Some(100.0),
-        },
-        poses: vec![],
-    }
-}
-
-fn settings(size: u32, samples: u32) -> RecordSettings {
-    RecordSettings {
-        width: size,
-        height: size,
-        samples,
-        ..Default::default()
-    }
-}
 
 // ---- bake and verify through the libraries ----
 

@@ -15,6 +15,7 @@
 pub mod baked;
 pub mod camera;
 pub mod container;
+pub mod fixtures;
 pub mod geometry;
 pub mod recording;
 

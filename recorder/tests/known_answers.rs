@@ -1,68 +1,11 @@
 //! Recorder tests with known answers on scenes built here: camera at the origin looking down
 //! −Z, axis-aligned quads facing it.
 
-use glam::{DMat4, DVec3};
-use trisort_format::{
-    AlphaMode, Camera, FrameState, Geometry, Material, Node, Phase, RecordSettings, Recording,
-    Vertex,
-};
+use glam::DVec3;
+use trisort_format::fixtures::{flat_quad, frame_at, material, scene, settings, tri};
+use trisort_format::{FrameState, Geometry, Phase, RecordSettings, Recording};
 use trisort_recorder::{record, RecordJob};
 use trisort_shaders::gpu::Gpu;
-
-/// Adds a quad (two triangles, ids 2k and 2k+1) spanning [x0,x1]×[y0,y1] at depth z, facing +Z.
-fn quad(g: &mut Geometry, x0: f32, x1: f32, y0: f32, y1: f32, z: f32, material: u32) {
-    let base = g.vertices.len() as u32;
-    for (x, y) in [(x0, y0), (x1, y0), (x1, y1), (x0, y1)] {
-        g.vertices.push(Vertex {
-            position: [x, y, z],
-            normal: [0.0, 0.0, 1.0],
-            uv: [0.0; 2],
-            material,
-            node: 0,
-        });
-    }
-    g.triangles.push([base, base + 1, base + 2]);
-    g.triangles.push([base, base + 2, base + 3]);
-}
-
-fn material(alpha: f32) -> Material {
-    Material {
-        base_color: [1.0, 1.0, 1.0, alpha],
-        alpha_mode: if alpha < 1.0 {
-            AlphaMode::Blend
-        } else {
-            AlphaMode::Opaque
-        },
-        double_sided: true,
-        ..Default::default()
-    }
-}
-
-fn scene(materials: Vec<Material>) -> Geometry {
-    Geometry {
-        materials,
-        nodes: vec![Node {
-            name: "root".into(),
-            parent: None,
-            rest: DMat4::IDENTITY.to_cols_array(),
-        }],
-        ..Default::default()
-    }
-}
-
-/// Looks down −Z from `eye`; fov so that y ∈ [-1, 1] fills the view at distance 1.
-fn frame_at(eye: DVec3) -> FrameState {
-    let view = DMat4::look_at_rh(eye, eye - DVec3::Z, DVec3::Y);
-    FrameState {
-        camera: Camera {
-            view: view.to_cols_array(),
-            yfov: 2.0 * 1f64.atan(),
-            znear: 0.01,
-            zfar: Some(100.0),
-        },
-        poses: vec![],
-    }
-}
 
 fn run(g: &Geometry, frames: &[FrameState], settings: RecordSettings) -> Option<Recording> {
     let gpu = Gpu::for_tests()?;
@@ -79,15 +22,6 @@ fn run(g: &Geometry, frames: &[FrameState], settings: RecordSettings) -> Option<
     Some(record(&gpu, &job, None, |_| {}).expect("recording succeeds"))
 }
 
-fn small(samples: u32) -> RecordSettings {
-    RecordSettings {
-        width: 16,
-        height: 16,
-        samples,
-        ..Default::default()
-    }
-}
-
 fn edge_weight(r: &Recording, f: usize, from: u32, to: u32) -> u32 {
     r.frames[f]
         .edges
@@ -101,11 +35,11 @@ fn three_stacked_transparent_quads() {
     // Full-screen quads at z = -2, -3, -4 (ids 0-1, 2-3, 4-5), alpha 0.5: all visible, and each
     // sample shows front → middle → back. A quad's diagonal splits the samples between its two
     // triangles, so sum the weights per quad.
-    let mut g = scene(vec![material(0.5)]);
+    let mut g = scene(vec![material([1.0, 1.0, 1.0], 0.5)]);
     for z in [-2.0, -3.0, -4.0] {
-        quad(&mut g, -10.0, 10.0, -10.0, 10.0, z, 0);
+        flat_quad(&mut g, -10.0, 10.0, -10.0, 10.0, z, 0);
     }
-    let Some(r) = run(&g, &[frame_at(DVec3::ZERO)], small(4)) else {
+    let Some(r) = run(&g, &[frame_at(DVec3::ZERO)], settings(16, 4)) else {
         return;
     };
     let f = &r.frames[0];
@@ -135,10 +69,10 @@ fn three_stacked_transparent_quads() {
 fn an_opaque_occluder_hides_unless_visible_elsewhere() {
     // Opaque quad (ids 0-1) in front of a small quad (ids 2-3) in frame 0; frame 1 looks from
     // the side so the small quad shows beside the occluder.
-    let mut g = scene(vec![material(1.0)]);
-    quad(&mut g, -0.5, 0.5, -0.5, 0.5, -2.0, 0);
-    quad(&mut g, -0.2, 0.2, -0.2, 0.2, -3.0, 0);
-    let only_front = run(&g, &[frame_at(DVec3::ZERO)], small(4));
+    let mut g = scene(vec![material([1.0, 1.0, 1.0], 1.0)]);
+    flat_quad(&mut g, -0.5, 0.5, -0.5, 0.5, -2.0, 0);
+    flat_quad(&mut g, -0.2, 0.2, -0.2, 0.2, -3.0, 0);
+    let only_front = run(&g, &[frame_at(DVec3::ZERO)], settings(16, 4));
     let Some(only_front) = only_front else { return };
     assert_eq!(
         only_front.unique_visible,
@@ -150,7 +84,7 @@ fn an_opaque_occluder_hides_unless_visible_elsewhere() {
     let r = run(
         &g,
         &[frame_at(DVec3::ZERO), frame_at(DVec3::new(3.0, 0.0, 0.0))],
-        small(4),
+        settings(16, 4),
     )
     .unwrap();
     assert!(
@@ -176,23 +110,15 @@ fn an_opaque_occluder_hides_unless_visible_elsewhere() {
 #[test]
 fn a_small_triangle_missed_by_every_sample_is_ignored() {
     // A tiny triangle: covers a sample centre in frame 0 (placed on one), none in frame 1.
-    let mut g = scene(vec![material(1.0)]);
-    quad(&mut g, -10.0, 10.0, -10.0, 10.0, -5.0, 0); // background, ids 0-1
-                                                     // Pixel (8, 8) centre at 1x is at NDC (1/16, -1/16) → at z=-1, x = 0.0625, y = -0.0625.
+    let mut g = scene(vec![material([1.0, 1.0, 1.0], 1.0)]);
+    // Background, ids 0-1.
+    flat_quad(&mut g, -10.0, 10.0, -10.0, 10.0, -5.0, 0);
+    // Pixel (8, 8) centre at 1x is at NDC (1/16, -1/16) → at z=-1, x = 0.0625, y = -0.0625.
     let (cx, cy, d) = (0.0625f32, -0.0625f32, 0.01f32);
-    let base = g.vertices.len() as u32;
-    for (x, y) in [(cx - d, cy - d), (cx + d, cy - d), (cx, cy + d)] {
-        g.vertices.push(Vertex {
-            position: [x, y, -1.0],
-            normal: [0.0, 0.0, 1.0],
-            uv: [0.0; 2],
-            material: 0,
-            node: 0,
-        });
-    }
-    g.triangles.push([base, base + 1, base + 2]); // id 2
+    let corners = [(cx - d, cy - d), (cx + d, cy - d), (cx, cy + d)].map(|(x, y)| [x, y, -1.0]);
+    tri(&mut g, corners, 0); // id 2
     let shifted = frame_at(DVec3::new(0.03, 0.0, 0.0)); // moves it off every sample centre
-    let Some(r) = run(&g, &[frame_at(DVec3::ZERO), shifted], small(1)) else {
+    let Some(r) = run(&g, &[frame_at(DVec3::ZERO), shifted], settings(16, 1)) else {
         return;
     };
     assert!(r.frames[0].visible.contains(&2), "sampled in frame 0");
@@ -206,10 +132,10 @@ fn a_small_triangle_missed_by_every_sample_is_ignored() {
 
 #[test]
 fn coplanar_quads_are_both_peeled_lower_id_in_front() {
-    let mut g = scene(vec![material(0.5)]);
-    quad(&mut g, -10.0, 10.0, -10.0, 10.0, -2.0, 0); // ids 0-1
-    quad(&mut g, -10.0, 10.0, -10.0, 10.0, -2.0, 0); // ids 2-3, same plane and diagonal
-    let Some(r) = run(&g, &[frame_at(DVec3::ZERO)], small(4)) else {
+    let mut g = scene(vec![material([1.0, 1.0, 1.0], 0.5)]);
+    flat_quad(&mut g, -10.0, 10.0, -10.0, 10.0, -2.0, 0); // ids 0-1
+    flat_quad(&mut g, -10.0, 10.0, -10.0, 10.0, -2.0, 0); // ids 2-3, same plane and diagonal
+    let Some(r) = run(&g, &[frame_at(DVec3::ZERO)], settings(16, 4)) else {
         return;
     };
     let f = &r.frames[0];
@@ -230,11 +156,11 @@ fn coplanar_quads_are_both_peeled_lower_id_in_front() {
 #[test]
 fn a_stack_of_alpha_point_one_stops_at_saturation() {
     // 64 full-screen quads of alpha 0.1: 1 − 0.9^k ≥ 0.998 first at k = 59.
-    let mut g = scene(vec![material(0.1)]);
+    let mut g = scene(vec![material([1.0, 1.0, 1.0], 0.1)]);
     for k in 0..64 {
-        quad(&mut g, -10.0, 10.0, -10.0, 10.0, -2.0 - k as f32 * 0.1, 0);
+        flat_quad(&mut g, -10.0, 10.0, -10.0, 10.0, -2.0 - k as f32 * 0.1, 0);
     }
-    let Some(r) = run(&g, &[frame_at(DVec3::ZERO)], small(1)) else {
+    let Some(r) = run(&g, &[frame_at(DVec3::ZERO)], settings(16, 1)) else {
         return;
     };
     let k = (1..=64).find(|&k| 1.0 - 0.9f64.powi(k) >= 0.998).unwrap() as u32;
@@ -252,7 +178,7 @@ fn a_stack_of_alpha_point_one_stops_at_saturation() {
         &[frame_at(DVec3::ZERO)],
         RecordSettings {
             max_layers: 10,
-            ..small(1)
+            ..settings(16, 1)
         },
     )
     .unwrap();

@@ -11,8 +11,9 @@
 //! `trisort-scene` and `trisort-paths`, which this crate does not depend on: they were
 //! compared outside the test suite (GlassVaseFlowers, AlphaBlendModeTest, CarConcept: equal).
 
-use glam::{DMat4, DVec3};
-use trisort_format::{AlphaMode, Camera, FrameState, Geometry, Material, Node, Vertex};
+use glam::DVec3;
+use trisort_format::fixtures::{frame_at, material, scene, split_quad, tri};
+use trisort_format::{FrameState, Geometry};
 use trisort_player::Mode;
 use trisort_reference::{
     ExactReference, OitConfig, OitFrame, OitRenderer, ReferenceConfig, ReferenceError,
@@ -20,71 +21,6 @@ use trisort_reference::{
 use trisort_shaders::gpu::Gpu;
 
 // ---- scenes built here: camera at the origin looking down −Z ----
-
-fn vertex(p: [f32; 3], material: u32) -> Vertex {
-    Vertex {
-        position: p,
-        normal: [0.0, 0.0, 1.0],
-        uv: [0.0; 2],
-        material,
-        node: 0,
-    }
-}
-
-/// Adds a triangle (counter-clockwise seen from the camera).
-fn tri(g: &mut Geometry, corners: [[f32; 3]; 3], material: u32) {
-    let base = g.vertices.len() as u32;
-    for p in corners {
-        g.vertices.push(vertex(p, material));
-    }
-    g.triangles.push([base, base + 1, base + 2]);
-}
-
-/// Adds a quad with corners (x0, y0, z0), (x1, y0, z1), (x1, y1, z1), (x0, y1, z0), facing +Z.
-#[allow(clippy::too_many_arguments)]
-fn quad(g: &mut Geometry, x0: f32, x1: f32, y0: f32, y1: f32, z0: f32, z1: f32, material: u32) {
-    tri(g, [[x0, y0, z0], [x1, y0, z1], [x1, y1, z1]], material);
-    tri(g, [[x0, y0, z0], [x1, y1, z1], [x0, y1, z0]], material);
-}
-
-fn material(rgb: [f32; 3], alpha: f32) -> Material {
-    Material {
-        base_color: [rgb[0], rgb[1], rgb[2], alpha],
-        alpha_mode: if alpha < 1.0 {
-            AlphaMode::Blend
-        } else {
-            AlphaMode::Opaque
-        },
-        double_sided: true,
-        ..Default::default()
-    }
-}
-
-fn scene(materials: Vec<Material>) -> Geometry {
-    Geometry {
-        materials,
-        nodes: vec![Node {
-            name: "root".into(),
-            parent: None,
-            rest: DMat4::IDENTITY.to_cols_array(),
-        }],
-        ..Default::default()
-    }
-}
-
-/// Looks from `eye` towards `eye − Z`; y ∈ [−1, 1] fills the view at distance 1.
-fn frame_at(eye: DVec3) -> FrameState {
-    let view = DMat4::look_at_rh(eye, eye - DVec3::Z, DVec3::Y);
-    FrameState {
-        camera: Camera {
-            view: view.to_cols_array(),
-            yfov: 2.0 * 1f64.atan(),
-            znear: 0.01,
-            zfar: Some(100.0),
-        },
-        poses: vec![],
-    }
-}
 
 /// Two frames: straight on, and from the side so the quads' edges are not aligned.
 fn frames() -> Vec<FrameState> {
@@ -174,9 +110,9 @@ fn stacked() -> Geometry {
         material([0.1, 0.8, 0.3], 0.35),
         material([0.2, 0.3, 0.95], 0.7),
     ]);
-    quad(&mut g, -1.5, 0.9, -1.2, 0.8, -3.0, -3.0, 0);
-    quad(&mut g, -0.7, 1.6, -0.6, 1.4, -2.2, -4.1, 1);
-    quad(&mut g, -1.1, 1.2, -1.5, 0.3, -4.0, -2.0, 2);
+    split_quad(&mut g, -1.5, 0.9, -1.2, 0.8, -3.0, -3.0, 0);
+    split_quad(&mut g, -0.7, 1.6, -0.6, 1.4, -2.2, -4.1, 1);
+    split_quad(&mut g, -1.1, 1.2, -1.5, 0.3, -4.0, -2.0, 2);
     tri(
         &mut g,
         [[-1.8, -1.7, -2.5], [1.7, -1.1, -3.5], [0.2, 1.9, -3.2]],
@@ -198,8 +134,8 @@ fn coplanar_triangles_break_ties_by_id() {
             material([0.95, 0.1, 0.1], 0.6),
             material([0.1, 0.1, 0.95], 0.6),
         ]);
-        quad(&mut g, -1.0, 1.0, -1.0, 1.0, -2.5, -3.0, first);
-        quad(&mut g, -1.4, 0.6, -0.7, 1.3, -2.5, -3.0, 1 - first);
+        split_quad(&mut g, -1.0, 1.0, -1.0, 1.0, -2.5, -3.0, first);
+        split_quad(&mut g, -1.4, 0.6, -0.7, 1.3, -2.5, -3.0, 1 - first);
         g
     };
     let a = assert_matches("coplanar red first", &build(0), &frames(), 40);
@@ -217,10 +153,10 @@ fn opaque_in_front_matches_the_reference() {
         material([0.2, 0.7, 0.9], 0.4),
         material([0.6, 0.1, 0.6], 1.0),
     ]);
-    quad(&mut g, -1.5, 1.5, -1.5, 1.5, -5.0, -5.0, 2);
-    quad(&mut g, -1.0, 0.5, -1.0, 1.0, -3.0, -3.0, 1);
-    quad(&mut g, -0.2, 1.2, -0.8, 0.6, -2.0, -2.6, 0);
-    quad(&mut g, -1.3, 0.0, 0.2, 1.2, -1.5, -1.5, 1);
+    split_quad(&mut g, -1.5, 1.5, -1.5, 1.5, -5.0, -5.0, 2);
+    split_quad(&mut g, -1.0, 0.5, -1.0, 1.0, -3.0, -3.0, 1);
+    split_quad(&mut g, -0.2, 1.2, -0.8, 0.6, -2.0, -2.6, 0);
+    split_quad(&mut g, -1.3, 0.0, 0.2, 1.2, -1.5, -1.5, 1);
     let oit = assert_matches("opaque", &g, &frames(), 40);
     for o in &oit {
         assert_eq!(o.dropped, 0);
@@ -232,7 +168,7 @@ fn full_screen_layers(layers: u32) -> Geometry {
     let mut g = scene(vec![material([0.5, 0.6, 0.7], 0.3)]);
     for k in 0..layers {
         let z = -2.0 - k as f32 * 0.25;
-        quad(&mut g, -5.0, 5.0, -5.0, 5.0, z, z, 0);
+        split_quad(&mut g, -5.0, 5.0, -5.0, 5.0, z, z, 0);
     }
     g
 }

@@ -3,9 +3,10 @@
 #![allow(dead_code)]
 
 use glam::{DMat4, DVec3};
+use trisort_format::fixtures::{flat_quad, scene};
 use trisort_format::{
     AlphaMode, Baked, Camera, DeviceInfo, DrawIndexedIndirectArgs, FrameState, FrameWindow,
-    Geometry, Material, Node, RecordSettings, Vertex,
+    Geometry, Material, RecordSettings, Vertex,
 };
 
 /// Recorded image size (square).
@@ -20,22 +21,6 @@ pub const RED: [f32; 4] = [1.0, 0.0, 0.0, 0.5];
 pub const GREEN: [f32; 4] = [0.0, 1.0, 0.0, 0.5];
 /// Blue, opaque, behind everything, covering the whole view.
 pub const BLUE: [f32; 4] = [0.0, 0.0, 1.0, 1.0];
-
-/// A quad in the plane z, from (x0, y0) to (x1, y1), front face towards +Z (the camera).
-fn quad(g: &mut Geometry, x0: f32, y0: f32, x1: f32, y1: f32, z: f32, material: u32) {
-    let base = g.vertices.len() as u32;
-    for (x, y) in [(x0, y0), (x1, y0), (x1, y1), (x0, y1)] {
-        g.vertices.push(Vertex {
-            position: [x, y, z],
-            normal: [0.0, 0.0, 1.0],
-            uv: [0.0; 2],
-            material,
-            node: 0,
-        });
-    }
-    g.triangles.push([base, base + 1, base + 2]);
-    g.triangles.push([base, base + 2, base + 3]);
-}
 
 fn material(base_color: [f32; 4], alpha_mode: AlphaMode) -> Material {
     Material {
@@ -80,22 +65,14 @@ pub fn frame_state() -> FrameState {
 /// the draw list is [A, B, D, C]. Frames: 0 = [A] (red over green), 1 = [A, B] (red over
 /// green over blue), 2 = [D, C] (red over green from two ranges).
 pub fn quads() -> Baked {
-    let mut g = Geometry {
-        materials: vec![
-            material(RED, AlphaMode::Blend),
-            material(GREEN, AlphaMode::Blend),
-            material(BLUE, AlphaMode::Opaque),
-        ],
-        nodes: vec![Node {
-            name: "root".into(),
-            parent: None,
-            rest: DMat4::IDENTITY.to_cols_array(),
-        }],
-        ..Default::default()
-    };
-    quad(&mut g, -0.8, -0.8, 0.3, 0.3, 0.5, 0);
-    quad(&mut g, -0.3, -0.3, 0.8, 0.8, 0.0, 1);
-    quad(&mut g, -3.0, -3.0, 3.0, 3.0, -0.5, 2);
+    let mut g = scene(vec![
+        material(RED, AlphaMode::Blend),
+        material(GREEN, AlphaMode::Blend),
+        material(BLUE, AlphaMode::Opaque),
+    ]);
+    flat_quad(&mut g, -0.8, 0.3, -0.8, 0.3, 0.5, 0);
+    flat_quad(&mut g, -0.3, 0.8, -0.3, 0.8, 0.0, 1);
+    flat_quad(&mut g, -3.0, 3.0, -3.0, 3.0, -0.5, 2);
     let frames = 3;
     Baked {
         tool_version: trisort_format::TOOL_VERSION.into(),
