@@ -54,7 +54,7 @@ pub struct BenchArgs {
     /// Opacity at which transmissive glass is recorded and played.
     #[arg(long, default_value_t = 0.0)]
     glass_opacity: f32,
-    /// Sampling rate for `--path gltf`, TOML and generated paths.
+    /// Sampling rate for `--path gltf` and generated paths (a TOML file sets its own).
     #[arg(long, default_value_t = 30.0)]
     fps: f64,
     /// Skip timing `merged` with wgpu's indirect-call validation off.
