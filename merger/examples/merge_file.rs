@@ -52,6 +52,7 @@ fn main() {
             "--bridge" => {
                 base.bridge = match value().as_str() {
                     "ignored" => Bridge::Ignored,
+                    "visible" => Bridge::Visible,
                     _ => Bridge::Hidden,
                 }
             }

@@ -144,6 +144,10 @@ pub enum Bridge {
     /// Only frames where the triangle has no fragment (t ∉ C_f): drawing it changes nothing
     /// and costs no fill.
     Ignored,
+    /// None: a copy spans only frames where its triangle is visible, so every frame draws
+    /// exactly its V_f (no drawn-not-visible triangle, the `source` lower bound in triangles)
+    /// at the price of more copies. For devices whose cost is per submitted triangle.
+    Visible,
 }
 
 impl Bridge {
@@ -152,6 +156,7 @@ impl Bridge {
         match self {
             Bridge::Hidden => "hidden",
             Bridge::Ignored => "ignored",
+            Bridge::Visible => "visible",
         }
     }
 }

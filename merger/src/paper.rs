@@ -86,6 +86,7 @@ fn wildcard(cx: &Context<'_>, t: u32, a: u32, b: u32) -> bool {
     match cx.bridge {
         crate::Bridge::Hidden => true,
         crate::Bridge::Ignored => (a..=b).all(|f| !cx.graphs[f as usize].is_covered(t)),
+        crate::Bridge::Visible => false,
     }
 }
 

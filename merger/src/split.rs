@@ -74,6 +74,7 @@ impl Context<'_> {
         match self.bridge {
             Bridge::Hidden => true,
             Bridge::Ignored => !self.graphs[f as usize].is_covered(t),
+            Bridge::Visible => false,
         }
     }
 
@@ -92,6 +93,10 @@ impl Context<'_> {
             return None;
         }
         let (mut lo, mut hi) = (vis[a], vis[b - 1]);
+        if self.bridge == Bridge::Visible {
+            // No extension either: a copy spans only frames where its triangle is visible.
+            return Some((lo, hi));
+        }
         while lo > p && !self.graphs[lo as usize - 1].is_covered(t) {
             lo -= 1;
         }

@@ -57,7 +57,7 @@ fn assert_valid(recs: &[Recording], baked: &Baked, what: &str) {
 fn assert_all_valid(recs: &[Recording], what: &str) {
     for s in STRATEGIES {
         for l in LAYOUTS {
-            for b in [Bridge::Hidden, Bridge::Ignored] {
+            for b in [Bridge::Hidden, Bridge::Ignored, Bridge::Visible] {
                 for seeding in [Seeding::Interval, Seeding::Paper] {
                     let baked = merge(recs, &opts(s, l, b, seeding)).expect("merge");
                     assert_valid(

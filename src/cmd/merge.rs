@@ -48,6 +48,9 @@ pub enum BridgeArg {
     Hidden,
     /// Copies may span only frames where the triangle has no fragment.
     Ignored,
+    /// Copies span only frames where the triangle is visible: every frame draws exactly its
+    /// visible set (fewest triangles per frame), at the price of more copies.
+    Visible,
 }
 
 /// Seeding names of the CLI.
@@ -121,6 +124,7 @@ impl MergeOpts {
             bridge: match self.bridge {
                 BridgeArg::Hidden => Bridge::Hidden,
                 BridgeArg::Ignored => Bridge::Ignored,
+                BridgeArg::Visible => Bridge::Visible,
             },
             depth_only: self.depth_only,
             segment: (self.segment > 0).then_some(self.segment),

@@ -7,7 +7,7 @@
 //!    where its triangle is visible;
 //! 2. a drawn triangle that is not visible is allowed by the file's bridge policy: `hidden`
 //!    allows any such frame, `ignored` only frames where the triangle has no fragment
-//!    (t ∉ C_f);
+//!    (t ∉ C_f), `visible` none;
 //! 3. with E_f* = E_f (or the tie edges of a depth-only bake) minus the file's removed edges of
 //!    f: E_f* is acyclic, every removed edge is an edge of E_f with its weight, and for drawn
 //!    a, b with b reachable from a in E_f* through any triangles (drawn or not), a is drawn
@@ -95,12 +95,14 @@ pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
     };
     let ids = &baked.scene_ids;
     let n = ids.len();
-    let hidden_ok = match baked.merge.bridge.as_str() {
-        "hidden" => true,
-        "ignored" => false,
+    // (hidden frames allowed, frames without a fragment allowed)
+    let (hidden_ok, uncovered_ok) = match baked.merge.bridge.as_str() {
+        "hidden" => (true, true),
+        "ignored" => (false, true),
+        "visible" => (false, false),
         other => {
             report.problem(format!("unknown bridge policy {other:?}"));
-            false
+            (false, false)
         }
     };
     let ncopies = baked.copies.len();
@@ -165,7 +167,10 @@ pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
         let drawn_count = p - fm.drawn_twice;
         fm.drawn_not_visible =
             drawn_count.saturating_sub((visible.len() as u64).saturating_sub(fm.visible_missing));
-        if !hidden_ok {
+        if !uncovered_ok {
+            // `visible`: no triangle may be drawn where it is not visible.
+            fm.bridge_violations += fm.drawn_not_visible;
+        } else if !hidden_ok {
             // Drawn, not visible and covered: not allowed under `ignored`.
             for &t in &covered {
                 if drawn(t) && visible.binary_search(&t).is_err() {

@@ -176,6 +176,11 @@ fn bridge_policy_and_copies() {
     let r = check_graph(recs, &both("ignored"));
     assert!(!r.ok);
     assert_eq!(r.frames[0].bridge_violations, 1);
+    // `visible` allows no drawn-not-visible triangle at all.
+    let r = check_graph(recs, &both("visible"));
+    assert!(!r.ok);
+    assert_eq!(r.frames[0].bridge_violations, 1);
+    assert_eq!(r.frames[1].bridge_violations, r.frames[1].drawn_not_visible);
 
     // A visible triangle drawn twice in one frame.
     let twice = baked(
