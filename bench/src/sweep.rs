@@ -398,7 +398,7 @@ fn variants(config: &SweepConfig, base: RecordSettings) -> Vec<Variant> {
                 }
             }
             Factor::Bridge => {
-                for b in [Bridge::Hidden, Bridge::Ignored] {
+                for b in [Bridge::Hidden, Bridge::Ignored, Bridge::Visible] {
                     let m = MergeOptions { bridge: b, ..merge };
                     out.push(v(b.name().to_string(), base, m));
                 }

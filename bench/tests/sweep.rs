@@ -43,7 +43,7 @@ fn tiny_sweep_writes_consistent_outputs() {
     let factors: Vec<&str> = report.points.iter().map(|p| p.factor.as_str()).collect();
     let mut expected = vec!["record-size"; 3];
     expected.extend(["glass-opacity"; 3]);
-    expected.extend(["bridge"; 2]);
+    expected.extend(["bridge"; 3]);
     expected.extend(["segment"; 4]);
     assert_eq!(factors, expected);
 
@@ -96,6 +96,11 @@ fn tiny_sweep_writes_consistent_outputs() {
     assert!(value("record-size", "0.5x (32x32)").record_seconds > 0.0);
     assert!(value("segment", "none").is_default);
     assert!(value("bridge", "hidden").is_default);
+    // `visible` draws exactly each frame's V_f, for more copies.
+    assert_eq!(value("bridge", "visible").drawn_not_visible_mean, 0.0);
+    assert!(
+        value("bridge", "visible").index_triangles >= value("bridge", "hidden").index_triangles
+    );
 
     let frames_px = 2 * 64 * 64;
     for p in &report.points {

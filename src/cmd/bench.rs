@@ -17,7 +17,7 @@ use trisort_player::Mode;
 use trisort_shaders::gpu::Gpu;
 
 use crate::cmd::bake::{bake, recording_path};
-use crate::cmd::merge::MergeOpts;
+use crate::cmd::merge::{BridgeArg, MergeOpts};
 use crate::cmd::RecordOpts;
 use crate::common::{load_path, load_scene, parse_range, parse_size, print_json, FrameRange};
 
@@ -54,6 +54,10 @@ pub struct BenchArgs {
     /// Opacity at which transmissive glass is recorded and played.
     #[arg(long, default_value_t = 0.0)]
     glass_opacity: f32,
+    /// Bridge policy of the bakes (see `trisort merge --bridge`): `visible` draws exactly each
+    /// frame's visible set, for more copies.
+    #[arg(long, value_enum, default_value = "hidden")]
+    bridge: BridgeArg,
     /// Sampling rate for `--path gltf` and generated paths (a TOML file sets its own).
     #[arg(long, default_value_t = 30.0)]
     fps: f64,
@@ -126,9 +130,20 @@ fn bake_for(
     a: &BenchArgs,
     samples: u32,
 ) -> Result<BakeRun> {
-    let path = a
-        .out
-        .join(format!("bake-{}x{}-{}x.baked", a.size.0, a.size.1, samples));
+    let merge = MergeOpts {
+        bridge: a.bridge,
+        ..MergeOpts::defaults()
+    };
+    let bridge = merge.options().bridge.name();
+    let suffix = if bridge == "hidden" {
+        String::new()
+    } else {
+        format!("-{bridge}")
+    };
+    let path = a.out.join(format!(
+        "bake-{}x{}-{}x{suffix}.baked",
+        a.size.0, a.size.1, samples
+    ));
     let rec_path = recording_path(&path);
     let record = RecordOpts {
         size: a.size,
@@ -145,6 +160,8 @@ fn bake_for(
         if baked.scene_hash == scene.hash()
             && baked.path_hash == timeline.hash()
             && baked.settings == record.settings()
+            && baked.merge.bridge == bridge
+            && baked.merge.segment == merge.options().segment
             && recording.content_hash() == *baked.recording_hashes.first().unwrap_or(&[0; 32])
         {
             say(&format!("reusing {}", path.display()));
@@ -171,7 +188,6 @@ fn bake_for(
         a.size.1,
         samples
     ));
-    let merge = MergeOpts::defaults();
     let (recording, baked, record_s, merge_s) = bake(gpu, scene, timeline, &record, &merge, &path)?;
     let bytes = std::fs::metadata(&path)?.len();
     say(&format!(
@@ -329,6 +345,8 @@ fn report_json(
                 "draws_per_frame_mean": s.draws_per_frame_mean,
                 "draws_per_frame_max": s.draws_per_frame_max,
                 "strategy": b.baked.merge.strategy,
+                "bridge": b.baked.merge.bridge,
+                "segment": b.baked.merge.segment,
                 "layout": b.baked.merge.layout,
                 "draws_along_path": b.baked.frames.iter().map(|w| w.count).collect::<Vec<_>>(),
             })
