@@ -1078,7 +1078,7 @@ mod tests {
         assert_eq!(count(Factor::Samples), 2);
         assert_eq!(count(Factor::Saturation), 3);
         assert_eq!(count(Factor::GlassOpacity), 3);
-        assert_eq!(count(Factor::Bridge), 2);
+        assert_eq!(count(Factor::Bridge), 3);
         assert_eq!(count(Factor::StrategyLayout), 13);
         assert_eq!(count(Factor::Segment), 4);
         // Each factor has exactly one default point, and it is the same bake.

@@ -442,10 +442,20 @@ fn frames_without_visible_triangles() {
     ];
     let rec = recording_from_frames(4, &frames);
     assert_all_valid(std::slice::from_ref(&rec), "empty frames");
-    let baked = merge(std::slice::from_ref(&rec), &MergeOptions::default()).unwrap();
-    // Copies extend (for free) through frames where their triangle has no fragment, so frame
-    // 0 draws both triangles; one copy each suffices.
+    let hidden = MergeOptions {
+        bridge: Bridge::Hidden,
+        ..MergeOptions::default()
+    };
+    let baked = merge(std::slice::from_ref(&rec), &hidden).unwrap();
+    // With `hidden`, copies extend (for free) through frames where their triangle has no
+    // fragment, so frame 0 draws both triangles; one copy each suffices.
     assert_eq!(baked.stats.index_triangles, 2);
+    // With `visible` (the default) triangle 2, visible at frames 1 and 3 only, needs a copy
+    // for each, and nothing is drawn where it is not visible.
+    let visible = merge(std::slice::from_ref(&rec), &MergeOptions::default()).unwrap();
+    assert_eq!(visible.stats.index_triangles, 3);
+    assert_eq!(visible.stats.drawn_not_visible_mean, 0.0);
+    assert!(check_graph(std::slice::from_ref(&rec), &visible).ok);
     assert_eq!(
         trisort_merger::cell_counts(&baked)
             .iter()

@@ -55,8 +55,8 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 0.0)]
     glass_opacity: f32,
     /// Bridge policy of the bakes (see `trisort merge --bridge`): `visible` draws exactly each
-    /// frame's visible set, for more copies.
-    #[arg(long, value_enum, default_value = "hidden")]
+    /// frame's visible set; `hidden` shares more copies and draws more triangles.
+    #[arg(long, value_enum, default_value = "visible")]
     bridge: BridgeArg,
     /// Sampling rate for `--path gltf` and generated paths (a TOML file sets its own).
     #[arg(long, default_value_t = 30.0)]
@@ -135,7 +135,7 @@ fn bake_for(
         ..MergeOpts::defaults()
     };
     let bridge = merge.options().bridge.name();
-    let suffix = if bridge == "hidden" {
+    let suffix = if bridge == MergeOpts::defaults().options().bridge.name() {
         String::new()
     } else {
         format!("-{bridge}")

@@ -72,7 +72,7 @@ pub struct MergeOpts {
     #[arg(long, value_enum, default_value = "auto")]
     pub layout: LayoutArg,
     /// What a copy may span besides frames where its triangle is visible.
-    #[arg(long, value_enum, default_value = "hidden")]
+    #[arg(long, value_enum, default_value = "visible")]
     pub bridge: BridgeArg,
     /// Keep only equal-depth (tie) edges: plays only with the depth test.
     #[arg(long)]
@@ -91,13 +91,13 @@ pub struct MergeOpts {
 pub const DEFAULT_SEGMENT: u32 = 64;
 
 impl MergeOpts {
-    /// The command line's defaults (auto strategy and layout, bridge hidden, interval seeding,
-    /// one matrix).
+    /// The command line's defaults (auto strategy and layout, bridge visible, interval seeding,
+    /// segments of 64 frames).
     pub fn defaults() -> MergeOpts {
         MergeOpts {
             strategy: StrategyArg::Auto,
             layout: LayoutArg::Auto,
-            bridge: BridgeArg::Hidden,
+            bridge: BridgeArg::Visible,
             depth_only: false,
             segment: DEFAULT_SEGMENT,
             seeding: SeedingArg::Interval,
