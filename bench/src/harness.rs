@@ -17,6 +17,7 @@ use std::time::Instant;
 use serde::Serialize;
 use trisort_format::{FrameState, Geometry};
 use trisort_player::headless::COLOR_FORMAT;
+use trisort_player::GpuTimer;
 use trisort_shaders::gpu::Gpu;
 use trisort_shaders::scene_gpu::{SceneGpu, View};
 use wgpu::util::DeviceExt;
@@ -66,44 +67,6 @@ pub struct Timing {
     pub wall_ms: f64,
 }
 
-struct Timer {
-    set: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
-    staging: wgpu::Buffer,
-    period_ns: f64,
-}
-
-impl Timer {
-    fn new(gpu: &Gpu) -> Option<Timer> {
-        let device = &gpu.device;
-        device
-            .features()
-            .contains(
-                wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
-            )
-            .then(|| Timer {
-                set: device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("bench timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: 2,
-                }),
-                resolve: device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("bench timestamps"),
-                    size: 16,
-                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                }),
-                staging: device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("bench timestamps readback"),
-                    size: 16,
-                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                }),
-                period_ns: gpu.queue.get_timestamp_period() as f64,
-            })
-    }
-}
-
 fn wgpu_scope_error(gpu: &Gpu, scope: wgpu::ErrorScopeGuard) -> Result<(), BenchError> {
     match pollster::block_on(scope.pop()) {
         Some(e) => Err(BenchError::Wgpu(format!("{}: {e}", gpu.describe()))),
@@ -112,7 +75,11 @@ fn wgpu_scope_error(gpu: &Gpu, scope: wgpu::ErrorScopeGuard) -> Result<(), Bench
 }
 
 /// Times one call of `method` on `frame`.
-fn time_once(method: &dyn Method, timer: Option<&Timer>, frame: u32) -> Result<Timing, BenchError> {
+fn time_once(
+    method: &dyn Method,
+    timer: Option<&GpuTimer>,
+    frame: u32,
+) -> Result<Timing, BenchError> {
     let gpu = method.gpu();
     let device = &gpu.device;
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -121,13 +88,12 @@ fn time_once(method: &dyn Method, timer: Option<&Timer>, frame: u32) -> Result<T
         label: Some("bench frame"),
     });
     if let Some(t) = timer {
-        enc.write_timestamp(&t.set, 0);
+        t.write_start(&mut enc);
     }
     method.encode(&mut enc, frame, None);
     if let Some(t) = timer {
-        enc.write_timestamp(&t.set, 1);
-        enc.resolve_query_set(&t.set, 0..2, &t.resolve, 0);
-        enc.copy_buffer_to_buffer(&t.resolve, 0, &t.staging, 0, 16);
+        t.write_end(&mut enc);
+        t.resolve(&mut enc);
     }
     gpu.queue.submit([enc.finish()]);
     device
@@ -135,14 +101,7 @@ fn time_once(method: &dyn Method, timer: Option<&Timer>, frame: u32) -> Result<T
         .map_err(|e| BenchError::Wgpu(e.to_string()))?;
     let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
     wgpu_scope_error(gpu, scope)?;
-    let gpu_ms = match timer {
-        Some(t) => {
-            let bytes = gpu.map_read(&t.staging);
-            let ts: &[u64] = bytemuck::cast_slice(&bytes);
-            (ts[1] >= ts[0]).then(|| (ts[1] - ts[0]) as f64 * t.period_ns / 1e6)
-        }
-        None => None,
-    };
+    let gpu_ms = timer.and_then(|t| t.ms(&gpu.map_read(t.staging())));
     Ok(Timing {
         frame,
         gpu_ms,
@@ -160,7 +119,10 @@ pub fn time_methods(
     repeats: u32,
     progress: &dyn Fn(usize, usize),
 ) -> Result<Vec<Vec<Timing>>, BenchError> {
-    let timers: Vec<Option<Timer>> = methods.iter().map(|m| Timer::new(m.gpu())).collect();
+    let timers: Vec<Option<GpuTimer>> = methods
+        .iter()
+        .map(|m| GpuTimer::new(&m.gpu().device, &m.gpu().queue, true))
+        .collect();
     let total = methods.len() * frames.len() * (repeats as usize + 1);
     let mut done = 0;
     for &f in frames {

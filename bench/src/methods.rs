@@ -18,7 +18,7 @@ use trisort_format::{
 use trisort_player::commands::{index_buffer, Order};
 use trisort_player::config::{DrawPath, PlayerConfig};
 use trisort_player::headless::{COLOR_FORMAT, DEPTH_FORMAT};
-use trisort_player::{clear_colour, quantize_rgba16f, FrameTarget, Mode, Player};
+use trisort_player::{clear_colour, FrameTarget, Mode, Player};
 use trisort_reference::exact::whole_scene_baked;
 use trisort_reference::DefaultRenderer;
 use trisort_shaders::gpu::Gpu;
@@ -93,31 +93,6 @@ impl BenchView {
             glass_opacity: self.glass_opacity,
         }
     }
-}
-
-/// Reads `target`'s resolved frame after `encode` ran and quantizes it like the player.
-fn read_target(
-    gpu: &Gpu,
-    target: &FrameTarget,
-    mode: Mode,
-    encode: impl FnOnce(&mut wgpu::CommandEncoder),
-) -> Result<Vec<u8>, BenchError> {
-    let device = &gpu.device;
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let mut enc = device.create_command_encoder(&Default::default());
-    encode(&mut enc);
-    target.copy_to_staging(&mut enc);
-    gpu.queue.submit([enc.finish()]);
-    if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(BenchError::Wgpu(e.to_string()));
-    }
-    let bytes = target.unpad(&gpu.map_read(target.staging().expect("created with readback")));
-    let halves: Vec<u16> = bytes
-        .chunks_exact(2)
-        .map(|b| u16::from_le_bytes([b[0], b[1]]))
-        .collect();
-    let under = (mode == Mode::Saturate).then_some(trisort_player::headless::BACKGROUND);
-    Ok(quantize_rgba16f(&halves, under))
 }
 
 fn stats_begin(pass: &mut wgpu::RenderPass<'_>, stats: Option<&wgpu::QuerySet>, slot: u32) {
@@ -229,9 +204,9 @@ impl Method for PlayerMethod<'_> {
         stats_end(&mut pass, stats);
     }
     fn image(&self, frame: u32) -> Result<Vec<u8>, BenchError> {
-        read_target(self.gpu, &self.target, self.mode, |enc| {
-            self.encode(enc, frame, None)
-        })
+        Ok(self
+            .target
+            .read_rgba8(self.gpu, self.mode, |enc| self.encode(enc, frame, None))?)
     }
     fn streams(&self, frame: u32) -> Vec<Stream> {
         let mut indices = Vec::new();
@@ -380,9 +355,9 @@ impl Method for DefaultMethod<'_> {
         stats_end(&mut pass, stats);
     }
     fn image(&self, frame: u32) -> Result<Vec<u8>, BenchError> {
-        read_target(self.gpu, &self.target, Mode::Blend, |enc| {
-            self.encode(enc, frame, None)
-        })
+        Ok(self
+            .target
+            .read_rgba8(self.gpu, Mode::Blend, |enc| self.encode(enc, frame, None))?)
     }
     fn streams(&self, _frame: u32) -> Vec<Stream> {
         vec![

@@ -7,13 +7,13 @@
 //! ([`crate::harness::time_methods`]) so the ratios within a group come from one run.
 
 use serde::Serialize;
-use trisort_format::{Baked, FrameState, Geometry, Recording};
+use trisort_format::{Baked, FrameState, Geometry};
 use trisort_player::Mode;
 use trisort_reference::{compare, ExactReference, ReferenceConfig, ReferenceError, RemovedEdges};
 use trisort_shaders::gpu::Gpu;
 
 use crate::harness::{pipeline_statistics, time_methods, FragmentCounter, Summary, Timing};
-use crate::methods::{default_depth, source_baked, BenchView, DefaultMethod, Method, PlayerMethod};
+use crate::methods::{default_depth, BenchView, DefaultMethod, Method, PlayerMethod};
 use crate::BenchError;
 
 /// The methods a group may run.
@@ -76,8 +76,9 @@ pub struct GroupInput<'a> {
     pub frame_states: &'a [FrameState],
     /// The bake played by `merged`, recorded at this group's sample count.
     pub baked: &'a Baked,
-    /// The recording it was merged from (for `source`).
-    pub recording: &'a Recording,
+    /// The `source` method's bake: [`crate::methods::source_baked`] of `baked` (made once per
+    /// bake by the caller, shared by its groups).
+    pub source: &'a Baked,
     /// Size, samples and glass opacity of playback.
     pub view: BenchView,
     /// Compositing mode.
@@ -199,9 +200,8 @@ pub fn run_group(
 ) -> Result<GroupReport, BenchError> {
     let view = input.view;
     let mode = input.mode;
-    let mut methods: Vec<(String, Box<dyn Method + '_>)> = Vec::new();
+    let mut methods: Vec<Box<dyn Method + '_>> = Vec::new();
     let mut skipped = Vec::new();
-    let source = source_baked(input.baked, input.recording)?;
     for &kind in input.methods {
         if !kind.supports(mode) {
             continue;
@@ -225,48 +225,39 @@ pub fn run_group(
                         view,
                     )?)
                 };
-                methods.push(("default".into(), m));
+                methods.push(m);
             }
-            MethodKind::Source => methods.push((
-                "source".into(),
-                Box::new(PlayerMethod::new(
-                    "source",
-                    "V_f only, one draw".into(),
+            MethodKind::Source => methods.push(Box::new(PlayerMethod::new(
+                "source",
+                "V_f only, one draw".into(),
+                gpu,
+                input.source,
+                mode,
+                view,
+            )?)),
+            MethodKind::Merged => {
+                methods.push(Box::new(PlayerMethod::new(
+                    "merged",
+                    "indirect validation on (wgpu default)".into(),
                     gpu,
-                    &source,
+                    input.baked,
                     mode,
                     view,
-                )?),
-            )),
-            MethodKind::Merged => {
-                methods.push((
-                    "merged".into(),
-                    Box::new(PlayerMethod::new(
-                        "merged",
-                        "indirect validation on (wgpu default)".into(),
-                        gpu,
+                )?));
+                if let Some(g) = input.unvalidated {
+                    methods.push(Box::new(PlayerMethod::new(
+                        "merged_unvalidated",
+                        "indirect validation off".into(),
+                        g,
                         input.baked,
                         mode,
                         view,
-                    )?),
-                ));
-                if let Some(g) = input.unvalidated {
-                    methods.push((
-                        "merged_unvalidated".into(),
-                        Box::new(PlayerMethod::new(
-                            "merged_unvalidated",
-                            "indirect validation off".into(),
-                            g,
-                            input.baked,
-                            mode,
-                            view,
-                        )?),
-                    ));
+                    )?));
                 }
             }
             MethodKind::Oit | MethodKind::Peeling => {
                 match crate::rivals::build(kind, gpu, input, progress) {
-                    Ok(Some(m)) => methods.push((kind.name().into(), m)),
+                    Ok(Some(m)) => methods.push(m),
                     Ok(None) => {}
                     // A rival the device cannot run at this size (OIT's node pool over the
                     // storage-buffer limit) is left out of the table, saying why, rather
@@ -344,7 +335,7 @@ pub fn run_group(
             input.frames.len()
         ));
         let reference_frame = reference.render(f, Some(&removed))?;
-        for ((_, m), a) in methods.iter().zip(&mut acc) {
+        for (m, a) in methods.iter().zip(&mut acc) {
             m.prepare(f)?;
             let image = m.image(f)?;
             let c = compare(
@@ -391,10 +382,8 @@ pub fn run_group(
     }
 
     progress("timing");
-    let refs: Vec<&dyn Method> = methods.iter().map(|(_, m)| m.as_ref()).collect();
-    let total_calls = std::cell::Cell::new(0usize);
+    let refs: Vec<&dyn Method> = methods.iter().map(|m| m.as_ref()).collect();
     let timings = time_methods(&refs, input.frames, input.repeats, &|done, total| {
-        total_calls.set(total);
         if done % methods.len().max(1) == 0 {
             progress(&format!("timing: {done}/{total} calls"));
         }
@@ -405,7 +394,7 @@ pub fn run_group(
         .iter()
         .zip(acc)
         .zip(timings)
-        .map(|(((name, m), a), t)| {
+        .map(|((m, a), t)| {
             let gpu: Vec<f64> = t.iter().filter_map(|x| x.gpu_ms).collect();
             let gpu_ms = (gpu.len() == t.len() && !t.is_empty()).then(|| Summary::of(&gpu));
             let wall_ms = Summary::of(&t.iter().map(|x| x.wall_ms).collect::<Vec<_>>());
@@ -419,7 +408,7 @@ pub fn run_group(
                 errors.psnr_min = 0.0;
             }
             MethodRow {
-                method: name.clone(),
+                method: m.name().to_string(),
                 variant: m.variant(),
                 mode: mode.name().into(),
                 samples: view.samples,

@@ -11,6 +11,7 @@ use crate::config::{DrawPath, Mode, PlayerConfig};
 use crate::error::PlayerError;
 use crate::player::{block_on_ready, Player};
 use crate::target::{clear_colour, FrameTarget};
+use crate::timer::GpuTimer;
 
 /// The background every headless frame is drawn over: a dark grey, linear RGB.
 pub const BACKGROUND: [f32; 3] = [0.03, 0.03, 0.03];
@@ -86,13 +87,6 @@ pub fn render_frames(
     frames.iter().map(|&f| renderer.render(f)).collect()
 }
 
-struct Timer {
-    set: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
-    staging: wgpu::Buffer,
-    period_ns: f64,
-}
-
 /// A [`Player`] with its own offscreen targets: renders one frame per call, each with a single
 /// command encoder (render pass, MSAA resolve, timestamp resolve, copy to a staging buffer).
 pub struct HeadlessRenderer<'g> {
@@ -100,7 +94,7 @@ pub struct HeadlessRenderer<'g> {
     player: Player,
     mode: Mode,
     target: FrameTarget,
-    timer: Option<Timer>,
+    timer: Option<GpuTimer>,
 }
 
 impl<'g> HeadlessRenderer<'g> {
@@ -141,34 +135,7 @@ impl<'g> HeadlessRenderer<'g> {
             Player::new(&gpu.device, &gpu.queue, baked, player_config)?
         };
 
-        let device = &gpu.device;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let timer = device
-            .features()
-            .contains(wgpu::Features::TIMESTAMP_QUERY)
-            .then(|| Timer {
-                set: device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("trisort frame time"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: 2,
-                }),
-                resolve: device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("trisort timestamps"),
-                    size: 16,
-                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                }),
-                staging: device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("trisort timestamps readback"),
-                    size: 16,
-                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                }),
-                period_ns: gpu.queue.get_timestamp_period() as f64,
-            });
-        if let Some(Some(e)) = block_on_ready(scope.pop()) {
-            return Err(PlayerError::Wgpu(e.to_string()));
-        }
+        let timer = GpuTimer::new(&gpu.device, &gpu.queue, false);
         Ok(HeadlessRenderer {
             gpu,
             player,
@@ -191,14 +158,7 @@ impl<'g> HeadlessRenderer<'g> {
             label: Some("trisort frame"),
         });
         let drawn = {
-            let timestamps = self
-                .timer
-                .as_ref()
-                .map(|t| wgpu::RenderPassTimestampWrites {
-                    query_set: &t.set,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
-                });
+            let timestamps = self.timer.as_ref().map(GpuTimer::pass_writes);
             let mut pass = self
                 .target
                 .begin_pass(&mut enc, clear_colour(self.mode), timestamps);
@@ -210,8 +170,7 @@ impl<'g> HeadlessRenderer<'g> {
             return Err(e);
         }
         if let Some(t) = &self.timer {
-            enc.resolve_query_set(&t.set, 0..2, &t.resolve, 0);
-            enc.copy_buffer_to_buffer(&t.resolve, 0, &t.staging, 0, 16);
+            t.resolve(&mut enc);
         }
         self.target.copy_to_staging(&mut enc);
         self.gpu.queue.submit([enc.finish()]);
@@ -221,21 +180,11 @@ impl<'g> HeadlessRenderer<'g> {
 
         let mut buffers = vec![self.target.staging().expect("created with readback")];
         if let Some(t) = &self.timer {
-            buffers.push(&t.staging);
+            buffers.push(t.staging());
         }
         let bytes = map_read_all(device, &buffers)?;
-        let halves: Vec<u16> = self
-            .target
-            .unpad(&bytes[0])
-            .chunks_exact(2)
-            .map(|b| u16::from_le_bytes([b[0], b[1]]))
-            .collect();
-        let under = (self.mode == Mode::Saturate).then_some(BACKGROUND);
-        let rgba8 = quantize_rgba16f(&halves, under);
-        let gpu_ms = self.timer.as_ref().and_then(|t| {
-            let ts: &[u64] = bytemuck::cast_slice(&bytes[1]);
-            (ts[1] >= ts[0]).then(|| (ts[1] - ts[0]) as f64 * t.period_ns / 1e6)
-        });
+        let rgba8 = self.target.rgba8(&bytes[0], self.mode);
+        let gpu_ms = self.timer.as_ref().and_then(|t| t.ms(&bytes[1]));
         Ok(RenderedFrame {
             frame,
             rgba8,

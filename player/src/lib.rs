@@ -31,6 +31,7 @@ mod error;
 pub mod headless;
 mod player;
 pub mod target;
+mod timer;
 
 pub use config::{playback_warnings, DrawPath, Mode, ParseModeError, PlayerConfig};
 pub use draw_calls::{Call, CallLog, DrawCalls};
@@ -40,6 +41,7 @@ pub use headless::{
 };
 pub use player::{blend_state, fragment_entry_point, open_baked, Player};
 pub use target::{clear_colour, FrameTarget};
+pub use timer::GpuTimer;
 
 /// Instance flags with wgpu's indirect-call validation (`VALIDATION_INDIRECT_CALL`) switched
 /// on or off, the other flags as wgpu chooses them (build type and `WGPU_*` environment).

@@ -6,7 +6,7 @@
 
 use crate::config::Mode;
 use crate::error::PlayerError;
-use crate::headless::{BACKGROUND, DEPTH_FORMAT};
+use crate::headless::{quantize_rgba16f, BACKGROUND, DEPTH_FORMAT};
 
 /// The clear colour of a mode's target: the background with alpha 1 for `blend` and `depth`;
 /// transparent for `saturate`, whose background goes under the accumulated colour at the end.
@@ -188,6 +188,42 @@ impl FrameTarget {
             },
             self.resolved.size(),
         );
+    }
+
+    /// The staging buffer's mapped bytes of an `Rgba16Float` frame as 8-bit sRGB RGBA with
+    /// alpha 255, quantized once like every frame trisort compares: in `saturate` mode the
+    /// background goes under the accumulated colour first.
+    pub fn rgba8(&self, padded: &[u8], mode: Mode) -> Vec<u8> {
+        let halves: Vec<u16> = self
+            .unpad(padded)
+            .chunks_exact(2)
+            .map(|b| u16::from_le_bytes([b[0], b[1]]))
+            .collect();
+        quantize_rgba16f(&halves, (mode == Mode::Saturate).then_some(BACKGROUND))
+    }
+
+    /// Runs `encode` in one command encoder, copies the resolved frame to the staging buffer,
+    /// submits, waits and returns [`FrameTarget::rgba8`]. Errors on a wgpu validation error.
+    /// Panics if the target was created without `readback`.
+    pub fn read_rgba8(
+        &self,
+        gpu: &trisort_shaders::gpu::Gpu,
+        mode: Mode,
+        encode: impl FnOnce(&mut wgpu::CommandEncoder),
+    ) -> Result<Vec<u8>, PlayerError> {
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        encode(&mut enc);
+        self.copy_to_staging(&mut enc);
+        gpu.queue.submit([enc.finish()]);
+        if let Some(Some(e)) = crate::player::block_on_ready(scope.pop()) {
+            return Err(PlayerError::Wgpu(e.to_string()));
+        }
+        let staging = self
+            .staging
+            .as_ref()
+            .expect("FrameTarget created without readback");
+        Ok(self.rgba8(&gpu.map_read(staging), mode))
     }
 
     /// The staging buffer's mapped bytes as tightly packed rows (drops the row padding).

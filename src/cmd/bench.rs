@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
-use trisort_bench::methods::BenchView;
+use trisort_bench::methods::{source_baked, BenchView};
 use trisort_bench::plot::{write_svg, Chart, Series, Style};
 use trisort_bench::table::{run_group, GroupInput, GroupReport, MethodKind};
 use trisort_format::{Baked, FileKind, Recording};
@@ -111,11 +111,12 @@ fn measured_frames(range: std::ops::Range<u32>, max: u32) -> Vec<u32> {
     v
 }
 
-/// A bake of the path at one sample count, with its recording and costs.
+/// A bake of the path at one sample count, the `source` method's bake made from it and its
+/// recording, and its costs.
 struct BakeRun {
     samples: u32,
     baked: Baked,
-    recording: Recording,
+    source: Baked,
     record_seconds: Option<f64>,
     merge_seconds: Option<f64>,
     bytes: u64,
@@ -168,8 +169,8 @@ fn bake_for(
             let bytes = std::fs::metadata(&path)?.len();
             return Ok(BakeRun {
                 samples,
+                source: source_baked(&baked, &recording)?,
                 baked,
-                recording,
                 record_seconds: None,
                 merge_seconds: None,
                 bytes,
@@ -199,8 +200,8 @@ fn bake_for(
     ));
     Ok(BakeRun {
         samples,
+        source: source_baked(&baked, &recording)?,
         baked,
-        recording,
         record_seconds: Some(record_s),
         merge_seconds: Some(merge_s),
         bytes,
@@ -264,7 +265,7 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
                 geometry: &scene.geometry,
                 frame_states: &timeline.frames,
                 baked: &b.baked,
-                recording: &b.recording,
+                source: &b.source,
                 view: BenchView {
                     size: a.size,
                     samples: b.samples,
