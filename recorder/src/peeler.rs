@@ -7,7 +7,9 @@ use std::ops::Range;
 
 use trisort_format::{FrameState, Geometry};
 use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_shaders::scene_gpu::{
+    begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
+};
 use wgpu::util::DeviceExt;
 
 use crate::RecordError;
@@ -97,21 +99,13 @@ impl<'g> Peeler<'g> {
             },
             count: None,
         };
+        let previous = previous_key_entries(view.samples);
         let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("peel"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(16),
-                    },
-                    count: None,
-                },
-                tex(1, wgpu::TextureSampleType::Depth),
-                tex(2, wgpu::TextureSampleType::Uint),
+                previous[0],
+                previous[1],
+                previous[2],
                 wgpu::BindGroupLayoutEntry {
                     binding: 3,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -389,7 +383,14 @@ impl<'g> Peeler<'g> {
         let t = std::time::Instant::now();
         let mut enc = device.create_command_encoder(&Default::default());
         {
-            let mut pass = self.begin_layer_pass(&mut enc, &id_views[cur], &depth_views[cur]);
+            let mut pass = begin_peel_pass(
+                &mut enc,
+                "peel layer",
+                &id_views[cur],
+                &depth_views[cur],
+                1.0,
+                None,
+            );
             pass.set_pipeline(if plain { &self.plain } else { &self.pipeline });
             pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
             pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
@@ -449,35 +450,6 @@ impl<'g> Peeler<'g> {
             })
     }
 
-    fn begin_layer_pass<'e>(
-        &self,
-        enc: &'e mut wgpu::CommandEncoder,
-        ids: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-    ) -> wgpu::RenderPass<'e> {
-        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("peel layer"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: ids,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        })
-    }
-
     fn layer(
         &self,
         frame: u32,
@@ -517,7 +489,14 @@ impl<'g> Peeler<'g> {
             label: Some("peel layer"),
         });
         {
-            let mut pass = self.begin_layer_pass(&mut enc, &id_views[cur], &depth_views[cur]);
+            let mut pass = begin_peel_pass(
+                &mut enc,
+                "peel layer",
+                &id_views[cur],
+                &depth_views[cur],
+                1.0,
+                None,
+            );
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
             pass.set_vertex_buffer(0, self.scene.vertices.slice(..));

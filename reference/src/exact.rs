@@ -34,7 +34,7 @@ use trisort_shaders::gpu::Gpu;
 use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
-use crate::target::{clear_colour, halves, Target};
+use crate::target::{check_pattern, clear_colour, halves, Target};
 use crate::ReferenceError;
 
 /// The pattern and mode a reference frame is rendered at.
@@ -211,13 +211,7 @@ impl<'g> ExactReference<'g> {
         frames: &[FrameState],
         config: ReferenceConfig,
     ) -> Result<ExactReference<'g>, ReferenceError> {
-        if config.size.0 == 0 || config.size.1 == 0 || !(config.samples == 1 || config.samples == 4)
-        {
-            return Err(ReferenceError::Invalid(format!(
-                "{}x{} at {} samples: sizes must be positive and samples 1 or 4",
-                config.size.0, config.size.1, config.samples
-            )));
-        }
+        check_pattern(config.size, config.samples)?;
         let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
         let view = config.view();
         let peeler = Peeler::new(gpu, geometry, &all, frames, view)?;

@@ -40,7 +40,7 @@ use trisort_shaders::gpu::Gpu;
 use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
-use crate::target::halves;
+use crate::target::{halves, scene_index};
 use crate::ReferenceError;
 
 /// Bytes of one node of the pool: colour (4 × f32), depth (f32), triangle id, next index.
@@ -282,16 +282,7 @@ impl<'g> OitRenderer<'g> {
             glass_opacity,
         };
         let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
-        let indices: Vec<u32> = geometry.triangles.iter().flatten().copied().collect();
-        let index = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("oit indices"),
-            contents: bytemuck::cast_slice(if indices.is_empty() {
-                &[0u32; 3]
-            } else {
-                &indices
-            }),
-            usage: wgpu::BufferUsages::INDEX,
-        });
+        let index = scene_index(device, geometry, "oit indices");
 
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {

@@ -42,9 +42,12 @@ use trisort_format::{FrameState, Geometry};
 use trisort_player::headless::COLOR_FORMAT;
 use trisort_player::{blend_state, clear_colour, quantize_rgba16f, Mode};
 use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_shaders::scene_gpu::{
+    begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
+};
 use wgpu::util::DeviceExt;
 
+use crate::target::{check_pattern, halves, scene_index};
 use crate::ReferenceError;
 
 /// Format of the peel passes' id target (triangle id + 1, 0 = no fragment).
@@ -159,12 +162,7 @@ impl<'g> PeelingRenderer<'g> {
         max_layers: u32,
         glass_opacity: f32,
     ) -> Result<Self, ReferenceError> {
-        if size.0 == 0 || size.1 == 0 || !(samples == 1 || samples == 4) {
-            return Err(ReferenceError::Invalid(format!(
-                "{}x{} at {samples} samples: sizes must be positive and samples 1 or 4",
-                size.0, size.1
-            )));
-        }
+        check_pattern(size, samples)?;
         if mode == Mode::Saturate {
             return Err(ReferenceError::Invalid(
                 "depth peeling renders blend and depth; saturate has no peeling renderer".into(),
@@ -202,15 +200,7 @@ impl<'g> PeelingRenderer<'g> {
             glass_opacity,
         };
         let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
-        let mut index_data: Vec<u32> = geometry.triangles.iter().flatten().copied().collect();
-        if index_data.is_empty() {
-            index_data.extend_from_slice(&[0, 0, 0]);
-        }
-        let index = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("peeling indices"),
-            contents: bytemuck::cast_slice(&index_data),
-            usage: wgpu::BufferUsages::INDEX,
-        });
+        let index = scene_index(device, geometry, "peeling indices");
 
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("peeling"),
@@ -229,20 +219,7 @@ impl<'g> PeelingRenderer<'g> {
         };
         let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("peeling peel"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(16),
-                    },
-                    count: None,
-                },
-                texture_entry(1, wgpu::TextureSampleType::Depth),
-                texture_entry(2, wgpu::TextureSampleType::Uint),
-            ],
+            entries: &previous_key_entries(samples),
         });
         let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("peeling composite"),
@@ -615,28 +592,14 @@ impl<'g> PeelingRenderer<'g> {
             Direction::FrontToBack => 1.0,
             Direction::BackToFront => 0.0,
         };
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("peeling peel"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &self.ids[write],
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth[write],
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear_depth),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            occlusion_query_set: occlusion.then_some(&self.occlusion),
-            ..Default::default()
-        });
+        let mut pass = begin_peel_pass(
+            enc,
+            "peeling peel",
+            &self.ids[write],
+            &self.depth[write],
+            clear_depth,
+            occlusion.then_some(&self.occlusion),
+        );
         pass.set_pipeline(match direction {
             Direction::FrontToBack => &self.front,
             Direction::BackToFront => &self.back,
@@ -735,12 +698,12 @@ impl<'g> PeelingRenderer<'g> {
         }
         let padded = self.gpu.map_read(&self.staging);
         let row = self.size.0 as usize * 8;
-        let halves: Vec<u16> = (0..self.size.1 as usize)
-            .flat_map(|y| padded[y * self.row_bytes as usize..][..row].chunks_exact(2))
-            .map(|b| u16::from_le_bytes([b[0], b[1]]))
+        let bytes: Vec<u8> = (0..self.size.1 as usize)
+            .flat_map(|y| &padded[y * self.row_bytes as usize..][..row])
+            .copied()
             .collect();
         Ok(PeeledFrame {
-            rgba8: quantize_rgba16f(&halves, None),
+            rgba8: quantize_rgba16f(&halves(&bytes), None),
             layers,
             truncated,
         })

@@ -1,8 +1,10 @@
 //! An offscreen target like the player's headless one: an MSAA colour attachment (and depth
 //! where asked) resolved to one sample by the render pass, then read back.
 
+use trisort_format::Geometry;
 use trisort_player::FrameTarget;
 use trisort_shaders::gpu::Gpu;
+use wgpu::util::DeviceExt;
 
 use crate::ReferenceError;
 
@@ -72,3 +74,29 @@ pub(crate) fn halves(bytes: &[u8]) -> Vec<u16> {
 
 /// The clear colour of a mode's target, as the headless player clears it.
 pub(crate) use trisort_player::clear_colour;
+
+/// Rejects an empty size or a sample count other than 1 or 4 (the exact reference's and the
+/// peeling renderer's patterns).
+pub(crate) fn check_pattern(size: (u32, u32), samples: u32) -> Result<(), ReferenceError> {
+    if size.0 == 0 || size.1 == 0 || !(samples == 1 || samples == 4) {
+        return Err(ReferenceError::Invalid(format!(
+            "{}x{} at {samples} samples: sizes must be positive and samples 1 or 4",
+            size.0, size.1
+        )));
+    }
+    Ok(())
+}
+
+/// An index buffer of every triangle of `geometry` in scene order, so that `primitive_index`
+/// is the scene id (one degenerate triangle where the scene has none: no empty buffers).
+pub(crate) fn scene_index(device: &wgpu::Device, geometry: &Geometry, label: &str) -> wgpu::Buffer {
+    let mut indices: Vec<u32> = geometry.triangles.iter().flatten().copied().collect();
+    if indices.is_empty() {
+        indices.extend_from_slice(&[0, 0, 0]);
+    }
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(&indices),
+        usage: wgpu::BufferUsages::INDEX,
+    })
+}

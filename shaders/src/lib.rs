@@ -36,10 +36,11 @@ pub const PEEL: &str = include_str!("wgsl/peel.wgsl");
 /// The compute pass that gathers a peel layer per sample; compose with [`gather_shader`].
 pub const GATHER: &str = include_str!("wgsl/gather.wgsl");
 
-/// Fills the texture-type placeholders of the peel and gather shaders for a sample count:
-/// multisampled textures for `samples > 1`, plain ones for a single sample.
-fn peel_types(body: &str, samples: u32) -> String {
-    let (ids, depth, sample) = if samples > 1 {
+/// The id texture type, the depth texture type and the sample argument of a `textureLoad` at
+/// sample `sample`, for a sample count: multisampled textures for `samples > 1`, plain ones
+/// (and sample 0) for a single sample.
+fn sample_types(samples: u32) -> (&'static str, &'static str, &'static str) {
+    if samples > 1 {
         (
             "texture_multisampled_2d<u32>",
             "texture_depth_multisampled_2d",
@@ -47,7 +48,13 @@ fn peel_types(body: &str, samples: u32) -> String {
         )
     } else {
         ("texture_2d<u32>", "texture_depth_2d", "0")
-    };
+    }
+}
+
+/// Fills the texture-type placeholders of the peel and gather shaders for a sample count
+/// ([`sample_types`]).
+fn peel_types(body: &str, samples: u32) -> String {
+    let (ids, depth, sample) = sample_types(samples);
     body.replace("PREV_IDS_TYPE", ids)
         .replace("PREV_DEPTH_TYPE", depth)
         .replace(
@@ -119,16 +126,8 @@ pub const PEELING: &str = include_str!("wgsl/peeling.wgsl");
 /// per-sample loads filled in (needs `Features::PRIMITIVE_INDEX`).
 pub fn peeling_shader(samples: u32) -> String {
     let samples = samples.max(1);
-    let (ids, depth, at, at_s) = if samples > 1 {
-        (
-            "texture_multisampled_2d<u32>",
-            "texture_depth_multisampled_2d",
-            "i32(sample)",
-            "i32(s)",
-        )
-    } else {
-        ("texture_2d<u32>", "texture_depth_2d", "0", "0")
-    };
+    let (ids, depth, at) = sample_types(samples);
+    let at_s = at.replace("sample", "s");
     let body = PEELING
         .replace("PREV_DEPTH_TYPE", depth)
         .replace("IDS_TYPE", ids)

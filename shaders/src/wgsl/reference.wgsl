@@ -38,13 +38,9 @@ struct ReferenceOut {
     @builtin(sample_mask) mask: u32,
 }
 
-// `blend` and `depth`: as `fs_player_straight`, limited to the layer's samples.
-@fragment
-fn fs_reference_straight(
-    v: PlayerVarying,
-    @builtin(front_facing) front_facing: bool,
-    @builtin(primitive_index) primitive: u32,
-) -> ReferenceOut {
+// `player_colour` at the samples where triangle `primitive` is the layer's fragment; discards
+// where it is at none.
+fn layer_colour(v: PlayerVarying, front_facing: bool, primitive: u32) -> ReferenceOut {
     let mask = layer_mask(v.position, primitive);
     if (mask == 0u) {
         discard;
@@ -55,6 +51,16 @@ fn fs_reference_straight(
     return out;
 }
 
+// `blend` and `depth`: as `fs_player_straight`, limited to the layer's samples.
+@fragment
+fn fs_reference_straight(
+    v: PlayerVarying,
+    @builtin(front_facing) front_facing: bool,
+    @builtin(primitive_index) primitive: u32,
+) -> ReferenceOut {
+    return layer_colour(v, front_facing, primitive);
+}
+
 // `saturate`: as `fs_player_premultiplied`, limited to the layer's samples.
 @fragment
 fn fs_reference_premultiplied(
@@ -62,13 +68,8 @@ fn fs_reference_premultiplied(
     @builtin(front_facing) front_facing: bool,
     @builtin(primitive_index) primitive: u32,
 ) -> ReferenceOut {
-    let mask = layer_mask(v.position, primitive);
-    if (mask == 0u) {
-        discard;
-    }
-    let c = player_colour(v, front_facing);
-    var out: ReferenceOut;
+    var out = layer_colour(v, front_facing, primitive);
+    let c = out.color;
     out.color = vec4<f32>(c.rgb * c.a, c.a);
-    out.mask = mask;
     return out;
 }
