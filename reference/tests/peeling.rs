@@ -185,6 +185,21 @@ fn same_as_reference(
         .collect()
 }
 
+/// [`same_as_reference`] for a stack seen head-on: one frame, 48 pixels, `blend`.
+fn one_frame_stack(gpu: &Gpu, g: &Geometry, samples: u32, max_layers: u32) -> Vec<Rendered> {
+    let frame = [frame_at(DVec3::ZERO)];
+    same_as_reference(
+        gpu,
+        "stack",
+        g,
+        &frame,
+        48,
+        samples,
+        Mode::Blend,
+        max_layers,
+    )
+}
+
 // ---- tests ----
 
 #[test]
@@ -193,16 +208,7 @@ fn stacked_quads_peel_as_many_layers_as_the_stack_is_deep() {
     for n in [1, 3, 6] {
         let g = stack(n);
         for samples in [1, 4] {
-            let r = same_as_reference(
-                &gpu,
-                "stack",
-                &g,
-                &[frame_at(DVec3::ZERO)],
-                48,
-                samples,
-                Mode::Blend,
-                64,
-            );
+            let r = one_frame_stack(&gpu, &g, samples, 64);
             assert_eq!(r[0].layers, n, "{n} quads at {samples}x");
             assert!(!r[0].truncated);
         }
@@ -283,30 +289,12 @@ fn a_frame_beyond_max_layers_is_truncated_to_its_front_layers() {
     let g = stack(6);
     for samples in [1, 4] {
         for max_layers in [1, 2, 5] {
-            let r = same_as_reference(
-                &gpu,
-                "stack",
-                &g,
-                &[frame_at(DVec3::ZERO)],
-                48,
-                samples,
-                Mode::Blend,
-                max_layers,
-            );
+            let r = one_frame_stack(&gpu, &g, samples, max_layers);
             assert_eq!(r[0].layers, max_layers);
             assert!(r[0].truncated, "6 quads, at most {max_layers} layers");
         }
         // Exactly as many layers as the stack: complete.
-        let r = same_as_reference(
-            &gpu,
-            "stack",
-            &g,
-            &[frame_at(DVec3::ZERO)],
-            48,
-            samples,
-            Mode::Blend,
-            6,
-        );
+        let r = one_frame_stack(&gpu, &g, samples, 6);
         assert_eq!((r[0].layers, r[0].truncated), (6, false));
     }
 }
