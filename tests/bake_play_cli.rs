@@ -17,10 +17,9 @@ fn pngs(dir: &std::path::Path) -> Vec<String> {
 
 #[test]
 fn demo_car_bakes_verifies_and_plays() {
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let v = run_json(
         dir.path(),
         &[
@@ -88,10 +87,9 @@ fn car_concept_bakes_and_plays_a_few_frames() {
     let Some(car) = scene("CarConcept") else {
         return;
     };
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     run(
         dir.path(),
         &[
@@ -148,10 +146,9 @@ fn car_concept_bakes_and_plays_a_few_frames() {
 
 #[test]
 fn demo_exports_a_scene_that_imports_back_with_the_same_triangles() {
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let out = run(
         dir.path(),
         &[

@@ -25,10 +25,9 @@ fn f(v: &serde_json::Value) -> f64 {
 
 #[test]
 fn bench_table_on_the_demo_car() {
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let out = dir.path().join("bench");
     let out_s = out.display().to_string();
     let args = [
@@ -202,10 +201,9 @@ fn bench_rejects_bad_options() {
 
 #[test]
 fn bench_sweep_through_the_cli() {
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let out = dir.path().join("sweep");
     let out_s = out.display().to_string();
     let v = run_json(
@@ -247,10 +245,9 @@ fn bench_sweep_through_the_cli() {
 
 #[test]
 fn bench_scaling_through_the_cli() {
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let out = dir.path().join("scaling");
     let out_s = out.display().to_string();
     let v = run_json(
@@ -284,10 +281,9 @@ fn bench_scaling_through_the_cli() {
 /// and still reports the other methods.
 #[test]
 fn bench_leaves_out_a_rival_the_device_cannot_run() {
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let out_s = dir.path().join("big").display().to_string();
     let v = run_json(
         dir.path(),

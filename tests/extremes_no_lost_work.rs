@@ -78,10 +78,9 @@ fn read(dir: &Path, name: &str) -> Vec<u8> {
 /// is set by the folder, not by timing, so the test holds on a device of any speed.
 #[test]
 fn an_interrupted_bake_resumes_to_identical_bytes() {
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let d = dir.path();
     run_bake(d, "clean.baked", "2");
     let mut child = trisort(d)
@@ -165,10 +164,9 @@ fn an_interrupted_bake_resumes_to_identical_bytes() {
 /// baked files (the merger tries all strategies and layouts in parallel).
 #[test]
 fn bakes_are_byte_identical_across_runs_and_thread_counts() {
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let d = dir.path();
     let mut files = vec![];
     for (k, threads) in ["1", "2", "2"].iter().enumerate() {
@@ -186,10 +184,9 @@ fn bakes_are_byte_identical_across_runs_and_thread_counts() {
 /// any binding limit) ends with exit 1 and a message naming the limit, no panic, no output.
 #[test]
 fn a_recording_too_large_for_the_device_fails_cleanly() {
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let d = dir.path();
     let out = trisort(d)
         .args([

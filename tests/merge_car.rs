@@ -31,10 +31,9 @@ fn car_concept_orbit_merges_validly_with_every_strategy_and_layout() {
     let Some(car) = scene("CarConcept") else {
         return;
     };
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let d = dir.path();
     run_json(
         d,

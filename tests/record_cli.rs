@@ -17,10 +17,9 @@ fn car_concept_records_edges_and_interior_through_the_glass() {
     let Some(car) = scene("CarConcept") else {
         return;
     };
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let v = run_json(
         dir.path(),
         &[
@@ -78,14 +77,13 @@ fn an_interrupted_recording_resumes_to_identical_bytes() {
     let Some(car) = scene("CarConcept") else {
         return;
     };
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let args = |out: &str| -> Vec<String> {
+    };
+    let args = |out: &'static str| {
         [
             "record",
-            &car,
+            car.as_str(),
             "--path",
             "orbit:frames=8",
             "--size",
@@ -95,17 +93,9 @@ fn an_interrupted_recording_resumes_to_identical_bytes() {
             "-o",
             out,
         ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
     };
     // A clean run.
-    let clean = args("clean.rec");
-    run(
-        dir.path(),
-        &clean.iter().map(String::as_str).collect::<Vec<_>>(),
-        true,
-    );
+    run(dir.path(), &args("clean.rec"), true);
     // A run killed once some frames are finished.
     let mut child = trisort(dir.path())
         .args(args("resumed.rec"))
@@ -135,14 +125,7 @@ fn an_interrupted_recording_resumes_to_identical_bytes() {
         !dir.path().join("resumed.rec").exists(),
         "no output file after an interrupted run"
     );
-    let out = run(
-        dir.path(),
-        &args("resumed.rec")
-            .iter()
-            .map(String::as_str)
-            .collect::<Vec<_>>(),
-        true,
-    );
+    let out = run(dir.path(), &args("resumed.rec"), true);
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("resuming"),
         "the rerun did not resume"
@@ -158,10 +141,9 @@ fn recordings_are_byte_identical_across_runs_and_thread_counts() {
     let Some(truck) = scene("CesiumMilkTruck") else {
         return;
     };
-    if !gpu_available() {
+    let Some(dir) = gpu_tempdir() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    };
     let mut outputs = vec![];
     for threads in ["1", "2"] {
         let out = format!("t{threads}.rec");

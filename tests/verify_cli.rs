@@ -5,17 +5,17 @@
 
 mod support;
 
-use std::path::Path;
-
 use support::*;
 use trisort_format::{Baked, FileKind, Recording};
 
 const SCENE: &str = "demo:10000";
 
-/// Bakes the demo car (2 frames, 64², 4×) into `dir/car.baked` (recording beside it).
-fn bake(dir: &Path) {
+/// A temporary directory holding the demo car baked (2 frames, 64², 4×) as `car.baked`
+/// (recording beside it), or `None` to skip the test where there is no GPU.
+fn baked_car() -> Option<tempfile::TempDir> {
+    let dir = gpu_tempdir()?;
     run(
-        dir,
+        dir.path(),
         &[
             "bake",
             SCENE,
@@ -30,15 +30,14 @@ fn bake(dir: &Path) {
         ],
         true,
     );
+    Some(dir)
 }
 
 #[test]
 fn verify_reports_contract_keys_and_writes_difference_images() {
-    if !gpu_available() {
+    let Some(dir) = baked_car() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    bake(dir.path());
+    };
     let v = run_json(
         dir.path(),
         &[
@@ -90,11 +89,9 @@ fn verify_reports_contract_keys_and_writes_difference_images() {
 
 #[test]
 fn another_scene_is_refused_with_a_clear_error() {
-    if !gpu_available() {
+    let Some(dir) = baked_car() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    bake(dir.path());
+    };
     let out = run(
         dir.path(),
         &["verify", "car.baked", "--scene", "demo:12000"],
@@ -110,25 +107,21 @@ fn another_scene_is_refused_with_a_clear_error() {
 
 #[test]
 fn off_pattern_is_measured_and_gated_only_by_max_error() {
-    if !gpu_available() {
+    let Some(dir) = baked_car() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    bake(dir.path());
+    };
     // Twice the recorded size: measured, not failed.
-    let v = run_json(
-        dir.path(),
-        &[
-            "verify",
-            "car.baked",
-            "--scene",
-            SCENE,
-            "--size",
-            "128x128",
-            "--frames",
-            "0..1",
-        ],
-    );
+    let off_pattern = [
+        "verify",
+        "car.baked",
+        "--scene",
+        SCENE,
+        "--size",
+        "128x128",
+        "--frames",
+        "0..1",
+    ];
+    let v = run_json(dir.path(), &off_pattern);
     assert_eq!(v["at_recorded_pattern"], false);
     assert_eq!(v["ok"], true);
     let max = v["frames"][0]["max_channel_diff_ordered"].as_u64().unwrap();
@@ -137,18 +130,7 @@ fn off_pattern_is_measured_and_gated_only_by_max_error() {
     let bound = (max - 1).to_string();
     let out = run(
         dir.path(),
-        &[
-            "verify",
-            "car.baked",
-            "--scene",
-            SCENE,
-            "--size",
-            "128x128",
-            "--frames",
-            "0..1",
-            "--max-error",
-            &bound,
-        ],
+        &[&off_pattern[..], &["--max-error", &bound]].concat(),
         false,
     );
     assert_eq!(out.status.code(), Some(3));
@@ -159,11 +141,9 @@ fn off_pattern_is_measured_and_gated_only_by_max_error() {
 /// verify fails with exit code 3, writing the failing frame's images.
 #[test]
 fn corrupted_order_fails_verification() {
-    if !gpu_available() {
+    let Some(dir) = baked_car() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    bake(dir.path());
+    };
     let path = dir.path().join("car.baked");
     let mut baked: Baked = trisort_format::read_file(FileKind::Baked, &path).unwrap();
     let rec: Recording =

@@ -121,6 +121,18 @@ fn stacked_transparent_quads_verify_in_every_mode() {
     }
 }
 
+/// The exact reference's settings for the 64², 4× scenes built here, in `mode` (opaque
+/// glass, up to 64 layers).
+fn reference_config(mode: Mode) -> trisort_reference::ReferenceConfig {
+    trisort_reference::ReferenceConfig {
+        size: (64, 64),
+        samples: 4,
+        mode,
+        glass_opacity: 0.0,
+        max_layers: 64,
+    }
+}
+
 /// On an opaque scene the `depth` reference equals DESIGN's plain z-buffer of all triangles
 /// in ascending id order (the player drawing the whole scene in id order with `Less`).
 #[test]
@@ -142,15 +154,9 @@ fn depth_reference_equals_the_plain_z_buffer_on_opaque_scenes() {
     let played =
         trisort_player::render_frames(&gpu, &zbuffer, &[0, 1], (64, 64), 4, Mode::Depth, None)
             .expect("z-buffer renders");
-    let config = trisort_reference::ReferenceConfig {
-        size: (64, 64),
-        samples: 4,
-        mode: Mode::Depth,
-        glass_opacity: 0.0,
-        max_layers: 64,
-    };
     let reference =
-        trisort_reference::ExactReference::new(&gpu, &g, &frames, config).expect("reference");
+        trisort_reference::ExactReference::new(&gpu, &g, &frames, reference_config(Mode::Depth))
+            .expect("reference");
     for f in 0..2 {
         let r = reference.render(f, None).expect("reference frame");
         assert_eq!(r.rgba8, played[f as usize].rgba8, "frame {f}");
@@ -234,10 +240,18 @@ fn real_scene(name: &str) -> Option<trisort_scene::Scene> {
     Some(trisort_scene::load(&path).expect("scene loads"))
 }
 
-fn orbit(scene: &trisort_scene::Scene, spec: &str) -> Vec<FrameState> {
-    trisort_paths::load(spec, scene, &trisort_paths::PathOptions { fps: 30.0 })
+/// Bakes the shared scene `name` along the orbit `spec` at 96², 4×, and verifies every frame
+/// in every mode ([`verify_all_modes`]); skips without a GPU or without the scene.
+fn orbit_verifies_in_every_mode(name: &str, spec: &str) {
+    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(s) = real_scene(name) else {
+        return;
+    };
+    let frames = trisort_paths::load(spec, &s, &trisort_paths::PathOptions { fps: 30.0 })
         .expect("path")
-        .frames
+        .frames;
+    let (_, baked) = bake(&gpu, &s.geometry, &frames, settings(96, 4));
+    verify_all_modes(&gpu, name, &baked, &s.geometry);
 }
 
 /// CarConcept on tour frames around the opening driver door.
@@ -265,25 +279,16 @@ fn car_concept_tour_range_verifies_in_every_mode() {
 /// Textured alpha (BLEND leaves and glass).
 #[test]
 fn glass_vase_flowers_verifies_in_every_mode() {
-    let Some(gpu) = Gpu::for_tests() else { return };
-    let Some(s) = real_scene("GlassVaseFlowers") else {
-        return;
-    };
-    let frames = orbit(&s, "orbit:frames=2,degrees=40");
-    let (_, baked) = bake(&gpu, &s.geometry, &frames, settings(96, 4));
-    verify_all_modes(&gpu, "GlassVaseFlowers", &baked, &s.geometry);
+    orbit_verifies_in_every_mode("GlassVaseFlowers", "orbit:frames=2,degrees=40");
 }
 
 /// Textured alpha (MASK and BLEND materials with alpha from textures).
 #[test]
 fn alpha_blend_mode_test_verifies_in_every_mode() {
-    let Some(gpu) = Gpu::for_tests() else { return };
-    let Some(s) = real_scene("AlphaBlendModeTest") else {
-        return;
-    };
-    let frames = orbit(&s, "orbit:frames=2,degrees=30,elevation=10");
-    let (_, baked) = bake(&gpu, &s.geometry, &frames, settings(96, 4));
-    verify_all_modes(&gpu, "AlphaBlendModeTest", &baked, &s.geometry);
+    orbit_verifies_in_every_mode(
+        "AlphaBlendModeTest",
+        "orbit:frames=2,degrees=30,elevation=10",
+    );
 }
 
 /// The default pipeline (opaque first, transparent unsorted in id order, depth writes off)
@@ -302,15 +307,9 @@ fn default_pipeline_is_exact_only_when_id_order_is_back_to_front() {
     let render = |g: &Geometry| {
         let default = trisort_reference::DefaultRenderer::new(&gpu, g, &frames, view)
             .expect("default pipeline");
-        let config = trisort_reference::ReferenceConfig {
-            size: (64, 64),
-            samples: 4,
-            mode: Mode::Blend,
-            glass_opacity: 0.0,
-            max_layers: 64,
-        };
         let reference =
-            trisort_reference::ExactReference::new(&gpu, g, &frames, config).expect("reference");
+            trisort_reference::ExactReference::new(&gpu, g, &frames, reference_config(Mode::Blend))
+                .expect("reference");
         let d = default.render(0).expect("default frame");
         let r = reference.render(0, None).expect("reference frame");
         trisort_reference::compare(&d, &r.rgba8, 64, 64, &[])

@@ -147,19 +147,10 @@ fn tools_missing(tools: &[&str]) -> bool {
     !missing.is_empty()
 }
 
-#[test]
-fn window_plays_frames_under_xvfb() {
-    if tools_missing(&["xvfb-run"]) {
-        eprintln!(
-            "skipping the windowed part: xvfb-run is not on PATH (apt-get install xvfb); \
-             only the no-display error is tested"
-        );
-        return;
-    }
-    if !gpu_available() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+/// A temporary directory holding the demo car (3,000 triangles, 4 frames at 64×48) baked as
+/// `w.baked`, or `None` to skip the test where there is no GPU.
+fn baked_demo() -> Option<tempfile::TempDir> {
+    let dir = gpu_tempdir()?;
     run(
         dir.path(),
         &[
@@ -174,6 +165,21 @@ fn window_plays_frames_under_xvfb() {
         ],
         true,
     );
+    Some(dir)
+}
+
+#[test]
+fn window_plays_frames_under_xvfb() {
+    if tools_missing(&["xvfb-run"]) {
+        eprintln!(
+            "skipping the windowed part: xvfb-run is not on PATH (apt-get install xvfb); \
+             only the no-display error is tested"
+        );
+        return;
+    }
+    let Some(dir) = baked_demo() else {
+        return;
+    };
     for (mode, samples, frames) in [
         ("blend", "4", 5u64),
         ("depth", "1", 3),
@@ -262,24 +268,9 @@ fn window_shows_the_png_frames_pixels() {
         );
         return;
     }
-    if !gpu_available() {
+    let Some(dir) = baked_demo() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    run(
-        dir.path(),
-        &[
-            "bake",
-            "demo:3000",
-            "--path",
-            "orbit:frames=4",
-            "--size",
-            "64x48",
-            "-o",
-            "w.baked",
-        ],
-        true,
-    );
+    };
     for mode in ["blend", "saturate"] {
         let png_dir = format!("png-{mode}");
         run(

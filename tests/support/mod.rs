@@ -62,3 +62,9 @@ pub fn scene(name: &str) -> Option<String> {
 pub fn gpu_available() -> bool {
     trisort_shaders::gpu::Gpu::for_tests().is_some()
 }
+
+/// A fresh temporary directory for a test that needs a GPU, or `None` to skip the test where
+/// [`gpu_available`] finds none (it panics instead when a GPU is required).
+pub fn gpu_tempdir() -> Option<tempfile::TempDir> {
+    gpu_available().then(|| tempfile::tempdir().unwrap())
+}
