@@ -7,7 +7,7 @@
 //! - [`DefaultRenderer`]: every triangle with the depth test, opaque first, transparent
 //!   unsorted after: what engines do today.
 //! - [`Srgb8Player`]: the player on an 8-bit sRGB target (the deployment error).
-//! - [`compare`]: pixel, PSNR and FLIP figures, difference and mask images.
+//! - [`compare()`]: pixel, PSNR and FLIP figures, difference and mask images.
 //! - [`ImageVerifier`]: `trisort verify --scene`: a baked file's frames against the reference,
 //!   with the pass/fail rule of the recorded pattern.
 //!

@@ -38,7 +38,7 @@ pub struct VerifyArgs {
     /// Recording(s) the file was merged from: checks the graph rules.
     #[arg(long, num_args = 1..)]
     recording: Vec<PathBuf>,
-    /// Scene (.glb/.gltf or demo[:TRIANGLES]): checks the images against the exact reference.
+    /// Scene (.glb/.gltf or `demo[:TRIANGLES]`): checks the images against the exact reference.
     #[arg(long)]
     scene: Option<String>,
     /// Compositing mode of the image check.
