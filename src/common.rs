@@ -128,8 +128,8 @@ pub fn print_json(v: &serde_json::Value) {
 /// device asynchronously, and its default handler panics; the CLI instead prints the error
 /// and exits with status 1. Work already finished is safe: recordings keep their finished
 /// frames in `OUT.partial/` (a rerun resumes) and every output file is written by rename.
-pub fn open_gpu() -> Result<trisort_shaders::gpu::Gpu> {
-    let gpu = trisort_shaders::gpu::Gpu::new()?;
+pub fn open_gpu() -> Result<trisort_gpu::Gpu> {
+    let gpu = trisort_gpu::Gpu::new()?;
     let adapter = gpu.info.name.clone();
     gpu.device
         .on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {

@@ -11,7 +11,7 @@ use trisort_format::{
 use trisort_player::Mode;
 use trisort_recorder::{record, RecordJob};
 use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 // ---- scenes built here: camera at the origin looking down −Z ----
 
@@ -298,7 +298,7 @@ fn alpha_blend_mode_test_verifies_in_every_mode() {
 fn default_pipeline_is_exact_only_when_id_order_is_back_to_front() {
     let Some(gpu) = Gpu::for_tests() else { return };
     let frames = [frame_at(DVec3::ZERO)];
-    let view = trisort_shaders::scene_gpu::View {
+    let view = trisort_gpu::scene_gpu::View {
         width: 64,
         height: 64,
         samples: 4,

@@ -15,7 +15,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use trisort_bench::scaling::{self, growth, ScalingConfig, ScalingRow};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();

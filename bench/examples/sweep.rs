@@ -88,7 +88,7 @@ fn main() -> ExitCode {
         factors,
         ..SweepConfig::new(size, samples)
     };
-    let gpu = match trisort_shaders::gpu::Gpu::new() {
+    let gpu = match trisort_gpu::Gpu::new() {
         Ok(g) => g,
         Err(e) => {
             eprintln!("{e}");

@@ -18,8 +18,8 @@ use serde::Serialize;
 use trisort_format::{FrameState, Geometry};
 use trisort_player::headless::COLOR_FORMAT;
 use trisort_player::GpuTimer;
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{SceneGpu, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::{SceneGpu, View};
 use wgpu::util::DeviceExt;
 
 use crate::methods::{Method, Stream};
@@ -267,7 +267,7 @@ impl<'g> FragmentCounter<'g> {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("bench fragment counter"),
             source: wgpu::ShaderSource::Wgsl(
-                trisort_shaders::compose(&[], trisort_shaders::PLAYER).into(),
+                trisort_gpu::compose(&[], trisort_gpu::PLAYER).into(),
             ),
         });
         let pipeline = |compare: wgpu::CompareFunction, write: bool| {
@@ -292,7 +292,7 @@ impl<'g> FragmentCounter<'g> {
                     module: &module,
                     entry_point: Some("vs_player"),
                     compilation_options: Default::default(),
-                    buffers: &[Some(trisort_shaders::scene_gpu::vertex_layout())],
+                    buffers: &[Some(trisort_gpu::scene_gpu::vertex_layout())],
                 },
                 primitive: wgpu::PrimitiveState {
                     front_face: wgpu::FrontFace::Ccw,

@@ -21,8 +21,8 @@ use trisort_player::headless::{COLOR_FORMAT, DEPTH_FORMAT};
 use trisort_player::{clear_colour, FrameTarget, Mode, Player};
 use trisort_reference::exact::whole_scene_baked;
 use trisort_reference::DefaultRenderer;
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::View;
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::View;
 
 use crate::BenchError;
 

@@ -4,7 +4,7 @@
 use trisort_format::{FrameState, Geometry};
 use trisort_player::Mode;
 use trisort_reference::{OitConfig, OitRenderer, PeelingRenderer};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 use crate::methods::{BenchView, Method, Stream};
 use crate::BenchError;

@@ -19,7 +19,7 @@ use trisort_format::{Phase, RecordSettings, Recording};
 use trisort_merger::synth::{split_frames, turntable, Turntable};
 use trisort_merger::MergeOptions;
 use trisort_recorder::{record, RecordJob};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 use crate::plot::{write_svg, Chart, Series, Style};
 use crate::BenchError;

@@ -42,7 +42,7 @@ use trisort_player::headless::{HeadlessConfig, HeadlessRenderer};
 use trisort_player::Mode;
 use trisort_recorder::RecordJob;
 use trisort_reference::{compare, ExactReference, ReferenceConfig};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 use crate::plot::{write_atomic, write_svg, write_svg_labelled, Chart, Series, Style};
 use crate::BenchError;

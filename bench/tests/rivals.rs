@@ -7,8 +7,8 @@ use trisort_player::Mode;
 use trisort_reference::{
     DefaultRenderer, ExactReference, OitConfig, OitRenderer, PeelingRenderer, ReferenceConfig,
 };
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::View;
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::View;
 
 #[test]
 fn oit_and_peeling_equal_the_reference_on_glass_vase_flowers() {

@@ -5,7 +5,7 @@ use trisort_bench::scaling::{
     self, growth, growth_exponent, path_spec, ScalingConfig, ScalingRow, AXIS_FRAMES,
     AXIS_FRAMES_SEGMENTED, AXIS_SYNTHETIC, AXIS_TRIANGLES,
 };
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 #[test]
 fn slope_of_a_power_law() {

@@ -2,7 +2,7 @@
 //! what DESIGN guarantees at the recorded pattern.
 
 use trisort_bench::sweep::{run, Factor, SweepConfig, SweepPoint, CSV_COLUMNS};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 #[test]
 fn tiny_sweep_writes_consistent_outputs() {

@@ -100,7 +100,7 @@ pub struct PlayerConfig {
     /// How draws are issued ([`DrawPath::for_adapter`] picks the right one).
     pub draw_path: DrawPath,
     /// The device it is played on, as a file records it
-    /// (`trisort_shaders::gpu::device_info`), to warn when it is not the recording device.
+    /// (`trisort_gpu::device_info`), to warn when it is not the recording device.
     /// `None` skips that check.
     pub device: Option<DeviceInfo>,
 }
@@ -129,7 +129,7 @@ impl PlayerConfig {
     ) -> PlayerConfig {
         PlayerConfig {
             draw_path: DrawPath::for_adapter(adapter),
-            device: Some(trisort_shaders::gpu::device_info(&adapter.get_info())),
+            device: Some(trisort_gpu::device_info(&adapter.get_info())),
             ..PlayerConfig::recorded(baked, color_format)
         }
     }

@@ -5,7 +5,7 @@
 use std::sync::mpsc;
 
 use trisort_format::Baked;
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 use crate::config::{DrawPath, Mode, PlayerConfig};
 use crate::error::PlayerError;

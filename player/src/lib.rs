@@ -51,7 +51,7 @@ pub use timer::GpuTimer;
 /// player checks every draw of a baked file against its index buffer on the CPU when it loads
 /// it ([`Player::new`]), so hosts that trust that check may turn the GPU pass off. The flag is
 /// read when the *instance* creates a device, so it must be chosen before the device exists:
-/// `trisort_shaders::gpu::Gpu::with_flags(instance_flags(false))`, or set
+/// `trisort_gpu::Gpu::with_flags(instance_flags(false))`, or set
 /// `wgpu::InstanceDescriptor::flags` in a host's own setup.
 pub fn instance_flags(validate_indirect: bool) -> wgpu::InstanceFlags {
     let mut flags = wgpu::InstanceFlags::from_build_config().with_env();

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use trisort_format::{Baked, DrawIndexedIndirectArgs, FileKind, FrameWindow};
-use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use trisort_gpu::scene_gpu::{vertex_layout, SceneGpu, View};
 use wgpu::util::DeviceExt;
 
 use crate::commands::{frame_commands, index_buffer, Order};
@@ -243,7 +243,7 @@ impl Player {
     }
 }
 
-/// The fragment entry point of [`trisort_shaders::PLAYER`] a mode uses: straight alpha for
+/// The fragment entry point of [`trisort_gpu::PLAYER`] a mode uses: straight alpha for
 /// `blend` and `depth`, premultiplied for `saturate`. With [`blend_state`], what a reference
 /// renderer needs to composite exactly as the player does.
 pub fn fragment_entry_point(mode: Mode) -> &'static str {
@@ -290,7 +290,7 @@ fn create_pipeline(
     scene_layout: &wgpu::BindGroupLayout,
     config: &PlayerConfig,
 ) -> wgpu::RenderPipeline {
-    let source = trisort_shaders::compose(&[], trisort_shaders::PLAYER);
+    let source = trisort_gpu::compose(&[], trisort_gpu::PLAYER);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("trisort player"),
         source: wgpu::ShaderSource::Wgsl(source.into()),

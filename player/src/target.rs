@@ -207,7 +207,7 @@ impl FrameTarget {
     /// Panics if the target was created without `readback`.
     pub fn read_rgba8(
         &self,
-        gpu: &trisort_shaders::gpu::Gpu,
+        gpu: &trisort_gpu::gpu::Gpu,
         mode: Mode,
         encode: impl FnOnce(&mut wgpu::CommandEncoder),
     ) -> Result<Vec<u8>, PlayerError> {

@@ -10,7 +10,7 @@ use trisort_player::{
     Call, CallLog, DrawPath, HeadlessConfig, HeadlessRenderer, Mode, Player, PlayerConfig,
     PlayerError, BACKGROUND,
 };
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 fn gpu() -> Option<Gpu> {
     std::env::set_var(

@@ -6,8 +6,8 @@
 
 use glam::{DMat4, DVec3};
 use trisort_format::{Camera, FrameState, Geometry, Material, Node, Vertex};
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
 
 use crate::peeler::Peeler;
 
@@ -130,12 +130,12 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
     let scene = SceneGpu::new(device, &gpu.queue, g, frames, view);
     let body = format!(
         "{}\n@fragment\nfn fs_coverage(v: PlayerVarying, @builtin(primitive_index) p: u32) -> @location(0) vec2<u32> {{\n    return vec2<u32>(p + 1u, 0u);\n}}\n",
-        trisort_shaders::PLAYER
+        trisort_gpu::PLAYER
     );
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("coverage"),
         source: wgpu::ShaderSource::Wgsl(
-            trisort_shaders::compose(&["primitive_index"], &body).into(),
+            trisort_gpu::compose(&["primitive_index"], &body).into(),
         ),
     });
     let pipeline = ScenePipeline {
@@ -187,7 +187,7 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
     // Gather with the recorder's own compute shader.
     let gather = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("gather"),
-        source: wgpu::ShaderSource::Wgsl(trisort_shaders::gather_shader(4).into()),
+        source: wgpu::ShaderSource::Wgsl(trisort_gpu::gather_shader(4).into()),
     });
     let gather_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: None,

@@ -10,7 +10,7 @@
 //!
 //! Each layer is one render pass: triangles in ascending id order, depth test `Less`, the
 //! depth written explicitly, and fragments whose (depth, id) key is not greater than the
-//! previous layer's at that sample discarded (see `shaders/src/wgsl/peel.wgsl`). Samples that
+//! previous layer's at that sample discarded (see `gpu/src/wgsl/peel.wgsl`). Samples that
 //! are finished are masked so later layers do no work there.
 #![deny(missing_docs)]
 
@@ -26,8 +26,8 @@ use std::ops::Range;
 use trisort_format::{
     DeviceInfo, Edge, FrameRecord, FrameState, Geometry, Hash, Phase, RecordSettings, Recording,
 };
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::View;
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::View;
 
 use partial::{Graph, Visibility};
 pub use peeler::{Layer, Peeler};

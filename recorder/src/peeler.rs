@@ -6,8 +6,8 @@
 use std::ops::Range;
 
 use trisort_format::{FrameState, Geometry};
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::{
     begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
 };
 use wgpu::util::DeviceExt;
@@ -86,7 +86,7 @@ impl<'g> Peeler<'g> {
         let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("peel"),
-            source: wgpu::ShaderSource::Wgsl(trisort_shaders::peel_shader(view.samples).into()),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::peel_shader(view.samples).into()),
         });
         let ms = view.samples > 1;
         let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
@@ -133,7 +133,7 @@ impl<'g> Peeler<'g> {
 
         let gather_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("gather"),
-            source: wgpu::ShaderSource::Wgsl(trisort_shaders::gather_shader(view.samples).into()),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::gather_shader(view.samples).into()),
         });
         let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather"),
@@ -253,7 +253,7 @@ impl<'g> Peeler<'g> {
         // one colour per pixel.
         let plain_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("plain"),
-            source: wgpu::ShaderSource::Wgsl(trisort_shaders::plain_shader().into()),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::plain_shader().into()),
         });
         let plain = ScenePipeline {
             label: "plain",

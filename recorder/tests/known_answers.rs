@@ -5,7 +5,7 @@ use glam::DVec3;
 use trisort_format::fixtures::{flat_quad, frame_at, material, scene, settings, tri};
 use trisort_format::{FrameState, Geometry, Phase, RecordSettings, Recording};
 use trisort_recorder::{record, RecordJob};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 fn run(g: &Geometry, frames: &[FrameState], settings: RecordSettings) -> Option<Recording> {
     let gpu = Gpu::for_tests()?;

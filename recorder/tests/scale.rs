@@ -3,7 +3,7 @@
 use glam::{DMat4, DVec3};
 use trisort_format::{Geometry, Node, Phase, RecordSettings};
 use trisort_recorder::{record, RecordJob};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 /// `copies` copies of `g` on a grid, each under a new root node translated by `spacing`.
 fn instanced(g: &Geometry, copies: u32, spacing: f64) -> Geometry {

@@ -10,8 +10,8 @@
 
 use trisort_format::{AlphaMode, FrameState, Geometry};
 use trisort_player::{blend_state, quantize_rgba16f, Mode};
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
 use crate::target::{clear_colour, halves, Target, DEPTH_FORMAT};
@@ -57,7 +57,7 @@ impl<'g> DefaultRenderer<'g> {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("default pipeline"),
             source: wgpu::ShaderSource::Wgsl(
-                trisort_shaders::compose(&[], trisort_shaders::PLAYER).into(),
+                trisort_gpu::compose(&[], trisort_gpu::PLAYER).into(),
             ),
         });
         let pipeline = |write: bool| {

@@ -5,7 +5,7 @@
 use trisort_format::Baked;
 use trisort_player::headless::linear_to_srgb;
 use trisort_player::{Mode, Player, PlayerConfig, BACKGROUND};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 use crate::target::{clear_colour, Target, DEPTH_FORMAT};
 use crate::ReferenceError;

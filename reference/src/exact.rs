@@ -6,7 +6,7 @@
 //! front; `saturate`: front to back, under) through the player's vertex shader, its
 //! `player_colour`, its blend state and its `Rgba16Float` target, one render pass with one draw
 //! per layer: each triangle of a layer writes only the samples where the peel found it in that
-//! layer (`@builtin(sample_mask)`, see `shaders/src/wgsl/reference.wgsl`); shading stays per
+//! layer (`@builtin(sample_mask)`, see `gpu/src/wgsl/reference.wgsl`); shading stays per
 //! pixel as in the player. The pass resolves MSAA like the headless player and the result is
 //! quantized once with [`quantize_rgba16f`].
 //!
@@ -30,8 +30,8 @@ use trisort_format::{
 };
 use trisort_player::{blend_state, quantize_rgba16f, Mode, BACKGROUND};
 use trisort_recorder::Peeler;
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
 use crate::target::{check_pattern, clear_colour, halves, Target};
@@ -246,7 +246,7 @@ impl<'g> ExactReference<'g> {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("reference composite"),
-            source: wgpu::ShaderSource::Wgsl(trisort_shaders::reference_shader().into()),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::reference_shader().into()),
         });
         // The fragment outputs of `trisort_player::fragment_entry_point(mode)`, masked.
         let entry = match config.mode {

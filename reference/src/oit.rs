@@ -4,7 +4,7 @@
 //! Every frame draws the *whole scene* (every triangle, ascending ids, one draw, no depth test)
 //! once into per-sample linked lists, then resolves them with one full-screen pass:
 //!
-//! 1. **List pass** (`fs_oit_list` in `shaders/src/wgsl/oit.wgsl`): the player's `vs_player`
+//! 1. **List pass** (`fs_oit_list` in `gpu/src/wgsl/oit.wgsl`): the player's `vs_player`
 //!    and `player_colour`, shaded once per covered sample (`@builtin(sample_index)`). Each
 //!    fragment with alpha > 0 takes a node of a fixed pool with an atomic counter
 //!    (straight-alpha colour as f32, depth, scene triangle id from
@@ -36,8 +36,8 @@
 use trisort_format::{FrameState, Geometry};
 use trisort_player::headless::COLOR_FORMAT;
 use trisort_player::{clear_colour, quantize_rgba16f, FrameTarget, Mode};
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
 use crate::target::{halves, scene_index};
@@ -370,7 +370,7 @@ impl<'g> OitRenderer<'g> {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("oit"),
-            source: wgpu::ShaderSource::Wgsl(trisort_shaders::oit_shader(config.max_sorted).into()),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::oit_shader(config.max_sorted).into()),
         });
         // The list pass writes nothing to its colour attachment, which only gives the pass its
         // size and sample count: the smallest format that multisamples.

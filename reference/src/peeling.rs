@@ -41,8 +41,8 @@ use std::sync::Mutex;
 use trisort_format::{FrameState, Geometry};
 use trisort_player::headless::COLOR_FORMAT;
 use trisort_player::{blend_state, clear_colour, quantize_rgba16f, Mode};
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::{
     begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
 };
 use wgpu::util::DeviceExt;
@@ -204,7 +204,7 @@ impl<'g> PeelingRenderer<'g> {
 
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("peeling"),
-            source: wgpu::ShaderSource::Wgsl(trisort_shaders::peeling_shader(samples).into()),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::peeling_shader(samples).into()),
         });
         let multisampled = samples > 1;
         let texture_entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {

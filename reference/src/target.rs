@@ -3,7 +3,7 @@
 
 use trisort_format::Geometry;
 use trisort_player::FrameTarget;
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::gpu::Gpu;
 use wgpu::util::DeviceExt;
 
 use crate::ReferenceError;

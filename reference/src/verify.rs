@@ -18,7 +18,7 @@
 use serde::Serialize;
 use trisort_format::{Baked, Geometry};
 use trisort_player::{HeadlessConfig, HeadlessRenderer, Mode};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 use crate::compare::{compare, Comparison};
 use crate::deploy::Srgb8Player;

@@ -18,7 +18,7 @@ use trisort_player::Mode;
 use trisort_reference::{
     ExactReference, OitConfig, OitFrame, OitRenderer, ReferenceConfig, ReferenceError,
 };
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 // ---- scenes built here: camera at the origin looking down −Z ----
 

@@ -10,7 +10,7 @@ use trisort_format::fixtures::{frame_at, material, quad, scene};
 use trisort_format::{FrameState, Geometry, Vertex};
 use trisort_player::Mode;
 use trisort_reference::{ExactReference, PeelingRenderer, ReferenceConfig, ReferenceError};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 // ---- scenes built here: camera at the origin looking down −Z ----
 

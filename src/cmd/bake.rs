@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::Result;
 use clap::Args;
 use trisort_format::{Baked, Phase, Recording};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 use crate::cmd::merge::{baked_json, merge_to_file, print_summary, MergeOpts};
 use crate::cmd::record::{record_to_file, recording_json};

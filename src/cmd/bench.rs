@@ -14,7 +14,7 @@ use trisort_bench::plot::{write_svg, Chart, Series, Style};
 use trisort_bench::table::{run_group, GroupInput, GroupReport, MethodKind};
 use trisort_format::{Baked, FileKind, Recording};
 use trisort_player::Mode;
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 use crate::cmd::bake::{bake, recording_path};
 use crate::cmd::merge::{BridgeArg, MergeOpts};

@@ -9,7 +9,7 @@ use serde_json::json;
 use trisort_format::{Baked, FileKind};
 use trisort_player::config::Mode;
 use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
-use trisort_shaders::gpu::Gpu;
+use trisort_gpu::Gpu;
 
 use crate::common::{parse_range, parse_size, print_json, progress_bar, FrameRange};
 

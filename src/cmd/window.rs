@@ -455,7 +455,7 @@ impl Viewer {
             })?;
         let info = adapter.get_info();
         let adapter_name = info.name.clone();
-        let features = adapter.features() & trisort_shaders::gpu::wanted_features();
+        let features = adapter.features() & trisort_gpu::wanted_features();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("trisort window"),
             required_features: features,

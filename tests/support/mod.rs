@@ -60,7 +60,7 @@ pub fn scene(name: &str) -> Option<String> {
 
 /// Whether GPU tests can run here; panics when a GPU is required (CI) but missing.
 pub fn gpu_available() -> bool {
-    trisort_shaders::gpu::Gpu::for_tests().is_some()
+    trisort_gpu::Gpu::for_tests().is_some()
 }
 
 /// A fresh temporary directory for a test that needs a GPU, or `None` to skip the test where

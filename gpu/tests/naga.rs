@@ -2,7 +2,7 @@
 
 #[test]
 fn every_shader_validates() {
-    let all = trisort_shaders::all();
+    let all = trisort_gpu::all();
     assert!(!all.is_empty());
     for (name, source) in all {
         let module = naga::front::wgsl::parse_str(&source)
@@ -18,6 +18,6 @@ fn every_shader_validates() {
 
 #[test]
 fn a_broken_shader_is_caught() {
-    let source = trisort_shaders::compose(&[], "fn broken() -> f32 { return undefined_thing; }");
+    let source = trisort_gpu::compose(&[], "fn broken() -> f32 { return undefined_thing; }");
     assert!(naga::front::wgsl::parse_str(&source).is_err());
 }

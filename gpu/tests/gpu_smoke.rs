@@ -3,8 +3,8 @@
 
 use glam::{DMat4, DVec3};
 use trisort_format::{Camera, FrameState, Geometry, Material, Node, Vertex};
-use trisort_shaders::gpu::Gpu;
-use trisort_shaders::scene_gpu::{vertex_layout, SceneGpu, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::scene_gpu::{vertex_layout, SceneGpu, View};
 
 fn vertex(x: f32, y: f32) -> Vertex {
     Vertex {
@@ -55,7 +55,7 @@ fn one_triangle_renders_and_reads_back() {
         glass_opacity: 0.0,
     };
     let scene = SceneGpu::new(&gpu.device, &gpu.queue, &geometry, &[frame], v);
-    let source = trisort_shaders::compose(&[], trisort_shaders::SMOKE);
+    let source = trisort_gpu::compose(&[], trisort_gpu::SMOKE);
     let module = gpu
         .device
         .create_shader_module(wgpu::ShaderModuleDescriptor {

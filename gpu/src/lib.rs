@@ -7,7 +7,8 @@
 //! [`compose`] concatenates.
 #![deny(missing_docs)]
 
-pub mod gpu;
+pub mod device;
+pub use device::{device_info, wanted_features, Gpu, GpuError, REQUIRE_GPU_ENV};
 pub mod scene_gpu;
 
 /// The shared bindings, vertex layout, vertex transform and surface functions.
