@@ -16,10 +16,9 @@ use std::time::Instant;
 
 use serde::Serialize;
 use trisort_format::{FrameState, Geometry};
-use trisort_player::headless::COLOR_FORMAT;
-use trisort_player::GpuTimer;
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::{SceneGpu, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::{GpuTimer, COLOR_FORMAT};
 use wgpu::util::DeviceExt;
 
 use crate::methods::{Method, Stream};
@@ -266,9 +265,7 @@ impl<'g> FragmentCounter<'g> {
         let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("bench fragment counter"),
-            source: wgpu::ShaderSource::Wgsl(
-                trisort_gpu::compose(&[], trisort_gpu::PLAYER).into(),
-            ),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::compose(&[], trisort_gpu::PLAYER).into()),
         });
         let pipeline = |compare: wgpu::CompareFunction, write: bool| {
             let face = wgpu::StencilFaceState {
@@ -332,20 +329,14 @@ impl<'g> FragmentCounter<'g> {
             pipeline(wgpu::CompareFunction::Less, false),
         ];
         let texture = |format, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("bench fragment counter"),
-                size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
+            trisort_gpu::pipeline::texture_2d(
+                device,
+                "bench fragment counter",
+                size,
+                1,
                 format,
                 usage,
-                view_formats: &[],
-            })
+            )
         };
         let color = texture(COLOR_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT)
             .create_view(&Default::default());

@@ -23,6 +23,9 @@ pub enum BenchError {
     /// The player failed.
     #[error(transparent)]
     Player(#[from] trisort_player::PlayerError),
+    /// A GPU target or readback failed.
+    #[error(transparent)]
+    Gpu(#[from] trisort_gpu::GpuError),
     /// Recording failed.
     #[error(transparent)]
     Record(#[from] trisort_recorder::RecordError),

@@ -15,14 +15,14 @@
 use trisort_format::{
     Baked, DrawIndexedIndirectArgs, FrameState, FrameWindow, Geometry, Recording,
 };
+use trisort_gpu::scene_gpu::View;
+use trisort_gpu::Gpu;
+use trisort_gpu::{clear_colour, FrameTarget, TargetConfig, COLOR_FORMAT, DEPTH_FORMAT};
 use trisort_player::commands::{index_buffer, Order};
 use trisort_player::config::{DrawPath, PlayerConfig};
-use trisort_player::headless::{COLOR_FORMAT, DEPTH_FORMAT};
-use trisort_player::{clear_colour, FrameTarget, Mode, Player};
+use trisort_player::{Mode, Player};
 use trisort_reference::exact::whole_scene_baked;
 use trisort_reference::DefaultRenderer;
-use trisort_gpu::Gpu;
-use trisort_gpu::scene_gpu::View;
 
 use crate::BenchError;
 
@@ -134,11 +134,7 @@ impl<'g> PlayerMethod<'g> {
         let target = FrameTarget::new(
             &gpu.adapter,
             &gpu.device,
-            view.size,
-            view.samples,
-            COLOR_FORMAT,
-            depth,
-            true,
+            TargetConfig::readback(view.size, view.samples, mode),
         )?;
         let config = PlayerConfig {
             color_format: COLOR_FORMAT,
@@ -304,11 +300,10 @@ impl<'g> DefaultMethod<'g> {
         let target = FrameTarget::new(
             &gpu.adapter,
             &gpu.device,
-            view.size,
-            view.samples,
-            COLOR_FORMAT,
-            true,
-            true,
+            TargetConfig {
+                depth: true,
+                ..TargetConfig::readback(view.size, view.samples, Mode::Blend)
+            },
         )?;
         let mut streams = [Vec::new(), Vec::new()];
         for (t, tri) in geometry.triangles.iter().enumerate() {

@@ -2,9 +2,9 @@
 //! and GPU depth peeling (both in `trisort-reference`).
 
 use trisort_format::{FrameState, Geometry};
-use trisort_player::Mode;
-use trisort_reference::{OitConfig, OitRenderer, PeelingRenderer};
 use trisort_gpu::Gpu;
+use trisort_player::Mode;
+use trisort_reference::{OitConfig, OitRenderer, PeelingConfig, PeelingRenderer};
 
 use crate::methods::{BenchView, Method, Stream};
 use crate::BenchError;
@@ -96,16 +96,11 @@ impl<'g> PeelingMethod<'g> {
         mode: Mode,
         max_layers: u32,
     ) -> Result<PeelingMethod<'g>, BenchError> {
-        let renderer = PeelingRenderer::with_glass_opacity(
-            gpu,
-            geometry,
-            frames,
-            view.size,
-            view.samples,
-            mode,
-            max_layers,
-            view.glass_opacity,
-        )?;
+        let config = PeelingConfig {
+            glass_opacity: view.glass_opacity,
+            ..PeelingConfig::new(view.size, view.samples, mode, max_layers)
+        };
+        let renderer = PeelingRenderer::new(gpu, geometry, frames, config)?;
         Ok(PeelingMethod {
             gpu,
             renderer,

@@ -5,15 +5,16 @@
 
 use trisort_player::Mode;
 use trisort_reference::{
-    DefaultRenderer, ExactReference, OitConfig, OitRenderer, PeelingRenderer, ReferenceConfig,
+    DefaultRenderer, ExactReference, OitConfig, OitRenderer, PeelingConfig, PeelingRenderer,
+    ReferenceConfig,
 };
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::View;
+use trisort_testkit::gpu;
 
 #[test]
 fn oit_and_peeling_equal_the_reference_on_glass_vase_flowers() {
-    let Some(gpu) = Gpu::for_tests() else { return };
-    let Some(path) = trisort_scene::test_scene("GlassVaseFlowers/GlassVaseFlowers.glb") else {
+    let Some(gpu) = gpu() else { return };
+    let Some(path) = trisort_testkit::scene_path("GlassVaseFlowers/GlassVaseFlowers.glb") else {
         return;
     };
     let scene = trisort_scene::load(&path).expect("scene loads");
@@ -38,15 +39,14 @@ fn oit_and_peeling_equal_the_reference_on_glass_vase_flowers() {
             };
             let exact =
                 ExactReference::new(&gpu, &scene.geometry, &frames, config).expect("reference");
-            let peeling = PeelingRenderer::with_glass_opacity(
+            let peeling = PeelingRenderer::new(
                 &gpu,
                 &scene.geometry,
                 &frames,
-                size,
-                samples,
-                mode,
-                4096,
-                glass,
+                PeelingConfig {
+                    glass_opacity: glass,
+                    ..PeelingConfig::new(size, samples, mode, 4096)
+                },
             )
             .expect("peeling");
             let oit = (mode == Mode::Blend).then(|| {

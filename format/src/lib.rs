@@ -15,14 +15,15 @@
 pub mod baked;
 pub mod camera;
 pub mod container;
-pub mod fixtures;
 pub mod geometry;
+pub mod mode;
 pub mod recording;
 
 pub use baked::{Baked, DrawIndexedIndirectArgs, FrameWindow, MatrixCell, MergeInfo, MergeStats};
 pub use camera::{world_transforms, Camera, FrameState, NodePose};
 pub use container::{read_file, write_file_atomic, FileKind, FormatError, FORMAT_VERSION};
 pub use geometry::{AlphaMode, Geometry, Material, Node, Texture, Vertex};
+pub use mode::{Mode, ParseModeError};
 pub use recording::{DeviceInfo, Edge, FrameRecord, Phase, RecordSettings, Recording};
 
 /// The version of the trisort tool that wrote a file (stored in every file).

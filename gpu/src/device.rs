@@ -1,8 +1,4 @@
-//! Headless device setup shared by every GPU stage, and the CI rule for missing adapters.
-
-/// Environment variable that, when `1` (CI sets it), turns a missing GPU adapter into a test
-/// failure instead of a skip.
-pub const REQUIRE_GPU_ENV: &str = "TRISORT_REQUIRE_GPU";
+//! Headless device setup shared by every GPU stage.
 
 /// Errors setting up the GPU.
 #[derive(Debug, thiserror::Error)]
@@ -18,6 +14,20 @@ pub enum GpuError {
         /// Why.
         reason: String,
     },
+    /// The adapter cannot render this format at this sample count.
+    #[error("{format:?} does not support {samples}x multisampling on this adapter")]
+    SampleCount {
+        /// The format.
+        format: wgpu::TextureFormat,
+        /// The sample count asked for.
+        samples: u32,
+    },
+    /// wgpu refused to create a resource or run a command.
+    #[error("wgpu: {0}")]
+    Wgpu(String),
+    /// The device was lost or a readback failed.
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
 }
 
 /// A device with what trisort learned about its adapter.
@@ -70,13 +80,32 @@ impl Gpu {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         desc.flags = flags;
         let instance = wgpu::Instance::new(desc);
+        Gpu::open(&instance, None, "trisort")
+    }
+
+    /// A device on an adapter of `instance` that can present to `surface` (a window's, created
+    /// from `instance`), with the adapter's own limits and the [`wanted_features`] it supports,
+    /// chosen like [`Gpu::new`] otherwise.
+    pub fn for_surface(
+        instance: &wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+    ) -> Result<Gpu, GpuError> {
+        Gpu::open(instance, Some(surface), "trisort window")
+    }
+
+    /// The one adapter and device request behind [`Gpu::with_flags`] and [`Gpu::for_surface`].
+    fn open(
+        instance: &wgpu::Instance,
+        compatible_surface: Option<&wgpu::Surface<'_>>,
+        label: &str,
+    ) -> Result<Gpu, GpuError> {
         let adapter =
             pollster::block_on(
                 instance.request_adapter(&wgpu::RequestAdapterOptions {
                     power_preference: wgpu::PowerPreference::from_env()
                         .unwrap_or(wgpu::PowerPreference::HighPerformance),
                     force_fallback_adapter: false,
-                    compatible_surface: None,
+                    compatible_surface,
                     apply_limit_buckets: false,
                 }),
             )
@@ -84,7 +113,7 @@ impl Gpu {
         let info = adapter.get_info();
         let features = adapter.features() & wanted_features();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("trisort"),
+            label: Some(label),
             required_features: features,
             required_limits: adapter.limits(),
             ..Default::default()
@@ -99,21 +128,6 @@ impl Gpu {
             queue,
             info,
         })
-    }
-
-    /// For tests: a device, or `None` (the test skips, saying why) when there is no adapter,
-    /// unless `TRISORT_REQUIRE_GPU=1`, in which case a missing adapter panics.
-    pub fn for_tests() -> Option<Gpu> {
-        match Gpu::new() {
-            Ok(g) => Some(g),
-            Err(e) if std::env::var(REQUIRE_GPU_ENV).as_deref() == Ok("1") => {
-                panic!("{e} and {REQUIRE_GPU_ENV}=1")
-            }
-            Err(e) => {
-                eprintln!("skipping GPU test: {e}");
-                None
-            }
-        }
     }
 
     /// One line describing the adapter, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Mesa 22.3.6)`.

@@ -1,4 +1,8 @@
-//! WGSL and GPU setup shared by trisort's recorder, player and reference.
+//! trisort's GPU code in one place: every WGSL shader, device setup (headless or for a
+//! window's surface), scene upload ([`scene_gpu`]), the off-screen frame target
+//! ([`FrameTarget`]), readback and the one quantisation to 8-bit sRGB ([`readback`]), GPU
+//! timestamps ([`GpuTimer`]). The recorder, the player, the reference, the bench and the window
+//! viewer build on it; the player keeps only what playing a baked file needs.
 //!
 //! Every pipeline's shader is [`COMMON`] followed by its own entry points, so all of them use
 //! the one vertex transform (`transform_position`) and the one surface function
@@ -8,14 +12,31 @@
 #![deny(missing_docs)]
 
 pub mod device;
-pub use device::{device_info, wanted_features, Gpu, GpuError, REQUIRE_GPU_ENV};
+pub mod pipeline;
+pub mod present;
+pub mod readback;
+pub mod target;
+mod timer;
+
+pub use device::{device_info, wanted_features, Gpu, GpuError};
+pub use readback::{
+    f16_to_f32, halves, linear_to_srgb, map_read_all, poll_ready, quantize_rgba16f,
+};
+pub use target::{clear_colour, FrameTarget, TargetConfig, BACKGROUND, COLOR_FORMAT, DEPTH_FORMAT};
+pub use timer::GpuTimer;
 pub mod scene_gpu;
 
 /// The shared bindings, vertex layout, vertex transform and surface functions.
 pub const COMMON: &str = include_str!("wgsl/common.wgsl");
 
-/// Entry points of the GPU smoke test (one triangle through the shared transform).
+/// The GPU smoke test's fragment entry point (`fs_smoke`); compose with [`smoke_shader`].
 pub const SMOKE: &str = include_str!("wgsl/smoke.wgsl");
+
+/// The complete smoke-test shader: [`COMMON`], the plain pass's vertex stage (`vs_plain`) and
+/// [`SMOKE`]'s `fs_smoke`, which colours each triangle by its material.
+pub fn smoke_shader() -> String {
+    compose(&[], &format!("{PLAIN}\n{SMOKE}"))
+}
 
 /// Entry points of the player (`vs_player`, `fs_player_straight`, `fs_player_premultiplied`).
 pub const PLAYER: &str = include_str!("wgsl/player.wgsl");
@@ -148,10 +169,34 @@ pub fn peeling_shader(samples: u32) -> String {
     compose(&["primitive_index"], &format!("{PLAYER}\n{body}"))
 }
 
+/// The coverage test's entry point (`fs_coverage`); compose with [`coverage_shader`].
+pub const COVERAGE: &str = include_str!("wgsl/coverage.wgsl");
+
+/// The complete shader of the recorder's coverage test: [`COMMON`], the player's [`PLAYER`]
+/// entry points (`vs_player`) and [`COVERAGE`] (needs `Features::PRIMITIVE_INDEX`).
+pub fn coverage_shader() -> String {
+    compose(&["primitive_index"], &format!("{PLAYER}\n{COVERAGE}"))
+}
+
+/// The window viewer's copy of a frame to its surface (`vs_blit`, `fs_blit`); stand-alone (no
+/// shared bindings): see [`blit_shader`].
+pub const BLIT: &str = include_str!("wgsl/blit.wgsl");
+
+/// The complete blit shader: `under` puts `background` (linear RGB) under the frame's
+/// premultiplied colour (`saturate` mode), `encode_srgb` applies the sRGB transfer function in
+/// the shader (for a non-sRGB view of an 8-bit surface).
+pub fn blit_shader(under: bool, encode_srgb: bool, background: [f32; 3]) -> String {
+    format!(
+        "const UNDER: bool = {under};\nconst ENCODE_SRGB: bool = {encode_srgb};\n\
+         const BACKGROUND: vec3<f32> = vec3<f32>({:?}, {:?}, {:?});\n{BLIT}",
+        background[0], background[1], background[2],
+    )
+}
+
 /// Every shader of the crate by name, composed and ready to compile (used by the naga test).
 pub fn all() -> Vec<(&'static str, String)> {
     vec![
-        ("smoke", compose(&[], SMOKE)),
+        ("smoke", smoke_shader()),
         ("player", compose(&[], PLAYER)),
         ("reference", reference_shader()),
         ("peel 1x", peel_shader(1)),
@@ -162,6 +207,9 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("peeling 1x", peeling_shader(1)),
         ("peeling 4x", peeling_shader(4)),
         ("oit", oit_shader(32)),
+        ("coverage", coverage_shader()),
+        ("blit", blit_shader(false, true, BACKGROUND)),
+        ("blit saturate linear", blit_shader(true, false, BACKGROUND)),
     ]
 }
 

@@ -3,8 +3,8 @@
 
 use glam::{DMat4, DVec3};
 use trisort_format::{Camera, FrameState, Geometry, Material, Node, Vertex};
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::{vertex_layout, SceneGpu, View};
+use trisort_testkit::gpu;
 
 fn vertex(x: f32, y: f32) -> Vertex {
     Vertex {
@@ -18,7 +18,7 @@ fn vertex(x: f32, y: f32) -> Vertex {
 
 #[test]
 fn one_triangle_renders_and_reads_back() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     eprintln!("adapter: {}", gpu.describe());
     let geometry = Geometry {
         // Covers the left half of the view; the right half stays clear.
@@ -55,7 +55,7 @@ fn one_triangle_renders_and_reads_back() {
         glass_opacity: 0.0,
     };
     let scene = SceneGpu::new(&gpu.device, &gpu.queue, &geometry, &[frame], v);
-    let source = trisort_gpu::compose(&[], trisort_gpu::SMOKE);
+    let source = trisort_gpu::smoke_shader();
     let module = gpu
         .device
         .create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -77,7 +77,7 @@ fn one_triangle_renders_and_reads_back() {
             layout: Some(&layout),
             vertex: wgpu::VertexState {
                 module: &module,
-                entry_point: Some("vs_main"),
+                entry_point: Some("vs_plain"),
                 compilation_options: Default::default(),
                 buffers: &[Some(vertex_layout())],
             },
@@ -86,7 +86,7 @@ fn one_triangle_renders_and_reads_back() {
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,
-                entry_point: Some("fs_main"),
+                entry_point: Some("fs_smoke"),
                 compilation_options: Default::default(),
                 targets: &[Some(format.into())],
             }),

@@ -27,14 +27,9 @@ pub enum PlayerError {
     /// `depth` mode without a depth attachment format.
     #[error("depth mode needs a depth attachment: set PlayerConfig::depth_format")]
     DepthFormatMissing,
-    /// The adapter cannot render this format at this sample count.
-    #[error("{format:?} does not support {samples}x multisampling on this adapter")]
-    SampleCount {
-        /// The format.
-        format: wgpu::TextureFormat,
-        /// The sample count asked for.
-        samples: u32,
-    },
+    /// A GPU resource could not be created or read (targets, readback).
+    #[error(transparent)]
+    Gpu(#[from] trisort_gpu::GpuError),
     /// wgpu refused to create a resource or run a command.
     #[error("wgpu: {0}")]
     Wgpu(String),

@@ -2,24 +2,17 @@
 //! into an `Rgba16Float` target (MSAA resolved to one sample), read back and quantized once to
 //! 8-bit sRGB, the way the exact reference renders (DESIGN § Frame accuracy).
 
-use std::sync::mpsc;
-
 use trisort_format::Baked;
 use trisort_gpu::Gpu;
 
-use crate::config::{DrawPath, Mode, PlayerConfig};
+use crate::config::{DrawPath, PlayerConfig};
 use crate::error::PlayerError;
-use crate::player::{block_on_ready, Player};
-use crate::target::{clear_colour, FrameTarget};
-use crate::timer::GpuTimer;
-
-/// The background every headless frame is drawn over: a dark grey, linear RGB.
-pub const BACKGROUND: [f32; 3] = [0.03, 0.03, 0.03];
-
-/// Format of the headless colour target.
-pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// Format of the headless depth target (`depth` mode only).
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+use crate::player::Player;
+use trisort_format::Mode;
+use trisort_gpu::{
+    clear_colour, map_read_all, poll_ready, FrameTarget, GpuTimer, TargetConfig, COLOR_FORMAT,
+    DEPTH_FORMAT,
+};
 
 /// One rendered frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -111,11 +104,7 @@ impl<'g> HeadlessRenderer<'g> {
         let target = FrameTarget::new(
             &gpu.adapter,
             &gpu.device,
-            (w, h),
-            samples,
-            COLOR_FORMAT,
-            config.mode == Mode::Depth,
-            true,
+            TargetConfig::readback((w, h), samples, config.mode),
         )?;
         let player_config = PlayerConfig {
             color_format: COLOR_FORMAT,
@@ -166,7 +155,7 @@ impl<'g> HeadlessRenderer<'g> {
         };
         if let Err(e) = drawn {
             drop(enc);
-            let _ = block_on_ready(scope.pop());
+            let _ = poll_ready(scope.pop());
             return Err(e);
         }
         if let Some(t) = &self.timer {
@@ -174,7 +163,7 @@ impl<'g> HeadlessRenderer<'g> {
         }
         self.target.copy_to_staging(&mut enc);
         self.gpu.queue.submit([enc.finish()]);
-        if let Some(Some(e)) = block_on_ready(scope.pop()) {
+        if let Some(Some(e)) = poll_ready(scope.pop()) {
             return Err(PlayerError::Wgpu(e.to_string()));
         }
 
@@ -190,123 +179,5 @@ impl<'g> HeadlessRenderer<'g> {
             rgba8,
             gpu_ms,
         })
-    }
-}
-
-/// Maps `MAP_READ` buffers after the queue is done with them and returns their bytes.
-fn map_read_all(
-    device: &wgpu::Device,
-    buffers: &[&wgpu::Buffer],
-) -> Result<Vec<Vec<u8>>, PlayerError> {
-    let (tx, rx) = mpsc::channel();
-    for (k, b) in buffers.iter().enumerate() {
-        let tx = tx.clone();
-        b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send((k, r));
-        });
-    }
-    drop(tx);
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| PlayerError::Readback(e.to_string()))?;
-    for (_, r) in rx.iter() {
-        r.map_err(|e| PlayerError::Readback(e.to_string()))?;
-    }
-    let mut out = Vec::with_capacity(buffers.len());
-    for b in buffers {
-        let bytes = b
-            .slice(..)
-            .get_mapped_range()
-            .map_err(|e| PlayerError::Readback(e.to_string()))?
-            .to_vec();
-        b.unmap();
-        out.push(bytes);
-    }
-    Ok(out)
-}
-
-/// An IEEE 754 half (binary16) as f32.
-pub fn f16_to_f32(h: u16) -> f32 {
-    let negative = h & 0x8000 != 0;
-    let exp = ((h >> 10) & 0x1f) as u32;
-    let man = (h & 0x3ff) as u32;
-    let magnitude = match exp {
-        0 => man as f32 * (1.0 / 16_777_216.0), // subnormal: man × 2⁻²⁴
-        31 => f32::from_bits(0x7f80_0000 | (man << 13)),
-        _ => f32::from_bits(((exp + 112) << 23) | (man << 13)),
-    };
-    if negative {
-        -magnitude
-    } else {
-        magnitude
-    }
-}
-
-/// Linear to sRGB transfer function (IEC 61966-2-1) on [0, 1].
-pub fn linear_to_srgb(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// Converts linear `Rgba16Float` texels (4 halves each) to 8-bit sRGB RGBA with alpha 255,
-/// quantizing once: the one conversion the player and the exact reference share.
-///
-/// With `under = None` the texels are final colours (`blend`, `depth`: already composited over
-/// an opaque background). With `Some(background)` they hold premultiplied colour and coverage
-/// alpha (`saturate`'s accumulation) and the background goes under them first:
-/// `rgb + (1 − a)·background`.
-pub fn quantize_rgba16f(halves: &[u16], under: Option<[f32; 3]>) -> Vec<u8> {
-    debug_assert!(halves.len().is_multiple_of(4));
-    let mut out = Vec::with_capacity(halves.len());
-    for px in halves.chunks_exact(4) {
-        let a = f16_to_f32(px[3]).clamp(0.0, 1.0);
-        for (c, &h) in px[..3].iter().enumerate() {
-            let mut v = f16_to_f32(h);
-            if let Some(bg) = under {
-                v += (1.0 - a) * bg[c];
-            }
-            out.push((linear_to_srgb(v) * 255.0).round() as u8);
-        }
-        out.push(255);
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn halves_decode() {
-        assert_eq!(f16_to_f32(0x0000), 0.0);
-        assert_eq!(f16_to_f32(0x3c00), 1.0);
-        assert_eq!(f16_to_f32(0xc000), -2.0);
-        assert_eq!(f16_to_f32(0x3800), 0.5);
-        assert_eq!(f16_to_f32(0x7bff), 65504.0);
-        assert_eq!(f16_to_f32(0x0001), 2f32.powi(-24));
-        assert_eq!(f16_to_f32(0x7c00), f32::INFINITY);
-        assert!(f16_to_f32(0x7e00).is_nan());
-    }
-
-    #[test]
-    fn quantize_once_with_and_without_background() {
-        // 1.0 and 0.5 linear; alpha 1.
-        let px = [0x3c00, 0x3800, 0x0000, 0x3c00];
-        assert_eq!(quantize_rgba16f(&px, None), vec![255, 188, 0, 255]);
-        // Premultiplied nothing (alpha 0) over a background of 0.5 gives the background.
-        let empty = [0, 0, 0, 0];
-        assert_eq!(
-            quantize_rgba16f(&empty, Some([0.5, 0.5, 1.0])),
-            vec![188, 188, 255, 255]
-        );
-        // Alpha 1 hides the background entirely.
-        assert_eq!(
-            quantize_rgba16f(&px, Some([1.0; 3])),
-            vec![255, 188, 0, 255]
-        );
     }
 }

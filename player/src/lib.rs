@@ -30,18 +30,15 @@ pub mod draw_calls;
 mod error;
 pub mod headless;
 mod player;
-pub mod target;
-mod timer;
 
-pub use config::{playback_warnings, DrawPath, Mode, ParseModeError, PlayerConfig};
+pub use config::{playback_warnings, DrawPath, PlayerConfig};
 pub use draw_calls::{Call, CallLog, DrawCalls};
 pub use error::PlayerError;
-pub use headless::{
-    quantize_rgba16f, render_frames, HeadlessConfig, HeadlessRenderer, RenderedFrame, BACKGROUND,
-};
+pub use headless::{render_frames, HeadlessConfig, HeadlessRenderer, RenderedFrame};
 pub use player::{blend_state, fragment_entry_point, open_baked, Player};
-pub use target::{clear_colour, FrameTarget};
-pub use timer::GpuTimer;
+pub use trisort_format::{Mode, ParseModeError};
+/// The background every frame is drawn over (re-exported from the GPU crate for hosts).
+pub use trisort_gpu::BACKGROUND;
 
 /// Instance flags with wgpu's indirect-call validation (`VALIDATION_INDIRECT_CALL`) switched
 /// on or off, the other flags as wgpu chooses them (build type and `WGPU_*` environment).

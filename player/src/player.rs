@@ -7,9 +7,10 @@ use trisort_gpu::scene_gpu::{vertex_layout, SceneGpu, View};
 use wgpu::util::DeviceExt;
 
 use crate::commands::{frame_commands, index_buffer, Order};
-use crate::config::{playback_warnings, DrawPath, Mode, PlayerConfig};
+use crate::config::{playback_warnings, DrawPath, PlayerConfig};
 use crate::draw_calls::DrawCalls;
 use crate::error::PlayerError;
+use trisort_format::Mode;
 
 /// Size in bytes of one `DrawIndexedIndirectArgs`.
 const ARGS_SIZE: u64 = std::mem::size_of::<DrawIndexedIndirectArgs>() as u64;
@@ -127,7 +128,7 @@ impl Player {
         });
         let pipeline = create_pipeline(device, &scene.layout, &config);
 
-        if let Some(Some(e)) = block_on_ready(scope.pop()) {
+        if let Some(Some(e)) = trisort_gpu::poll_ready(scope.pop()) {
             return Err(PlayerError::Wgpu(e.to_string()));
         }
         Ok(Player {
@@ -350,18 +351,4 @@ fn create_pipeline(
         multiview_mask: None,
         cache: None,
     })
-}
-
-/// Polls a future that native wgpu resolves immediately (error-scope pops). A future still
-/// pending after a bounded number of polls is taken to carry no error.
-pub(crate) fn block_on_ready<F: std::future::Future>(fut: F) -> Option<F::Output> {
-    let mut fut = std::pin::pin!(fut);
-    let mut cx = std::task::Context::from_waker(std::task::Waker::noop());
-    for _ in 0..1000 {
-        if let std::task::Poll::Ready(v) = fut.as_mut().poll(&mut cx) {
-            return Some(v);
-        }
-        std::thread::yield_now();
-    }
-    None
 }

@@ -6,8 +6,9 @@
 
 use glam::{DMat4, DVec3};
 use trisort_format::{Camera, FrameState, Geometry, Material, Node, Vertex};
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::Gpu;
+use trisort_testkit::gpu;
 
 use crate::peeler::Peeler;
 
@@ -128,15 +129,9 @@ fn frame() -> FrameState {
 fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View) -> Vec<u32> {
     let device = &gpu.device;
     let scene = SceneGpu::new(device, &gpu.queue, g, frames, view);
-    let body = format!(
-        "{}\n@fragment\nfn fs_coverage(v: PlayerVarying, @builtin(primitive_index) p: u32) -> @location(0) vec2<u32> {{\n    return vec2<u32>(p + 1u, 0u);\n}}\n",
-        trisort_gpu::PLAYER
-    );
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("coverage"),
-        source: wgpu::ShaderSource::Wgsl(
-            trisort_gpu::compose(&["primitive_index"], &body).into(),
-        ),
+        source: wgpu::ShaderSource::Wgsl(trisort_gpu::coverage_shader().into()),
     });
     let pipeline = ScenePipeline {
         label: "coverage",
@@ -154,20 +149,14 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
     }
     .build(device);
     let tex = |format| {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: None,
-            size: wgpu::Extent3d {
-                width: SIZE,
-                height: SIZE,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 4,
-            dimension: wgpu::TextureDimension::D2,
+        trisort_gpu::pipeline::texture_2d(
+            device,
+            "coverage",
+            (SIZE, SIZE),
+            4,
             format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        })
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        )
     };
     let ids = tex(wgpu::TextureFormat::Rg32Uint);
     let depth = tex(wgpu::TextureFormat::Depth32Float);
@@ -236,27 +225,9 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
     });
     let mut enc = device.create_command_encoder(&Default::default());
     {
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: None,
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &idv,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &dv,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
+        // The recorder's own pass set-up: ids cleared to 0, depth to 1, both stored.
+        let mut pass =
+            trisort_gpu::scene_gpu::begin_peel_pass(&mut enc, "coverage", &idv, &dv, 1.0, None);
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &scene.bind_group, &scene.offsets(0));
         pass.set_vertex_buffer(0, scene.vertices.slice(..));
@@ -277,7 +248,7 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
 
 #[test]
 fn recorded_samples_equal_an_independent_render_through_the_player_state() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let g = edge_case_scene();
     let frames = [frame()];
     let view = View {

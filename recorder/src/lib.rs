@@ -24,10 +24,10 @@ use std::collections::HashMap;
 use std::ops::Range;
 
 use trisort_format::{
-    DeviceInfo, Edge, FrameRecord, FrameState, Geometry, Hash, Phase, RecordSettings, Recording,
+    Edge, FrameRecord, FrameState, Geometry, Hash, Phase, RecordSettings, Recording,
 };
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::View;
+use trisort_gpu::Gpu;
 
 use partial::{Graph, Visibility};
 pub use peeler::{Layer, Peeler};
@@ -84,17 +84,6 @@ pub struct Progress {
     pub total: u32,
     /// Layers peeled for this frame.
     pub layers: u32,
-}
-
-/// The device description stored in recordings.
-pub fn device_info(gpu: &Gpu) -> DeviceInfo {
-    DeviceInfo {
-        adapter: gpu.info.name.clone(),
-        driver: format!("{} {}", gpu.info.driver, gpu.info.driver_info)
-            .trim()
-            .to_string(),
-        backend: format!("{:?}", gpu.info.backend),
-    }
 }
 
 fn check_job(job: &RecordJob) -> Result<Range<u32>, RecordError> {
@@ -359,7 +348,7 @@ pub fn record(
         scene_hash: job.scene_hash,
         path_hash: job.path_hash,
         settings: s,
-        device: device_info(gpu),
+        device: gpu.device_info(),
         phase: job.phase,
         scene_triangles: job.geometry.triangles.len() as u32,
         frame_states: job.frames.to_vec(),

@@ -6,10 +6,10 @@
 use std::ops::Range;
 
 use trisort_format::{FrameState, Geometry};
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::{
     begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
 };
+use trisort_gpu::Gpu;
 use wgpu::util::DeviceExt;
 
 use crate::RecordError;
@@ -188,23 +188,15 @@ impl<'g> Peeler<'g> {
             contents: bytemuck::cast_slice(&index_data),
             usage: wgpu::BufferUsages::INDEX,
         });
-        let size = wgpu::Extent3d {
-            width: view.width,
-            height: view.height,
-            depth_or_array_layers: 1,
-        };
         let target = |label, format| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: view.samples,
-                dimension: wgpu::TextureDimension::D2,
+            trisort_gpu::pipeline::texture_2d(
+                device,
+                label,
+                (view.width, view.height),
+                view.samples,
                 format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            })
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            )
         };
         let slots = view.width as u64 * view.height as u64 * view.samples as u64;
         let out_size = slots * 16;

@@ -9,12 +9,13 @@
 //! reference is what sorting buys.
 
 use trisort_format::{AlphaMode, FrameState, Geometry};
-use trisort_player::{blend_state, quantize_rgba16f, Mode};
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::{clear_colour, halves, quantize_rgba16f, COLOR_FORMAT};
+use trisort_player::{blend_state, Mode};
 use wgpu::util::DeviceExt;
 
-use crate::target::{clear_colour, halves, Target, DEPTH_FORMAT};
+use crate::target::{Target, DEPTH_FORMAT};
 use crate::ReferenceError;
 
 /// Whether a scene triangle is drawn in the transparent pass: its material (that of its first
@@ -50,15 +51,13 @@ impl<'g> DefaultRenderer<'g> {
             gpu,
             (view.width, view.height),
             view.samples,
-            trisort_player::headless::COLOR_FORMAT,
+            COLOR_FORMAT,
             true,
         )?;
         let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("default pipeline"),
-            source: wgpu::ShaderSource::Wgsl(
-                trisort_gpu::compose(&[], trisort_gpu::PLAYER).into(),
-            ),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::compose(&[], trisort_gpu::PLAYER).into()),
         });
         let pipeline = |write: bool| {
             ScenePipeline {
@@ -72,7 +71,7 @@ impl<'g> DefaultRenderer<'g> {
                 vertex: "vs_player",
                 fragment: trisort_player::fragment_entry_point(Mode::Blend),
                 target: wgpu::ColorTargetState {
-                    format: trisort_player::headless::COLOR_FORMAT,
+                    format: COLOR_FORMAT,
                     blend: Some(blend_state(Mode::Blend)),
                     write_mask: wgpu::ColorWrites::ALL,
                 },

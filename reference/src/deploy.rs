@@ -3,11 +3,11 @@
 //! gated on (DESIGN § Frame accuracy).
 
 use trisort_format::Baked;
-use trisort_player::headless::linear_to_srgb;
-use trisort_player::{Mode, Player, PlayerConfig, BACKGROUND};
 use trisort_gpu::Gpu;
+use trisort_gpu::{clear_colour, linear_to_srgb, BACKGROUND};
+use trisort_player::{Mode, Player, PlayerConfig};
 
-use crate::target::{clear_colour, Target, DEPTH_FORMAT};
+use crate::target::{Target, DEPTH_FORMAT};
 use crate::ReferenceError;
 
 /// Format of the deployment target.

@@ -28,13 +28,14 @@ use std::collections::HashSet;
 use trisort_format::{
     Baked, DrawIndexedIndirectArgs, FrameState, FrameWindow, Geometry, RecordSettings,
 };
-use trisort_player::{blend_state, quantize_rgba16f, Mode, BACKGROUND};
-use trisort_recorder::Peeler;
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::{clear_colour, halves, quantize_rgba16f, BACKGROUND, COLOR_FORMAT};
+use trisort_player::{blend_state, Mode};
+use trisort_recorder::Peeler;
 use wgpu::util::DeviceExt;
 
-use crate::target::{check_pattern, clear_colour, halves, Target};
+use crate::target::{check_pattern, Target};
 use crate::ReferenceError;
 
 /// The pattern and mode a reference frame is rendered at.
@@ -263,7 +264,7 @@ impl<'g> ExactReference<'g> {
             vertex: "vs_player",
             fragment: entry,
             target: wgpu::ColorTargetState {
-                format: trisort_player::headless::COLOR_FORMAT,
+                format: COLOR_FORMAT,
                 blend: Some(blend_state(config.mode)),
                 write_mask: wgpu::ColorWrites::ALL,
             },
@@ -276,13 +277,7 @@ impl<'g> ExactReference<'g> {
             contents: bytemuck::cast_slice(&[config.size.0, config.samples, 0, 0]),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let target = Target::new(
-            gpu,
-            config.size,
-            config.samples,
-            trisort_player::headless::COLOR_FORMAT,
-            false,
-        )?;
+        let target = Target::new(gpu, config.size, config.samples, COLOR_FORMAT, false)?;
         Ok(ExactReference {
             gpu,
             config,

@@ -32,7 +32,7 @@ pub use default_pipeline::DefaultRenderer;
 pub use deploy::Srgb8Player;
 pub use exact::{ExactReference, ReferenceConfig, ReferenceFrame, RemovedEdges};
 pub use oit::{OitConfig, OitFrame, OitRenderer};
-pub use peeling::{PeeledFrame, PeelingRenderer};
+pub use peeling::{PeeledFrame, PeelingConfig, PeelingRenderer};
 pub use verify::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
 
 /// Errors of the reference renderers.

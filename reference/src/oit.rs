@@ -33,14 +33,16 @@
 //! split over up to [`NODE_BUFFERS`] storage buffers since one binding is limited: 128 MiB on
 //! lavapipe, so the default 16 nodes per sample fit up to 512² at 4×) and the targets.
 
+use trisort_format::Mode;
 use trisort_format::{FrameState, Geometry};
-use trisort_player::headless::COLOR_FORMAT;
-use trisort_player::{clear_colour, quantize_rgba16f, FrameTarget, Mode};
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::{
+    clear_colour, halves, quantize_rgba16f, FrameTarget, TargetConfig, COLOR_FORMAT,
+};
 use wgpu::util::DeviceExt;
 
-use crate::target::{halves, scene_index};
+use crate::target::scene_index;
 use crate::ReferenceError;
 
 /// Bytes of one node of the pool: colour (4 × f32), depth (f32), triangle id, next index.
@@ -267,11 +269,7 @@ impl<'g> OitRenderer<'g> {
         let target = FrameTarget::new(
             &gpu.adapter,
             device,
-            config.size,
-            config.samples,
-            COLOR_FORMAT,
-            false,
-            true,
+            TargetConfig::readback(config.size, config.samples, Mode::Blend),
         )
         .map_err(|e| ReferenceError::Unsupported(format!("{}: {e}", gpu.describe())))?;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -399,56 +397,28 @@ impl<'g> OitRenderer<'g> {
             samples: config.samples,
         }
         .build(device);
-        let resolve_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("oit resolve"),
-            bind_group_layouts: &[Some(&scene.layout), Some(&layout)],
-            immediate_size: 0,
-        });
-        let resolve_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("oit resolve"),
-            layout: Some(&resolve_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_oit_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
+        let resolve_pipeline = trisort_gpu::pipeline::fullscreen(
+            device,
+            "oit resolve",
+            &[&scene.layout, &layout],
+            &module,
+            ("vs_oit_fullscreen", "fs_oit_resolve"),
+            wgpu::ColorTargetState {
+                format: COLOR_FORMAT,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
             },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState {
-                count: config.samples,
-                mask: !0,
-                alpha_to_coverage_enabled: false,
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_oit_resolve"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: COLOR_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let dummy = device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some("oit list pass attachment"),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: config.samples,
-                dimension: wgpu::TextureDimension::D2,
-                format: dummy_format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            })
-            .create_view(&Default::default());
+            config.samples,
+        );
+        let dummy = trisort_gpu::pipeline::texture_2d(
+            device,
+            "oit list pass attachment",
+            (w, h),
+            config.samples,
+            dummy_format,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(ReferenceError::Wgpu(e.to_string()));
         }

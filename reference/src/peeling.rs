@@ -39,21 +39,19 @@
 use std::sync::Mutex;
 
 use trisort_format::{FrameState, Geometry};
-use trisort_player::headless::COLOR_FORMAT;
-use trisort_player::{blend_state, clear_colour, quantize_rgba16f, Mode};
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::{
     begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
 };
+use trisort_gpu::Gpu;
+use trisort_gpu::{clear_colour, halves, quantize_rgba16f, COLOR_FORMAT, DEPTH_FORMAT};
+use trisort_player::{blend_state, Mode};
 use wgpu::util::DeviceExt;
 
-use crate::target::{check_pattern, halves, scene_index};
+use crate::target::{check_pattern, scene_index};
 use crate::ReferenceError;
 
 /// Format of the peel passes' id target (triangle id + 1, 0 = no fragment).
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
-/// Format of the peel passes' depth target (read back as the previous key).
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Which fragments a peel pass keeps (the `mode` uniform of `fs_peeling`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -124,44 +122,56 @@ pub struct PeelingRenderer<'g> {
     counted: Mutex<Vec<Option<(u32, bool)>>>,
 }
 
+/// Size, mode and budget of a [`PeelingRenderer`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PeelingConfig {
+    /// Image size (width, height).
+    pub size: (u32, u32),
+    /// MSAA samples (1 or 4).
+    pub samples: u32,
+    /// `Blend` or `Depth` (`Saturate` has no peeling renderer).
+    pub mode: Mode,
+    /// Most layers peeled a frame; a frame that needs more is marked truncated.
+    pub max_layers: u32,
+    /// Opacity transmissive glass is drawn at (a baked file's recorded opacity, or the one it
+    /// is played at).
+    pub glass_opacity: f32,
+}
+
+impl PeelingConfig {
+    /// `mode` at `size` and `samples` with at most `max_layers` layers, transmissive glass at
+    /// the recorder's default opacity.
+    pub fn new(size: (u32, u32), samples: u32, mode: Mode, max_layers: u32) -> PeelingConfig {
+        PeelingConfig {
+            size,
+            samples,
+            mode,
+            max_layers,
+            glass_opacity: trisort_format::RecordSettings::default().glass_opacity,
+        }
+    }
+}
+
 impl<'g> PeelingRenderer<'g> {
-    /// Uploads `geometry` with the path's `frames` for rendering at `size` with `samples`
-    /// (1 or 4) in `mode` (`Blend` or `Depth`), with at most `max_layers` layers a frame.
+    /// Uploads `geometry` with the path's `frames` for rendering as `config` says.
     ///
     /// Errors: [`ReferenceError::Invalid`] for `Saturate`, an empty size or another sample
-    /// count; [`ReferenceError::Unsupported`] where the device lacks `PRIMITIVE_INDEX` or
-    /// cannot multisample the id, depth or colour targets at `samples`.
-    ///
-    /// Transmissive glass is drawn at opacity 0 (the recorder's default); see
-    /// [`PeelingRenderer::with_glass_opacity`].
+    /// count than 1 or 4; [`ReferenceError::Unsupported`] where the device lacks
+    /// `PRIMITIVE_INDEX` or cannot multisample the id, depth or colour targets at the sample
+    /// count.
     pub fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
-        size: (u32, u32),
-        samples: u32,
-        mode: Mode,
-        max_layers: u32,
+        config: PeelingConfig,
     ) -> Result<Self, ReferenceError> {
-        let glass = trisort_format::RecordSettings::default().glass_opacity;
-        PeelingRenderer::with_glass_opacity(
-            gpu, geometry, frames, size, samples, mode, max_layers, glass,
-        )
-    }
-
-    /// [`PeelingRenderer::new`] with transmissive glass drawn at `glass_opacity` (a baked
-    /// file's recorded opacity, or the one it is played at).
-    #[allow(clippy::too_many_arguments)]
-    pub fn with_glass_opacity(
-        gpu: &'g Gpu,
-        geometry: &Geometry,
-        frames: &[FrameState],
-        size: (u32, u32),
-        samples: u32,
-        mode: Mode,
-        max_layers: u32,
-        glass_opacity: f32,
-    ) -> Result<Self, ReferenceError> {
+        let PeelingConfig {
+            size,
+            samples,
+            mode,
+            max_layers,
+            glass_opacity,
+        } = config;
         check_pattern(size, samples)?;
         if mode == Mode::Saturate {
             return Err(ReferenceError::Invalid(
@@ -269,22 +279,8 @@ impl<'g> PeelingRenderer<'g> {
             contents: &params,
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let extent = wgpu::Extent3d {
-            width: size.0,
-            height: size.1,
-            depth_or_array_layers: 1,
-        };
         let texture = |label, format, sample_count, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: extent,
-                mip_level_count: 1,
-                sample_count,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
+            trisort_gpu::pipeline::texture_2d(device, label, size, sample_count, format, usage)
         };
         let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let peel_usage = attachment | wgpu::TextureUsages::TEXTURE_BINDING;

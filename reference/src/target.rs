@@ -2,14 +2,13 @@
 //! where asked) resolved to one sample by the render pass, then read back.
 
 use trisort_format::Geometry;
-use trisort_player::FrameTarget;
-use trisort_gpu::gpu::Gpu;
+use trisort_gpu::{FrameTarget, Gpu, TargetConfig};
 use wgpu::util::DeviceExt;
 
 use crate::ReferenceError;
 
 /// Format of the depth attachment of [`Target`]s that have one (the headless player's).
-pub(crate) use trisort_player::headless::DEPTH_FORMAT;
+pub(crate) use trisort_gpu::DEPTH_FORMAT;
 
 /// The player's [`FrameTarget`] with a readback, rendered through one call.
 pub(crate) struct Target(FrameTarget);
@@ -24,17 +23,16 @@ impl Target {
         format: wgpu::TextureFormat,
         depth: bool,
     ) -> Result<Target, ReferenceError> {
-        FrameTarget::new(
-            &gpu.adapter,
-            &gpu.device,
+        let config = TargetConfig {
             size,
             samples,
             format,
             depth,
-            true,
-        )
-        .map(Target)
-        .map_err(|e| ReferenceError::Unsupported(format!("{}: {e}", gpu.describe())))
+            readback: true,
+        };
+        FrameTarget::new(&gpu.adapter, &gpu.device, config)
+            .map(Target)
+            .map_err(|e| ReferenceError::Unsupported(format!("{}: {e}", gpu.describe())))
     }
 
     /// Runs one render pass cleared to `clear` (depth to 1), lets `draw` record into it,
@@ -63,17 +61,6 @@ impl Target {
         Ok(self.0.unpad(&gpu.map_read(staging)))
     }
 }
-
-/// Little-endian halves from `Rgba16Float` bytes.
-pub(crate) fn halves(bytes: &[u8]) -> Vec<u16> {
-    bytes
-        .chunks_exact(2)
-        .map(|b| u16::from_le_bytes([b[0], b[1]]))
-        .collect()
-}
-
-/// The clear colour of a mode's target, as the headless player clears it.
-pub(crate) use trisort_player::clear_colour;
 
 /// Rejects an empty size or a sample count other than 1 or 4 (the exact reference's and the
 /// peeling renderer's patterns).

@@ -6,11 +6,14 @@
 //! order and blend state, so every frame must equal the reference's byte for byte.
 
 use glam::DVec3;
-use trisort_format::fixtures::{frame_at, material, quad, scene};
 use trisort_format::{FrameState, Geometry, Vertex};
 use trisort_player::Mode;
-use trisort_reference::{ExactReference, PeelingRenderer, ReferenceConfig, ReferenceError};
+use trisort_reference::{
+    ExactReference, PeelingConfig, PeelingRenderer, ReferenceConfig, ReferenceError,
+};
 use trisort_gpu::Gpu;
+use trisort_testkit::fixtures::{frame_at, material, quad, scene};
+use trisort_testkit::gpu;
 
 // ---- scenes built here: camera at the origin looking down −Z ----
 
@@ -143,10 +146,7 @@ fn same_as_reference(
         gpu,
         geometry,
         frames,
-        (size, size),
-        samples,
-        mode,
-        max_layers,
+        PeelingConfig::new((size, size), samples, mode, max_layers),
     )
     .expect("peeling renderer");
     assert_eq!(peeling.triangles(), geometry.triangles.len() as u64);
@@ -204,7 +204,7 @@ fn one_frame_stack(gpu: &Gpu, g: &Geometry, samples: u32, max_layers: u32) -> Ve
 
 #[test]
 fn stacked_quads_peel_as_many_layers_as_the_stack_is_deep() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     for n in [1, 3, 6] {
         let g = stack(n);
         for samples in [1, 4] {
@@ -217,7 +217,7 @@ fn stacked_quads_peel_as_many_layers_as_the_stack_is_deep() {
 
 #[test]
 fn coplanar_ties_resolve_by_id_as_in_the_reference() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     // Three coplanar quads of different colours, overlapping in part, behind one tilted quad
     // that cuts through them, and a coplanar pair facing away (double-sided).
     let mut g = scene(vec![
@@ -244,7 +244,7 @@ fn coplanar_ties_resolve_by_id_as_in_the_reference() {
 
 #[test]
 fn an_opaque_occluder_is_peeled_through_like_the_reference() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let mut g = stack(4);
     g.materials.push(material([0.9, 0.9, 0.9], 1.0));
     // Opaque, between the second and third quad, covering the left half.
@@ -260,7 +260,7 @@ fn an_opaque_occluder_is_peeled_through_like_the_reference() {
 
 #[test]
 fn a_soup_of_interpenetrating_triangles_matches_the_reference() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let g = soup(300, 7);
     for samples in [1, 4] {
         for mode in [Mode::Blend, Mode::Depth] {
@@ -275,7 +275,7 @@ fn a_soup_of_interpenetrating_triangles_matches_the_reference() {
 
 #[test]
 fn depth_mode_draws_the_first_layer_only() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let g = stack(5);
     for samples in [1, 4] {
         let r = same_as_reference(&gpu, "stack", &g, &frames(), 48, samples, Mode::Depth, 64);
@@ -285,7 +285,7 @@ fn depth_mode_draws_the_first_layer_only() {
 
 #[test]
 fn a_frame_beyond_max_layers_is_truncated_to_its_front_layers() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let g = stack(6);
     for samples in [1, 4] {
         for max_layers in [1, 2, 5] {
@@ -301,7 +301,7 @@ fn a_frame_beyond_max_layers_is_truncated_to_its_front_layers() {
 
 #[test]
 fn an_empty_view_has_no_layer_and_shows_the_background() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let mut g = stack(2);
     // Behind the camera.
     for v in &mut g.vertices {
@@ -318,10 +318,10 @@ fn an_empty_view_has_no_layer_and_shows_the_background() {
 
 #[test]
 fn encode_records_a_frame_without_readback_and_counts_passes() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let g = stack(3);
     let fs = [frame_at(DVec3::ZERO)];
-    let peeling = PeelingRenderer::new(&gpu, &g, &fs, (32, 32), 4, Mode::Blend, 16).unwrap();
+    let peeling = PeelingRenderer::new(&gpu, &g, &fs, PeelingConfig::new((32, 32), 4, Mode::Blend, 16)).unwrap();
     let layers = peeling.layers(0).unwrap();
     assert_eq!(layers, 3);
     let stats = gpu
@@ -351,10 +351,10 @@ fn encode_records_a_frame_without_readback_and_counts_passes() {
 
 #[test]
 fn saturate_and_bad_patterns_are_rejected() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let g = stack(1);
     let fs = [frame_at(DVec3::ZERO)];
-    let new = |size, samples, mode| PeelingRenderer::new(&gpu, &g, &fs, size, samples, mode, 8);
+    let new = |size, samples, mode| PeelingRenderer::new(&gpu, &g, &fs, PeelingConfig::new(size, samples, mode, 8));
     assert!(matches!(
         new((8, 8), 4, Mode::Saturate),
         Err(ReferenceError::Invalid(_))

@@ -7,9 +7,9 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde_json::json;
 use trisort_format::{Baked, FileKind};
-use trisort_player::config::Mode;
-use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
 use trisort_gpu::Gpu;
+use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
+use trisort_player::Mode;
 
 use crate::common::{parse_range, parse_size, print_json, progress_bar, FrameRange};
 

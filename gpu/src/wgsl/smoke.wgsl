@@ -1,19 +1,7 @@
-// The GPU smoke test: one triangle through the shared vertex transform.
-
-struct Out {
-    @invariant @builtin(position) position: vec4<f32>,
-    @location(0) @interpolate(flat) material: u32,
-}
-
-@vertex
-fn vs_main(v: VertexIn) -> Out {
-    var out: Out;
-    out.position = transform_position(v.position, v.node);
-    out.material = v.material;
-    return out;
-}
+// The GPU smoke test: one triangle through the shared vertex transform (the plain pass's
+// `vs_plain`, composed before this), coloured by its material.
 
 @fragment
-fn fs_main(in: Out) -> @location(0) vec4<f32> {
+fn fs_smoke(in: PlainVarying) -> @location(0) vec4<f32> {
     return materials[in.material].base_color;
 }

@@ -4,9 +4,49 @@
 //! `samples > 1`), an optional depth attachment, and an optional staging buffer to read the
 //! resolved frame back.
 
-use crate::config::Mode;
-use crate::error::PlayerError;
-use crate::headless::{quantize_rgba16f, BACKGROUND, DEPTH_FORMAT};
+use trisort_format::Mode;
+
+use crate::pipeline::texture_2d;
+use crate::readback::{halves, poll_ready, quantize_rgba16f};
+use crate::{Gpu, GpuError};
+
+/// The background every frame is drawn over: a dark grey, linear RGB.
+pub const BACKGROUND: [f32; 3] = [0.03, 0.03, 0.03];
+
+/// Format of the frame's colour attachment: linear, so blending is exact to f16 and the one
+/// quantisation to 8-bit sRGB happens at readback ([`quantize_rgba16f`]).
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Format of the frame's depth attachment (`depth` mode only).
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// What a [`FrameTarget`] holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TargetConfig {
+    /// Size in pixels (zero is taken as one).
+    pub size: (u32, u32),
+    /// MSAA samples (zero is taken as one); above one the colour is resolved by the pass.
+    pub samples: u32,
+    /// Colour format.
+    pub format: wgpu::TextureFormat,
+    /// Whether there is a [`DEPTH_FORMAT`] attachment.
+    pub depth: bool,
+    /// Whether there is a staging buffer to read the resolved frame back.
+    pub readback: bool,
+}
+
+impl TargetConfig {
+    /// A [`COLOR_FORMAT`] frame read back after the pass, with depth in `depth` mode: what the
+    /// headless player and the reference render into.
+    pub fn readback(size: (u32, u32), samples: u32, mode: Mode) -> TargetConfig {
+        TargetConfig {
+            size,
+            samples,
+            format: COLOR_FORMAT,
+            depth: mode == Mode::Depth,
+            readback: true,
+        }
+    }
+}
 
 /// The clear colour of a mode's target: the background with alpha 1 for `blend` and `depth`;
 /// transparent for `saturate`, whose background goes under the accumulated colour at the end.
@@ -35,19 +75,22 @@ pub struct FrameTarget {
 }
 
 impl FrameTarget {
-    /// Creates the attachments (`Depth32Float` when `depth`), and a staging buffer when
-    /// `readback`. The resolved texture can also be sampled (`TEXTURE_BINDING`). Errors where
-    /// the adapter cannot multisample `format` or the depth format at `samples`, or where
-    /// `format` has no fixed texel size.
+    /// Creates the attachments (`Depth32Float` when `config.depth`), and a staging buffer when
+    /// `config.readback`. The resolved texture can also be sampled (`TEXTURE_BINDING`). Errors
+    /// where the adapter cannot multisample the colour or the depth format at the sample
+    /// count, or where the colour format has no fixed texel size.
     pub fn new(
         adapter: &wgpu::Adapter,
         device: &wgpu::Device,
-        size: (u32, u32),
-        samples: u32,
-        format: wgpu::TextureFormat,
-        depth: bool,
-        readback: bool,
-    ) -> Result<FrameTarget, PlayerError> {
+        config: TargetConfig,
+    ) -> Result<FrameTarget, GpuError> {
+        let TargetConfig {
+            size,
+            samples,
+            format,
+            depth,
+            readback,
+        } = config;
         let size = (size.0.max(1), size.1.max(1));
         let samples = samples.max(1);
         for f in std::iter::once(format).chain(depth.then_some(DEPTH_FORMAT)) {
@@ -56,27 +99,14 @@ impl FrameTarget {
                 .flags
                 .sample_count_supported(samples)
             {
-                return Err(PlayerError::SampleCount { format: f, samples });
+                return Err(GpuError::SampleCount { format: f, samples });
             }
         }
         let bytes_per_pixel = format.block_copy_size(None).ok_or_else(|| {
-            PlayerError::Wgpu(format!("{format:?} has no fixed texel size to read back"))
+            GpuError::Wgpu(format!("{format:?} has no fixed texel size to read back"))
         })?;
         let texture = |label, format, sample_count, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
+            texture_2d(device, label, size, sample_count, format, usage)
         };
         let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let resolved = texture(
@@ -194,12 +224,10 @@ impl FrameTarget {
     /// alpha 255, quantized once like every frame trisort compares: in `saturate` mode the
     /// background goes under the accumulated colour first.
     pub fn rgba8(&self, padded: &[u8], mode: Mode) -> Vec<u8> {
-        let halves: Vec<u16> = self
-            .unpad(padded)
-            .chunks_exact(2)
-            .map(|b| u16::from_le_bytes([b[0], b[1]]))
-            .collect();
-        quantize_rgba16f(&halves, (mode == Mode::Saturate).then_some(BACKGROUND))
+        quantize_rgba16f(
+            &halves(&self.unpad(padded)),
+            (mode == Mode::Saturate).then_some(BACKGROUND),
+        )
     }
 
     /// Runs `encode` in one command encoder, copies the resolved frame to the staging buffer,
@@ -207,17 +235,17 @@ impl FrameTarget {
     /// Panics if the target was created without `readback`.
     pub fn read_rgba8(
         &self,
-        gpu: &trisort_gpu::gpu::Gpu,
+        gpu: &Gpu,
         mode: Mode,
         encode: impl FnOnce(&mut wgpu::CommandEncoder),
-    ) -> Result<Vec<u8>, PlayerError> {
+    ) -> Result<Vec<u8>, GpuError> {
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         encode(&mut enc);
         self.copy_to_staging(&mut enc);
         gpu.queue.submit([enc.finish()]);
-        if let Some(Some(e)) = crate::player::block_on_ready(scope.pop()) {
-            return Err(PlayerError::Wgpu(e.to_string()));
+        if let Some(Some(e)) = poll_ready(scope.pop()) {
+            return Err(GpuError::Wgpu(e.to_string()));
         }
         let staging = self
             .staging

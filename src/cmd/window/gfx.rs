@@ -1,0 +1,225 @@
+//! The viewer's GPU side: the window's surface and device, the player and its offscreen
+//! target, and the blit that presents the target ([`trisort_gpu::present`]). The event loop
+//! (`mod.rs`) decides what to show; this draws it.
+
+use std::sync::{Arc, Mutex};
+
+use anyhow::{anyhow, bail, Context, Result};
+use trisort_format::Baked;
+use trisort_gpu::present::{configure_surface, Blit};
+use trisort_gpu::{clear_colour, FrameTarget, Gpu, TargetConfig, COLOR_FORMAT, DEPTH_FORMAT};
+use trisort_player::{Mode, Player, PlayerConfig};
+use winit::event_loop::OwnedDisplayHandle;
+use winit::window::Window;
+
+/// How the viewer plays: sample count, mode and glass opacity (`None`: as recorded).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PlaySettings {
+    pub samples: u32,
+    pub mode: Mode,
+    pub glass_opacity: Option<f32>,
+}
+
+/// The window, its surface and device, the copy-to-surface pipeline and the player's targets.
+pub(super) struct Gfx {
+    pub window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    pub gpu: Gpu,
+    pub surface_config: wgpu::SurfaceConfiguration,
+    /// Format the blit writes through (the surface format without its sRGB suffix).
+    view_format: wgpu::TextureFormat,
+    blit: Blit,
+    play: PlaySettings,
+    /// The first wgpu error no error scope caught.
+    uncaptured: Arc<Mutex<Option<String>>>,
+    pub targets: Targets,
+}
+
+/// A player and the offscreen target it draws into, at one size.
+pub(super) struct Targets {
+    pub size: (u32, u32),
+    pub player: Player,
+    frame: FrameTarget,
+    blit_group: wgpu::BindGroup,
+}
+
+impl Gfx {
+    /// A surface for `window`, a device that can present to it, the blit and the player at the
+    /// window's size.
+    pub fn open(
+        window: Arc<Window>,
+        display: OwnedDisplayHandle,
+        baked: &Baked,
+        play: PlaySettings,
+    ) -> Result<Gfx> {
+        let mut desc =
+            wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(display));
+        desc.flags = wgpu::InstanceFlags::from_build_config().with_env();
+        let instance = wgpu::Instance::new(desc);
+        let surface = instance
+            .create_surface(window.clone())
+            .context("creating a wgpu surface for the window")?;
+        let gpu = Gpu::for_surface(&instance, &surface)
+            .context("opening a GPU device that can present to this window")?;
+        let uncaptured = Arc::new(Mutex::new(None::<String>));
+        {
+            let slot = uncaptured.clone();
+            gpu.device
+                .on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+                    let mut slot = slot.lock().unwrap_or_else(|p| p.into_inner());
+                    slot.get_or_insert_with(|| e.to_string());
+                }));
+        }
+        let inner = window.inner_size();
+        let (width, height) = (inner.width.max(1), inner.height.max(1));
+        let setup = configure_surface(&gpu, &surface, (width, height))?;
+        let blit = Blit::new(&gpu.device, setup.view_format, play.mode);
+        let targets = Targets::new(&gpu, baked, &blit, (width, height), play)?;
+        eprintln!(
+            "trisort: window {width}x{height} on {} ({:?}), surface {:?} written as {:?}, \
+             {} sample(s), {} mode",
+            gpu.info.name,
+            gpu.info.backend,
+            setup.config.format,
+            setup.view_format,
+            play.samples,
+            play.mode
+        );
+        Ok(Gfx {
+            window,
+            surface,
+            gpu,
+            surface_config: setup.config,
+            view_format: setup.view_format,
+            blit,
+            play,
+            uncaptured,
+            targets,
+        })
+    }
+
+    /// Reconfigures the surface at `size`; whether the player's targets now differ in size
+    /// (the caller rebuilds them once the size has settled).
+    pub fn resize_surface(&mut self, size: (u32, u32)) -> bool {
+        self.surface_config.width = size.0;
+        self.surface_config.height = size.1;
+        self.surface
+            .configure(&self.gpu.device, &self.surface_config);
+        size != self.targets.size
+    }
+
+    /// Rebuilds the player and its targets at `size`.
+    pub fn rebuild(&mut self, baked: &Baked, size: (u32, u32)) -> Result<()> {
+        // Free the old targets before allocating new ones.
+        self.gpu
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
+        self.targets = Targets::new(&self.gpu, baked, &self.blit, size, self.play)?;
+        Ok(())
+    }
+
+    /// Draws `frame` and presents it; `false` when nothing was presented (minimized,
+    /// occluded, or the surface must be reconfigured first).
+    pub fn present(&mut self, frame: u32) -> Result<bool> {
+        if self.window.inner_size().width == 0 || self.window.inner_size().height == 0 {
+            return Ok(false); // minimized
+        }
+        let surface_texture = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t) => t,
+            wgpu::CurrentSurfaceTexture::Suboptimal(t) => {
+                // Present this one; reconfigure for the next.
+                self.surface
+                    .configure(&self.gpu.device, &self.surface_config);
+                t
+            }
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(false);
+            }
+            wgpu::CurrentSurfaceTexture::Outdated => {
+                self.surface
+                    .configure(&self.gpu.device, &self.surface_config);
+                self.window.request_redraw();
+                return Ok(false);
+            }
+            wgpu::CurrentSurfaceTexture::Lost => bail!("the window's surface was lost"),
+            wgpu::CurrentSurfaceTexture::Validation => {
+                bail!("wgpu: {}", self.take_uncaptured().unwrap_or_default())
+            }
+        };
+        let surface_view = surface_texture
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor {
+                format: Some(self.view_format),
+                ..Default::default()
+            });
+        let t = &self.targets;
+        let mut enc = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("trisort window frame"),
+            });
+        {
+            // In saturate mode the background goes under the accumulated colour in the blit.
+            let mut pass = t
+                .frame
+                .begin_pass(&mut enc, clear_colour(self.play.mode), None);
+            t.player.draw(&mut pass, frame)?;
+        }
+        self.blit.encode(&mut enc, &surface_view, &t.blit_group);
+        self.gpu.queue.submit([enc.finish()]);
+        if let Some(e) = self.take_uncaptured() {
+            bail!("wgpu: {e}");
+        }
+        self.window.pre_present_notify();
+        self.gpu.queue.present(surface_texture);
+        Ok(true)
+    }
+
+    fn take_uncaptured(&self) -> Option<String> {
+        self.uncaptured
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .take()
+    }
+}
+
+impl Targets {
+    /// A player for `size` and its target: `Rgba16Float` (multisampled and resolved when
+    /// `samples > 1`), `Depth32Float` in `depth` mode.
+    fn new(
+        gpu: &Gpu,
+        baked: &Baked,
+        blit: &Blit,
+        size: (u32, u32),
+        play: PlaySettings,
+    ) -> Result<Targets> {
+        let depth_format = (play.mode == Mode::Depth).then_some(DEPTH_FORMAT);
+        let target = TargetConfig {
+            size,
+            samples: play.samples,
+            format: COLOR_FORMAT,
+            depth: depth_format.is_some(),
+            readback: false,
+        };
+        let frame = FrameTarget::new(&gpu.adapter, &gpu.device, target)
+            .map_err(|e| anyhow!("{e} (--samples)"))?;
+        let config = PlayerConfig {
+            depth_format,
+            sample_count: play.samples,
+            size,
+            mode: play.mode,
+            glass_opacity: play.glass_opacity,
+            ..PlayerConfig::for_adapter(baked, &gpu.adapter, COLOR_FORMAT)
+        };
+        let player = Player::new(&gpu.device, &gpu.queue, baked, config)?;
+        let blit_group = blit.bind(&gpu.device, frame.resolved_view())?;
+        Ok(Targets {
+            size,
+            player,
+            frame,
+            blit_group,
+        })
+    }
+}
