@@ -24,13 +24,11 @@ impl<'g> OitMethod<'g> {
         frames: &[FrameState],
         view: BenchView,
     ) -> Result<OitMethod<'g>, BenchError> {
-        let renderer = OitRenderer::with_glass_opacity(
-            gpu,
-            geometry,
-            frames,
-            OitConfig::new(view.size, view.samples),
-            view.glass_opacity,
-        )?;
+        let config = OitConfig {
+            glass_opacity: view.glass_opacity,
+            ..OitConfig::new(view.size, view.samples)
+        };
+        let renderer = OitRenderer::new(gpu, geometry, frames, config)?;
         Ok(OitMethod {
             gpu,
             renderer,

@@ -50,13 +50,11 @@ fn oit_and_peeling_equal_the_reference_on_glass_vase_flowers() {
             )
             .expect("peeling");
             let oit = (mode == Mode::Blend).then(|| {
-                OitRenderer::with_glass_opacity(
-                    &gpu,
-                    &scene.geometry,
-                    &frames,
-                    OitConfig::new(size, samples),
-                    glass,
-                )
+                let config = OitConfig {
+                    glass_opacity: glass,
+                    ..OitConfig::new(size, samples)
+                };
+                OitRenderer::new(&gpu, &scene.geometry, &frames, config)
                 .expect("oit")
             });
             let default = (mode == Mode::Blend).then(|| {

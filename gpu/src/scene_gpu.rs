@@ -227,81 +227,7 @@ impl SceneGpu {
             usage: wgpu::BufferUsages::VERTEX,
         });
 
-        // Texture array.
-        let (tw, th) = geometry
-            .textures
-            .iter()
-            .fold((1u32, 1u32), |(w, h), t| (w.max(t.width), h.max(t.height)));
-        let max_dim = limits.max_texture_dimension_2d;
-        let (tw, th) = (tw.min(max_dim), th.min(max_dim));
-        let layers = geometry.textures.len().max(1) as u32;
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("base colour textures"),
-            size: wgpu::Extent3d {
-                width: tw,
-                height: th,
-                depth_or_array_layers: layers,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8UnormSrgb,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        let mut uv_scales = Vec::new();
-        for (layer, t) in geometry.textures.iter().enumerate() {
-            let (w, h) = (t.width.min(tw), t.height.min(th));
-            // Rows beyond the device limit are cropped (documented limitation).
-            let mut data = Vec::with_capacity((w * h * 4) as usize);
-            for y in 0..h as usize {
-                data.extend_from_slice(&t.rgba8[y * t.width as usize * 4..][..w as usize * 4]);
-            }
-            queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d {
-                        x: 0,
-                        y: 0,
-                        z: layer as u32,
-                    },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                &data,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(w * 4),
-                    rows_per_image: Some(h),
-                },
-                wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-            );
-            uv_scales.push([w as f32 / tw as f32, h as f32 / th as f32]);
-        }
-        if geometry.textures.is_empty() {
-            queue.write_texture(
-                texture.as_image_copy(),
-                &[255u8; 4],
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(4),
-                    rows_per_image: Some(1),
-                },
-                wgpu::Extent3d {
-                    width: 1,
-                    height: 1,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
-        let texture_view = texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
+        let (texture_view, uv_scales) = upload_textures(device, queue, geometry);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("base colour"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -310,65 +236,18 @@ impl SceneGpu {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-
-        // Materials.
-        let mut mats: Vec<MaterialGpu> = geometry
-            .materials
-            .iter()
-            .map(|m| {
-                let mode = match m.alpha_mode {
-                    AlphaMode::Opaque => 0.0,
-                    AlphaMode::Mask => 1.0,
-                    AlphaMode::Blend => 2.0,
-                };
-                let (layer, scale) = match m.base_color_texture {
-                    Some(t) if (t as usize) < uv_scales.len() => (t as f32, uv_scales[t as usize]),
-                    _ => (-1.0, [1.0, 1.0]),
-                };
-                MaterialGpu {
-                    base_color: m.base_color,
-                    emissive: [m.emissive[0], m.emissive[1], m.emissive[2], m.transmission],
-                    params: [
-                        mode,
-                        m.alpha_cutoff,
-                        if m.double_sided { 1.0 } else { 0.0 },
-                        layer,
-                    ],
-                    uv_scale: [scale[0], scale[1], 0.0, 0.0],
-                }
-            })
-            .collect();
-        if mats.is_empty() {
-            mats.push(MaterialGpu::zeroed());
-        }
         let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("materials"),
-            contents: bytemuck::cast_slice(&mats),
+            contents: bytemuck::cast_slice(&material_table(geometry, &uv_scales)),
             usage: wgpu::BufferUsages::STORAGE,
         });
-
-        // Per-frame uniforms and node matrices.
-        let frame_stride = align(
-            std::mem::size_of::<FrameUniform>() as u64,
-            limits.min_uniform_buffer_offset_alignment as u64,
-        );
-        let node_count = geometry.nodes.len().max(1) as u64;
-        let node_stride = align(
-            node_count * 64,
-            limits.min_storage_buffer_offset_alignment as u64,
-        );
-        let nframes = frames.len().max(1) as u64;
-        let mut frame_bytes = vec![0u8; (frame_stride * nframes) as usize];
-        let mut node_bytes = vec![0u8; (node_stride * nframes) as usize];
-        for (f, state) in frames.iter().enumerate() {
-            let u = frame_uniform(state, view);
-            frame_bytes[f * frame_stride as usize..][..std::mem::size_of::<FrameUniform>()]
-                .copy_from_slice(bytemuck::bytes_of(&u));
-            let mats = trisort_format::camera::node_view_matrices(&geometry.nodes, state);
-            let m: Vec<[f32; 16]> = mats.iter().map(|m| m.to_cols_array()).collect();
-            let b: &[u8] = bytemuck::cast_slice(&m);
-            node_bytes[f * node_stride as usize..][..b.len()].copy_from_slice(b);
-        }
+        let FrameData {
+            frame_bytes,
+            node_bytes,
+            frame_stride,
+            node_stride,
+            node_count,
+        } = frame_data(&limits, geometry, frames, view);
         let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame uniforms"),
             contents: &frame_bytes,
@@ -453,6 +332,174 @@ pub fn frame_uniform(state: &FrameState, view: View) -> FrameUniform {
             view.height as f32,
             view.samples as f32,
         ],
+    }
+}
+
+/// Uploads the base-colour textures into one array (each layer as large as the largest
+/// texture, clamped to the device's limit; smaller textures fill the top-left corner) and
+/// returns its view and each texture's uv scale. A scene without textures gets one white
+/// texel.
+fn upload_textures(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    geometry: &Geometry,
+) -> (wgpu::TextureView, Vec<[f32; 2]>) {
+    let limits = device.limits();
+    let (tw, th) = geometry
+        .textures
+        .iter()
+        .fold((1u32, 1u32), |(w, h), t| (w.max(t.width), h.max(t.height)));
+    let max_dim = limits.max_texture_dimension_2d;
+    let (tw, th) = (tw.min(max_dim), th.min(max_dim));
+    let layers = geometry.textures.len().max(1) as u32;
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("base colour textures"),
+        size: wgpu::Extent3d {
+            width: tw,
+            height: th,
+            depth_or_array_layers: layers,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8UnormSrgb,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let mut uv_scales = Vec::new();
+    for (layer, t) in geometry.textures.iter().enumerate() {
+        let (w, h) = (t.width.min(tw), t.height.min(th));
+        // Rows beyond the device limit are cropped (documented limitation).
+        let mut data = Vec::with_capacity((w * h * 4) as usize);
+        for y in 0..h as usize {
+            data.extend_from_slice(&t.rgba8[y * t.width as usize * 4..][..w as usize * 4]);
+        }
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: 0,
+                    z: layer as u32,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            &data,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(w * 4),
+                rows_per_image: Some(h),
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        uv_scales.push([w as f32 / tw as f32, h as f32 / th as f32]);
+    }
+    if geometry.textures.is_empty() {
+        queue.write_texture(
+            texture.as_image_copy(),
+            &[255u8; 4],
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4),
+                rows_per_image: Some(1),
+            },
+            wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+    let texture_view = texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    (texture_view, uv_scales)
+}
+
+/// The materials as the shaders read them (one zeroed material where the scene has none).
+fn material_table(geometry: &Geometry, uv_scales: &[[f32; 2]]) -> Vec<MaterialGpu> {
+    let mut mats: Vec<MaterialGpu> = geometry
+        .materials
+        .iter()
+        .map(|m| {
+            let mode = match m.alpha_mode {
+                AlphaMode::Opaque => 0.0,
+                AlphaMode::Mask => 1.0,
+                AlphaMode::Blend => 2.0,
+            };
+            let (layer, scale) = match m.base_color_texture {
+                Some(t) if (t as usize) < uv_scales.len() => (t as f32, uv_scales[t as usize]),
+                _ => (-1.0, [1.0, 1.0]),
+            };
+            MaterialGpu {
+                base_color: m.base_color,
+                emissive: [m.emissive[0], m.emissive[1], m.emissive[2], m.transmission],
+                params: [
+                    mode,
+                    m.alpha_cutoff,
+                    if m.double_sided { 1.0 } else { 0.0 },
+                    layer,
+                ],
+                uv_scale: [scale[0], scale[1], 0.0, 0.0],
+            }
+        })
+        .collect();
+    if mats.is_empty() {
+        mats.push(MaterialGpu::zeroed());
+    }
+    mats
+}
+
+/// Every frame's uniform and node matrices, each frame at its stride (the device's dynamic
+/// offset alignments).
+struct FrameData {
+    frame_bytes: Vec<u8>,
+    node_bytes: Vec<u8>,
+    frame_stride: u64,
+    node_stride: u64,
+    node_count: u64,
+}
+
+/// Computes [`FrameData`]: camera-relative node matrices in f64, cast once.
+fn frame_data(
+    limits: &wgpu::Limits,
+    geometry: &Geometry,
+    frames: &[FrameState],
+    view: View,
+) -> FrameData {
+    let frame_stride = align(
+        std::mem::size_of::<FrameUniform>() as u64,
+        limits.min_uniform_buffer_offset_alignment as u64,
+    );
+    let node_count = geometry.nodes.len().max(1) as u64;
+    let node_stride = align(
+        node_count * 64,
+        limits.min_storage_buffer_offset_alignment as u64,
+    );
+    let nframes = frames.len().max(1) as u64;
+    let mut frame_bytes = vec![0u8; (frame_stride * nframes) as usize];
+    let mut node_bytes = vec![0u8; (node_stride * nframes) as usize];
+    for (f, state) in frames.iter().enumerate() {
+        let u = frame_uniform(state, view);
+        frame_bytes[f * frame_stride as usize..][..std::mem::size_of::<FrameUniform>()]
+            .copy_from_slice(bytemuck::bytes_of(&u));
+        let mats = trisort_format::camera::node_view_matrices(&geometry.nodes, state);
+        let m: Vec<[f32; 16]> = mats.iter().map(|m| m.to_cols_array()).collect();
+        let b: &[u8] = bytemuck::cast_slice(&m);
+        node_bytes[f * node_stride as usize..][..b.len()].copy_from_slice(b);
+    }
+    FrameData {
+        frame_bytes,
+        node_bytes,
+        frame_stride,
+        node_stride,
+        node_count,
     }
 }
 

@@ -156,6 +156,11 @@ impl FrameTarget {
         &self.resolved_view
     }
 
+    /// The resolved single-sample colour texture (what readback copies).
+    pub fn resolved(&self) -> &wgpu::Texture {
+        &self.resolved
+    }
+
     /// Begins the frame's render pass: colour cleared to `clear` (resolved at the end when
     /// multisampled), depth cleared to 1 and discarded, with optional timestamp writes.
     pub fn begin_pass<'e>(
@@ -164,8 +169,23 @@ impl FrameTarget {
         clear: wgpu::Color,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) -> wgpu::RenderPass<'e> {
+        self.begin_pass_with(enc, Some(clear), true, timestamp_writes)
+    }
+
+    /// Begins a render pass that accumulates over several passes: colour cleared to `clear`
+    /// when given (else loaded), and, when multisampled, resolved to the single-sample texture
+    /// at the end when `resolve` (else the samples are stored for the next pass); depth as in
+    /// [`FrameTarget::begin_pass`].
+    pub fn begin_pass_with<'e>(
+        &self,
+        enc: &'e mut wgpu::CommandEncoder,
+        clear: Option<wgpu::Color>,
+        resolve: bool,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) -> wgpu::RenderPass<'e> {
         let (view, resolve_target, store) = match &self.msaa {
-            Some(msaa) => (msaa, Some(&self.resolved_view), wgpu::StoreOp::Discard),
+            Some(msaa) if resolve => (msaa, Some(&self.resolved_view), wgpu::StoreOp::Discard),
+            Some(msaa) => (msaa, None, wgpu::StoreOp::Store),
             None => (&self.resolved_view, None, wgpu::StoreOp::Store),
         };
         enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -175,7 +195,7 @@ impl FrameTarget {
                 depth_slice: None,
                 resolve_target,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
+                    load: clear.map_or(wgpu::LoadOp::Load, wgpu::LoadOp::Clear),
                     store,
                 },
             })],

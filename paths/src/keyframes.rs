@@ -222,8 +222,27 @@ pub(crate) fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Timeline, 
         }
     })?;
     let ctx = Ctx { path, text };
+    let fps = path_fps(&ctx, &file)?;
+    let global = file.interpolation.unwrap_or_default();
+    let Some(camera) = &file.camera else {
+        return Err(ctx.whole(Problem::Inconsistent(
+            "no [camera] section: a path needs camera keys".into(),
+        )));
+    };
+    let cam = CameraTracks::parse(&ctx, camera, global, fps)?;
+    let mut nodes: Vec<NodeTrack> = Vec::new();
+    for section in &file.node {
+        let track = NodeTrack::parse(&ctx, scene, section, &nodes, global, fps)?;
+        nodes.push(track);
+    }
+    nodes.sort_by_key(|t| t.node);
+    let frame_count = frame_count(&ctx, &file, &cam, &nodes)?;
+    sample(&ctx, scene, camera, &cam, &nodes, frame_count, fps)
+}
 
-    let fps = match &file.fps {
+/// The path's frame rate: `fps` if given (positive), else [`DEFAULT_FPS`].
+fn path_fps(ctx: &Ctx, file: &PathFile) -> Result<f64, PathError> {
+    Ok(match &file.fps {
         Some(f) => {
             let fps = ctx.finite(f, "fps")?;
             if fps <= 0.0 {
@@ -235,85 +254,116 @@ pub(crate) fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Timeline, 
             fps
         }
         None => DEFAULT_FPS,
-    };
-    let global = file.interpolation.unwrap_or_default();
+    })
+}
 
-    // Camera.
-    let Some(camera) = &file.camera else {
-        return Err(ctx.whole(Problem::Inconsistent(
-            "no [camera] section: a path needs camera keys".into(),
-        )));
-    };
-    // Errors about the camera as a whole point at its first key (a `Spanned` camera table
-    // fails on an implicit `[camera]` created by `[[camera.key]]`).
-    let camera_span = camera.key.first().map_or(0..0, |k| k.span());
-    let cam_mode = camera.interpolation.unwrap_or(global);
-    let default_up = match &camera.up {
-        Some(u) => ctx.finite3(u, "up")?,
-        None => [0.0, 1.0, 0.0],
-    };
-    let default_yfov = match &camera.yfov {
-        Some(y) => {
-            let deg = ctx.finite(y, "yfov")?;
-            check_fov_degrees(deg).map_err(|p| ctx.at(y.span(), p))?;
-            deg
+/// The camera's tracks, with what frame errors need to point at the right key.
+struct CameraTracks {
+    eye: Track<3>,
+    target: Track<3>,
+    up: Track<3>,
+    fov: Track<1>,
+    /// Camera keys by frame, for pointing frame errors at the key that set the frame.
+    key_at: BTreeMap<u64, Range<usize>>,
+    /// Where errors about the camera as a whole point: its first key.
+    span: Range<usize>,
+}
+
+impl CameraTracks {
+    fn parse(
+        ctx: &Ctx,
+        camera: &CameraSection,
+        global: Interpolation,
+        fps: f64,
+    ) -> Result<CameraTracks, PathError> {
+        // Errors about the camera as a whole point at its first key (a `Spanned` camera table
+        // fails on an implicit `[camera]` created by `[[camera.key]]`).
+        let camera_span = camera.key.first().map_or(0..0, |k| k.span());
+        let cam_mode = camera.interpolation.unwrap_or(global);
+        let default_up = match &camera.up {
+            Some(u) => ctx.finite3(u, "up")?,
+            None => [0.0, 1.0, 0.0],
+        };
+        let default_yfov = match &camera.yfov {
+            Some(y) => {
+                let deg = ctx.finite(y, "yfov")?;
+                check_fov_degrees(deg).map_err(|p| ctx.at(y.span(), p))?;
+                deg
+            }
+            None => DEFAULT_YFOV_DEGREES,
+        };
+        let (mut eyes, mut targets, mut ups): (Keys<3>, Keys<3>, Keys<3>) = Default::default();
+        let mut fovs: Keys<1> = Vec::new();
+        // Camera keys by frame, for pointing frame errors at the key that set the frame.
+        let mut key_at: BTreeMap<u64, Range<usize>> = BTreeMap::new();
+        for key in &camera.key {
+            let span = key.span();
+            let k = key.get_ref();
+            let pos = ctx.position(span.clone(), &k.frame, &k.time, fps)?;
+            if pos.fract() == 0.0 {
+                key_at.insert(pos as u64, span.clone());
+            }
+            if k.eye.is_none() && k.target.is_none() && k.up.is_none() && k.yfov.is_none() {
+                return Err(ctx.at(
+                    span,
+                    Problem::Inconsistent(
+                        "a camera key sets none of `eye`, `target`, `up`, `yfov`".into(),
+                    ),
+                ));
+            }
+            if let Some(v) = &k.eye {
+                eyes.push((pos, ctx.finite3(v, "eye")?, v.span()));
+            }
+            if let Some(v) = &k.target {
+                targets.push((pos, ctx.finite3(v, "target")?, v.span()));
+            }
+            if let Some(v) = &k.up {
+                ups.push((pos, ctx.finite3(v, "up")?, v.span()));
+            }
+            if let Some(v) = &k.yfov {
+                let deg = ctx.finite(v, "yfov")?;
+                check_fov_degrees(deg).map_err(|p| ctx.at(v.span(), p))?;
+                fovs.push((pos, [deg], v.span()));
+            }
         }
-        None => DEFAULT_YFOV_DEGREES,
-    };
-    let (mut eyes, mut targets, mut ups): (Keys<3>, Keys<3>, Keys<3>) = Default::default();
-    let mut fovs: Keys<1> = Vec::new();
-    // Camera keys by frame, for pointing frame errors at the key that set the frame.
-    let mut camera_key_at: BTreeMap<u64, Range<usize>> = BTreeMap::new();
-    for key in &camera.key {
-        let span = key.span();
-        let k = key.get_ref();
-        let pos = ctx.position(span.clone(), &k.frame, &k.time, fps)?;
-        if pos.fract() == 0.0 {
-            camera_key_at.insert(pos as u64, span.clone());
-        }
-        if k.eye.is_none() && k.target.is_none() && k.up.is_none() && k.yfov.is_none() {
-            return Err(ctx.at(
-                span,
-                Problem::Inconsistent(
-                    "a camera key sets none of `eye`, `target`, `up`, `yfov`".into(),
-                ),
-            ));
-        }
-        if let Some(v) = &k.eye {
-            eyes.push((pos, ctx.finite3(v, "eye")?, v.span()));
-        }
-        if let Some(v) = &k.target {
-            targets.push((pos, ctx.finite3(v, "target")?, v.span()));
-        }
-        if let Some(v) = &k.up {
-            ups.push((pos, ctx.finite3(v, "up")?, v.span()));
-        }
-        if let Some(v) = &k.yfov {
-            let deg = ctx.finite(v, "yfov")?;
-            check_fov_degrees(deg).map_err(|p| ctx.at(v.span(), p))?;
-            fovs.push((pos, [deg], v.span()));
-        }
+        let eye_track = track(ctx, eyes, cam_mode, "eye")?.ok_or_else(|| {
+            ctx.at(
+                camera_span.clone(),
+                Problem::Inconsistent("no camera key sets `eye`".into()),
+            )
+        })?;
+        let target_track = track(ctx, targets, cam_mode, "target")?.ok_or_else(|| {
+            ctx.at(
+                camera_span.clone(),
+                Problem::Inconsistent("no camera key sets `target`".into()),
+            )
+        })?;
+        let up_track = track(ctx, ups, cam_mode, "up")?
+            .unwrap_or_else(|| Track::new(vec![(0.0, default_up)], cam_mode));
+        let fov_track = track(ctx, fovs, cam_mode, "yfov")?
+            .unwrap_or_else(|| Track::new(vec![(0.0, [default_yfov])], cam_mode));
+
+        Ok(CameraTracks {
+            eye: eye_track,
+            target: target_track,
+            up: up_track,
+            fov: fov_track,
+            key_at,
+            span: camera_span,
+        })
     }
-    let eye_track = track(&ctx, eyes, cam_mode, "eye")?.ok_or_else(|| {
-        ctx.at(
-            camera_span.clone(),
-            Problem::Inconsistent("no camera key sets `eye`".into()),
-        )
-    })?;
-    let target_track = track(&ctx, targets, cam_mode, "target")?.ok_or_else(|| {
-        ctx.at(
-            camera_span.clone(),
-            Problem::Inconsistent("no camera key sets `target`".into()),
-        )
-    })?;
-    let up_track = track(&ctx, ups, cam_mode, "up")?
-        .unwrap_or_else(|| Track::new(vec![(0.0, default_up)], cam_mode));
-    let fov_track = track(&ctx, fovs, cam_mode, "yfov")?
-        .unwrap_or_else(|| Track::new(vec![(0.0, [default_yfov])], cam_mode));
+}
 
-    // Nodes.
-    let mut nodes: Vec<NodeTrack> = Vec::new();
-    for section in &file.node {
+impl NodeTrack {
+    /// One `[[node]]` section's tracks; a node that already has one in `seen` is an error.
+    fn parse(
+        ctx: &Ctx,
+        scene: &Scene,
+        section: &Spanned<NodeSection>,
+        seen: &[NodeTrack],
+        global: Interpolation,
+        fps: f64,
+    ) -> Result<NodeTrack, PathError> {
         let s = section.get_ref();
         let name = s.name.get_ref();
         let Some(node) = scene.node_by_name(name) else {
@@ -326,7 +376,7 @@ pub(crate) fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Timeline, 
                 },
             ));
         };
-        if nodes.iter().any(|t| t.node == node) {
+        if seen.iter().any(|t| t.node == node) {
             return Err(ctx.at(
                 s.name.span(),
                 Problem::Inconsistent(format!("node {name:?} has two tracks")),
@@ -353,8 +403,8 @@ pub(crate) fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Timeline, 
                 moves.push((pos, ctx.finite3(t, "translation")?, t.span()));
             }
         }
-        let angle = track(&ctx, angles, mode, "angle")?;
-        let translation = track(&ctx, moves, mode, "translation")?;
+        let angle = track(ctx, angles, mode, "angle")?;
+        let translation = track(ctx, moves, mode, "translation")?;
         if angle.is_none() && translation.is_none() {
             return Err(ctx.at(
                 section.span(),
@@ -384,19 +434,25 @@ pub(crate) fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Timeline, 
             Some(p) => DVec3::from(ctx.finite3(p, "pivot")?),
             None => DVec3::ZERO,
         };
-        nodes.push(NodeTrack {
+        Ok(NodeTrack {
             node,
             rest: DMat4::from_cols_array(&scene.geometry.nodes[node as usize].rest),
             axis,
             pivot,
             angle,
             translation,
-        });
+        })
     }
-    nodes.sort_by_key(|t| t.node);
+}
 
-    // Frame count.
-    let frame_count = match &file.frames {
+/// Frames on the path: `frames` if given, else up to the last key of any track.
+fn frame_count(
+    ctx: &Ctx,
+    file: &PathFile,
+    cam: &CameraTracks,
+    nodes: &[NodeTrack],
+) -> Result<usize, PathError> {
+    Ok(match &file.frames {
         Some(f) => {
             let n = *f.get_ref();
             if n <= 0 {
@@ -411,12 +467,13 @@ pub(crate) fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Timeline, 
             n as usize
         }
         None => {
-            let mut last = eye_track
+            let mut last = cam
+                .eye
                 .last_position()
-                .max(target_track.last_position())
-                .max(up_track.last_position())
-                .max(fov_track.last_position());
-            for t in &nodes {
+                .max(cam.target.last_position())
+                .max(cam.up.last_position())
+                .max(cam.fov.last_position());
+            for t in nodes {
                 if let Some(a) = &t.angle {
                     last = last.max(a.last_position());
                 }
@@ -426,21 +483,33 @@ pub(crate) fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Timeline, 
             }
             last.floor() as usize + 1
         }
-    };
+    })
+}
 
+/// Samples the tracks at every frame: views, clip planes (defaults from the scene's bounds
+/// seen along the path) and node poses.
+fn sample(
+    ctx: &Ctx,
+    scene: &Scene,
+    camera: &CameraSection,
+    cam: &CameraTracks,
+    nodes: &[NodeTrack],
+    frame_count: usize,
+    fps: f64,
+) -> Result<Timeline, PathError> {
     // Clip planes.
-    let frame_error = |frame: usize, problem: Problem| match camera_key_at.get(&(frame as u64)) {
+    let frame_error = |frame: usize, problem: Problem| match cam.key_at.get(&(frame as u64)) {
         Some(span) => ctx.at(span.clone(), problem),
         None => ctx.whole(problem),
     };
     let mut views = Vec::with_capacity(frame_count);
     for f in 0..frame_count {
         let t = f as f64;
-        let eye = DVec3::from(eye_track.sample(t));
-        let target = DVec3::from(target_track.sample(t));
-        let up = DVec3::from(up_track.sample(t));
+        let eye = DVec3::from(cam.eye.sample(t));
+        let target = DVec3::from(cam.target.sample(t));
+        let up = DVec3::from(cam.up.sample(t));
         let view = look_at(eye, target, up, f).map_err(|p| frame_error(f, p))?;
-        views.push((eye, view, fov_track.sample(t)[0]));
+        views.push((eye, view, cam.fov.sample(t)[0]));
     }
     let znear = camera
         .znear
@@ -448,7 +517,7 @@ pub(crate) fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Timeline, 
         .map(|z| (ctx.finite(z, "znear"), z.span()));
     let zfar = match &camera.zfar {
         None => None,
-        Some(z) => Some((zfar_value(&ctx, z)?, z.span())),
+        Some(z) => Some((zfar_value(ctx, z)?, z.span())),
     };
     let (znear, zfar) = match (znear, zfar) {
         (Some((near, _)), Some((far, _))) => (near?, far),
@@ -467,14 +536,14 @@ pub(crate) fn parse(text: &str, path: &Path, scene: &Scene) -> Result<Timeline, 
         .as_ref()
         .map(|z| z.span())
         .or(camera.zfar.as_ref().map(|z| z.span()))
-        .unwrap_or(camera_span);
+        .unwrap_or(cam.span.clone());
     check_clip(znear, zfar).map_err(|p| ctx.at(clip_span, p))?;
 
     let mut frames = Vec::with_capacity(frame_count);
     for (f, (_, view, fov)) in views.into_iter().enumerate() {
         let t = f as f64;
         let mut poses = Vec::new();
-        for n in &nodes {
+        for n in nodes {
             let angle = n.angle.as_ref().map_or(0.0, |a| a.sample(t)[0]);
             let translation = n
                 .translation

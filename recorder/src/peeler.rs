@@ -53,6 +53,133 @@ pub struct Peeler<'g> {
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+/// Rejects a device that cannot peel: no `PRIMITIVE_INDEX`, or no [`ID_FORMAT`] target at the
+/// view's sample count.
+fn check_device(gpu: &Gpu, view: View) -> Result<(), RecordError> {
+    let device = &gpu.device;
+    if !device.features().contains(wgpu::Features::PRIMITIVE_INDEX) {
+        return Err(RecordError::Unsupported(format!(
+            "{} lacks PRIMITIVE_INDEX",
+            gpu.describe()
+        )));
+    }
+    let ff = gpu.adapter.get_texture_format_features(ID_FORMAT);
+    if !ff.flags.sample_count_supported(view.samples)
+        || (view.samples > 1
+            && !device
+                .features()
+                .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES))
+    {
+        return Err(RecordError::Unsupported(format!(
+            "{} cannot render {ID_FORMAT:?} ids at {}x MSAA",
+            gpu.describe(),
+            view.samples
+        )));
+    }
+    Ok(())
+}
+
+/// The compute pass that gathers a peel layer per sample (ids and depth in, one 16-byte slot
+/// per sample out), and its bind group layout.
+fn gather_pipeline(
+    device: &wgpu::Device,
+    samples: u32,
+) -> (wgpu::BindGroupLayout, wgpu::ComputePipeline) {
+    let ms = samples > 1;
+    let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: ms,
+        },
+        count: None,
+    };
+    let gather_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("gather"),
+        source: wgpu::ShaderSource::Wgsl(trisort_gpu::gather_shader(samples).into()),
+    });
+    let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("gather"),
+        entries: &[
+            tex(0, wgpu::TextureSampleType::Uint),
+            tex(1, wgpu::TextureSampleType::Depth),
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: false },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+        ],
+    });
+    let gather_pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("gather"),
+        bind_group_layouts: &[Some(&gather_layout)],
+        immediate_size: 0,
+    });
+    let gather_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("gather"),
+        layout: Some(&gather_pl),
+        module: &gather_module,
+        entry_point: Some("gather"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+
+    (gather_layout, gather_pipeline)
+}
+
+/// The per-sample buffers of the gather pass: which samples are done, the gathered layer, and
+/// its readback. Errors where the gathered layer exceeds the device's storage-buffer binding.
+fn gather_buffers(
+    device: &wgpu::Device,
+    view: View,
+) -> Result<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer), RecordError> {
+    let slots = view.width as u64 * view.height as u64 * view.samples as u64;
+    let out_size = slots * 16;
+    let max_binding = device.limits().max_storage_buffer_binding_size;
+    if out_size > max_binding {
+        return Err(RecordError::Unsupported(format!(
+            "{}x{} at {}x needs a {out_size}-byte gather buffer; the device binds at most {max_binding}",
+            view.width, view.height, view.samples
+        )));
+    }
+    let done = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("done"),
+        size: slots * 4,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let out = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("gathered"),
+        size: out_size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("gathered readback"),
+        size: out_size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    Ok((done, out, staging))
+}
+
 impl<'g> Peeler<'g> {
     /// Sets up peeling of `triangles` (indices into `geometry.triangles`, ascending: this is
     /// the draw order, and a fragment's id is its position in this list).
@@ -64,41 +191,12 @@ impl<'g> Peeler<'g> {
         view: View,
     ) -> Result<Self, RecordError> {
         let device = &gpu.device;
-        if !device.features().contains(wgpu::Features::PRIMITIVE_INDEX) {
-            return Err(RecordError::Unsupported(format!(
-                "{} lacks PRIMITIVE_INDEX",
-                gpu.describe()
-            )));
-        }
-        let ff = gpu.adapter.get_texture_format_features(ID_FORMAT);
-        if !ff.flags.sample_count_supported(view.samples)
-            || (view.samples > 1
-                && !device
-                    .features()
-                    .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES))
-        {
-            return Err(RecordError::Unsupported(format!(
-                "{} cannot render {ID_FORMAT:?} ids at {}x MSAA",
-                gpu.describe(),
-                view.samples
-            )));
-        }
+        check_device(gpu, view)?;
         let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("peel"),
             source: wgpu::ShaderSource::Wgsl(trisort_gpu::peel_shader(view.samples).into()),
         });
-        let ms = view.samples > 1;
-        let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Texture {
-                sample_type,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: ms,
-            },
-            count: None,
-        };
         let previous = previous_key_entries(view.samples);
         let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("peel"),
@@ -131,50 +229,7 @@ impl<'g> Peeler<'g> {
         }
         .build(device);
 
-        let gather_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("gather"),
-            source: wgpu::ShaderSource::Wgsl(trisort_gpu::gather_shader(view.samples).into()),
-        });
-        let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather"),
-            entries: &[
-                tex(0, wgpu::TextureSampleType::Uint),
-                tex(1, wgpu::TextureSampleType::Depth),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let gather_pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gather"),
-            bind_group_layouts: &[Some(&gather_layout)],
-            immediate_size: 0,
-        });
-        let gather_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("gather"),
-            layout: Some(&gather_pl),
-            module: &gather_module,
-            entry_point: Some("gather"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let (gather_layout, gather_pipeline) = gather_pipeline(device, view.samples);
 
         let mut index_data: Vec<u32> = Vec::with_capacity(triangles.len() * 3);
         for &t in triangles {
@@ -198,33 +253,7 @@ impl<'g> Peeler<'g> {
                 wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             )
         };
-        let slots = view.width as u64 * view.height as u64 * view.samples as u64;
-        let out_size = slots * 16;
-        let max_binding = device.limits().max_storage_buffer_binding_size;
-        if out_size > max_binding {
-            return Err(RecordError::Unsupported(format!(
-                "{}x{} at {}x needs a {out_size}-byte gather buffer; the device binds at most {max_binding}",
-                view.width, view.height, view.samples
-            )));
-        }
-        let done = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("done"),
-            size: slots * 4,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let out = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("gathered"),
-            size: out_size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("gathered readback"),
-            size: out_size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let (done, out, staging) = gather_buffers(device, view)?;
         let chunks = (triangles.len() as u64)
             .div_ceil(CHUNK_TRIANGLES as u64)
             .max(1)

@@ -44,6 +44,9 @@ pub enum ReferenceError {
     /// The player failed (structure, device).
     #[error("player: {0}")]
     Player(#[from] trisort_player::PlayerError),
+    /// A GPU target or readback failed.
+    #[error(transparent)]
+    Gpu(#[from] trisort_gpu::GpuError),
     /// The device lacks something the reference needs.
     #[error("unsupported device: {0}")]
     Unsupported(String),

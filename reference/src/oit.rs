@@ -57,7 +57,7 @@ pub const NODE_BUFFERS: u32 = 4;
 pub const MAX_SORTED_LIMIT: u32 = 1024;
 
 /// Size and budgets of an [`OitRenderer`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OitConfig {
     /// Image size (width, height).
     pub size: (u32, u32),
@@ -69,16 +69,22 @@ pub struct OitConfig {
     /// Length of each sample's sort array (default 32): a sample with more fragments keeps
     /// the nearest ones.
     pub max_sorted: u32,
+    /// Opacity transmissive glass is drawn at (default: the recorder's,
+    /// `RecordSettings::default().glass_opacity`; a baked file's recorded one to compare with
+    /// its player).
+    pub glass_opacity: f32,
 }
 
 impl OitConfig {
-    /// The defaults at `size` and `samples`: 16 nodes per sample, a 32-entry sort.
+    /// The defaults at `size` and `samples`: 16 nodes per sample, a 32-entry sort, glass at
+    /// the recorder's default opacity.
     pub fn new(size: (u32, u32), samples: u32) -> OitConfig {
         OitConfig {
             size,
             samples,
             nodes_per_sample: 16,
             max_sorted: 32,
+            glass_opacity: trisort_format::RecordSettings::default().glass_opacity,
         }
     }
 
@@ -173,115 +179,52 @@ impl OitConfig {
 /// Whether the adapter's blend unit rounds to binary16 toward zero when it stores to an
 /// `Rgba16Float` target: lavapipe (llvmpipe) does, measured by the tests; other adapters are
 /// assumed to round to nearest even. The resolve shader rounds the same way after each
-/// fragment, so that it composites exactly like the reference's blended layers.
-fn blend_rounds_to_zero(info: &wgpu::AdapterInfo) -> bool {
-    info.device_type == wgpu::DeviceType::Cpu && info.name.contains("llvmpipe")
+/// Rejects a device or scene the renderer cannot run: `config` over the device's limits, no
+/// `PRIMITIVE_INDEX` or fragment-writable storage, or more triangles than one draw holds.
+fn check_device(gpu: &Gpu, geometry: &Geometry, config: &OitConfig) -> Result<(), ReferenceError> {
+    let device = &gpu.device;
+    config.check(&device.limits())?;
+    if !device.features().contains(wgpu::Features::PRIMITIVE_INDEX) {
+        return Err(ReferenceError::Unsupported(format!(
+            "{}: OIT needs PRIMITIVE_INDEX (depth ties are broken by triangle id)",
+            gpu.describe()
+        )));
+    }
+    if !gpu
+        .adapter
+        .get_downlevel_capabilities()
+        .flags
+        .contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE)
+    {
+        return Err(ReferenceError::Unsupported(format!(
+            "{}: OIT needs writable storage buffers in fragment shaders",
+            gpu.describe()
+        )));
+    }
+    if geometry.triangles.len() as u64 >= u32::MAX as u64 / 3 {
+        return Err(ReferenceError::Invalid(format!(
+            "{} triangles: one draw holds fewer than {}",
+            geometry.triangles.len(),
+            u32::MAX / 3
+        )));
+    }
+    Ok(())
 }
 
-/// One resolved OIT frame and what its budgets lost.
-#[derive(Clone, Debug, PartialEq)]
-pub struct OitFrame {
-    /// `width × height` pixels, RGBA8, sRGB-encoded, alpha 255 (like the player's frames:
-    /// [`quantize_rgba16f`] of the resolved `Rgba16Float` frame).
-    pub rgba8: Vec<u8>,
-    /// Fragments the list pass tried to store: shaded fragments (covered samples of triangles
-    /// not discarded for facing or cut-out) with alpha > 0 (a fully transparent fragment
-    /// leaves `over` unchanged, so it is not stored).
-    pub fragments: u64,
-    /// Fragments lost because the node pool was full.
-    pub dropped: u64,
-    /// Samples whose list held more than `max_sorted` fragments (the farthest were dropped;
-    /// the sample is still exact where an opaque fragment is among the nearest kept).
-    pub overflowed_samples: u64,
-}
-
-/// The per-sample linked-list OIT renderer for one scene at one size.
-pub struct OitRenderer<'g> {
-    gpu: &'g Gpu,
-    config: OitConfig,
-    triangles: u32,
-    scene: SceneGpu,
-    index: wgpu::Buffer,
-    list_pipeline: wgpu::RenderPipeline,
-    resolve_pipeline: wgpu::RenderPipeline,
+/// The per-sample lists: head pointers, the node pool, the counters and their bind group
+/// (binding 0 the parameters, then heads, counters and the pool buffers).
+struct Lists {
+    layout: wgpu::BindGroupLayout,
     bind_group: wgpu::BindGroup,
     heads: wgpu::Buffer,
     counters: wgpu::Buffer,
     counters_staging: wgpu::Buffer,
-    dummy: wgpu::TextureView,
-    target: FrameTarget,
 }
 
-impl<'g> OitRenderer<'g> {
-    /// Uploads the full scene `geometry` with the path's `frames` and allocates the lists at
-    /// `config`. Errors where the configuration is invalid, the pool or head buffer exceeds the
-    /// device's storage-buffer limits, or the device lacks `PRIMITIVE_INDEX`, writable storage
-    /// in fragment shaders or multisampled `Rgba16Float` targets.
-    ///
-    /// Transmissive glass is drawn at the recorder's default glass opacity
-    /// (`RecordSettings::default().glass_opacity`); see [`OitRenderer::with_glass_opacity`].
-    pub fn new(
-        gpu: &'g Gpu,
-        geometry: &Geometry,
-        frames: &[FrameState],
-        config: OitConfig,
-    ) -> Result<OitRenderer<'g>, ReferenceError> {
-        let glass = trisort_format::RecordSettings::default().glass_opacity;
-        OitRenderer::with_glass_opacity(gpu, geometry, frames, config, glass)
-    }
-
-    /// [`OitRenderer::new`] with transmissive glass drawn at `glass_opacity` (a baked file's
-    /// recorded one, to compare with its player).
-    pub fn with_glass_opacity(
-        gpu: &'g Gpu,
-        geometry: &Geometry,
-        frames: &[FrameState],
-        config: OitConfig,
-        glass_opacity: f32,
-    ) -> Result<OitRenderer<'g>, ReferenceError> {
+impl Lists {
+    fn new(gpu: &Gpu, config: &OitConfig) -> Lists {
         let device = &gpu.device;
-        config.check(&device.limits())?;
-        if !device.features().contains(wgpu::Features::PRIMITIVE_INDEX) {
-            return Err(ReferenceError::Unsupported(format!(
-                "{}: OIT needs PRIMITIVE_INDEX (depth ties are broken by triangle id)",
-                gpu.describe()
-            )));
-        }
-        if !gpu
-            .adapter
-            .get_downlevel_capabilities()
-            .flags
-            .contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE)
-        {
-            return Err(ReferenceError::Unsupported(format!(
-                "{}: OIT needs writable storage buffers in fragment shaders",
-                gpu.describe()
-            )));
-        }
-        if geometry.triangles.len() as u64 >= u32::MAX as u64 / 3 {
-            return Err(ReferenceError::Invalid(format!(
-                "{} triangles: one draw holds fewer than {}",
-                geometry.triangles.len(),
-                u32::MAX / 3
-            )));
-        }
-        let (w, h) = config.size;
-        let target = FrameTarget::new(
-            &gpu.adapter,
-            device,
-            TargetConfig::readback(config.size, config.samples, Mode::Blend),
-        )
-        .map_err(|e| ReferenceError::Unsupported(format!("{}: {e}", gpu.describe())))?;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let view = View {
-            width: w,
-            height: h,
-            samples: config.samples,
-            glass_opacity,
-        };
-        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
-        let index = scene_index(device, geometry, "oit indices");
-
+        let w = config.size.0;
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -366,6 +309,85 @@ impl<'g> OitRenderer<'g> {
             layout: &layout,
             entries: &entries,
         });
+        Lists {
+            layout,
+            bind_group,
+            heads,
+            counters,
+            counters_staging,
+        }
+    }
+}
+
+/// fragment, so that it composites exactly like the reference's blended layers.
+fn blend_rounds_to_zero(info: &wgpu::AdapterInfo) -> bool {
+    info.device_type == wgpu::DeviceType::Cpu && info.name.contains("llvmpipe")
+}
+
+/// One resolved OIT frame and what its budgets lost.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OitFrame {
+    /// `width × height` pixels, RGBA8, sRGB-encoded, alpha 255 (like the player's frames:
+    /// [`quantize_rgba16f`] of the resolved `Rgba16Float` frame).
+    pub rgba8: Vec<u8>,
+    /// Fragments the list pass tried to store: shaded fragments (covered samples of triangles
+    /// not discarded for facing or cut-out) with alpha > 0 (a fully transparent fragment
+    /// leaves `over` unchanged, so it is not stored).
+    pub fragments: u64,
+    /// Fragments lost because the node pool was full.
+    pub dropped: u64,
+    /// Samples whose list held more than `max_sorted` fragments (the farthest were dropped;
+    /// the sample is still exact where an opaque fragment is among the nearest kept).
+    pub overflowed_samples: u64,
+}
+
+/// The per-sample linked-list OIT renderer for one scene at one size.
+pub struct OitRenderer<'g> {
+    gpu: &'g Gpu,
+    config: OitConfig,
+    triangles: u32,
+    scene: SceneGpu,
+    index: wgpu::Buffer,
+    list_pipeline: wgpu::RenderPipeline,
+    resolve_pipeline: wgpu::RenderPipeline,
+    bind_group: wgpu::BindGroup,
+    heads: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    counters_staging: wgpu::Buffer,
+    dummy: wgpu::TextureView,
+    target: FrameTarget,
+}
+
+impl<'g> OitRenderer<'g> {
+    /// Uploads the full scene `geometry` with the path's `frames` and allocates the lists at
+    /// `config`. Errors where the configuration is invalid, the pool or head buffer exceeds the
+    /// device's storage-buffer limits, or the device lacks `PRIMITIVE_INDEX`, writable storage
+    /// in fragment shaders or multisampled `Rgba16Float` targets.
+    pub fn new(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        config: OitConfig,
+    ) -> Result<OitRenderer<'g>, ReferenceError> {
+        let device = &gpu.device;
+        check_device(gpu, geometry, &config)?;
+        let (w, h) = config.size;
+        let target = FrameTarget::new(
+            &gpu.adapter,
+            device,
+            TargetConfig::readback(config.size, config.samples, Mode::Blend),
+        )
+        .map_err(|e| ReferenceError::Unsupported(format!("{}: {e}", gpu.describe())))?;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let view = View {
+            width: w,
+            height: h,
+            samples: config.samples,
+            glass_opacity: config.glass_opacity,
+        };
+        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let index = scene_index(device, geometry, "oit indices");
+        let lists = Lists::new(gpu, &config);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("oit"),
             source: wgpu::ShaderSource::Wgsl(trisort_gpu::oit_shader(config.max_sorted).into()),
@@ -384,7 +406,7 @@ impl<'g> OitRenderer<'g> {
         // The player's pipeline state (CCW, no hardware culling, its MSAA count, no depth).
         let list_pipeline = ScenePipeline {
             label: "oit lists",
-            layouts: &[&scene.layout, &layout],
+            layouts: &[&scene.layout, &lists.layout],
             module: &module,
             vertex: "vs_player",
             fragment: "fs_oit_list",
@@ -400,7 +422,7 @@ impl<'g> OitRenderer<'g> {
         let resolve_pipeline = trisort_gpu::pipeline::fullscreen(
             device,
             "oit resolve",
-            &[&scene.layout, &layout],
+            &[&scene.layout, &lists.layout],
             &module,
             ("vs_oit_fullscreen", "fs_oit_resolve"),
             wgpu::ColorTargetState {
@@ -430,10 +452,10 @@ impl<'g> OitRenderer<'g> {
             index,
             list_pipeline,
             resolve_pipeline,
-            bind_group,
-            heads,
-            counters,
-            counters_staging,
+            bind_group: lists.bind_group,
+            heads: lists.heads,
+            counters: lists.counters,
+            counters_staging: lists.counters_staging,
             dummy,
             target,
         })

@@ -43,7 +43,7 @@ use trisort_gpu::scene_gpu::{
     begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
 };
 use trisort_gpu::Gpu;
-use trisort_gpu::{clear_colour, halves, quantize_rgba16f, COLOR_FORMAT, DEPTH_FORMAT};
+use trisort_gpu::{clear_colour, FrameTarget, TargetConfig, COLOR_FORMAT, DEPTH_FORMAT};
 use trisort_player::{blend_state, Mode};
 use wgpu::util::DeviceExt;
 
@@ -91,7 +91,6 @@ pub struct PeeledFrame {
 /// GPU-only exact depth peeling of one scene at one size, sample count and mode.
 pub struct PeelingRenderer<'g> {
     gpu: &'g Gpu,
-    size: (u32, u32),
     samples: u32,
     mode: Mode,
     max_layers: u32,
@@ -109,12 +108,9 @@ pub struct PeelingRenderer<'g> {
     composite_groups: [wgpu::BindGroup; 2],
     ids: [wgpu::TextureView; 2],
     depth: [wgpu::TextureView; 2],
-    /// The multisampled accumulation (`None` at one sample: `resolved` is drawn directly).
-    msaa: Option<wgpu::TextureView>,
-    resolved: wgpu::Texture,
-    resolved_view: wgpu::TextureView,
-    row_bytes: u32,
-    staging: wgpu::Buffer,
+    /// The accumulation (multisampled at `samples`, resolved by the last compositing pass)
+    /// and its readback.
+    target: FrameTarget,
     occlusion: wgpu::QuerySet,
     occlusion_resolve: wgpu::Buffer,
     occlusion_staging: wgpu::Buffer,
@@ -152,6 +148,136 @@ impl PeelingConfig {
     }
 }
 
+/// Rejects what the renderer cannot do: a pattern other than 1× or 4×, `saturate`, a device
+/// without `PRIMITIVE_INDEX` or one that cannot multisample the id, depth or colour targets.
+fn check_device(gpu: &Gpu, config: &PeelingConfig) -> Result<(), ReferenceError> {
+    let PeelingConfig {
+        size,
+        samples,
+        mode,
+        ..
+    } = *config;
+    check_pattern(size, samples)?;
+    if mode == Mode::Saturate {
+        return Err(ReferenceError::Invalid(
+            "depth peeling renders blend and depth; saturate has no peeling renderer".into(),
+        ));
+    }
+    let device = &gpu.device;
+    if !device.features().contains(wgpu::Features::PRIMITIVE_INDEX) {
+        return Err(ReferenceError::Unsupported(format!(
+            "{} lacks PRIMITIVE_INDEX (triangle ids in the fragment shader)",
+            gpu.describe()
+        )));
+    }
+    for format in [ID_FORMAT, DEPTH_FORMAT, COLOR_FORMAT] {
+        let supported = gpu
+            .adapter
+            .get_texture_format_features(format)
+            .flags
+            .sample_count_supported(samples);
+        let adapter_specific = device
+            .features()
+            .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+        if !supported || (samples > 1 && format == ID_FORMAT && !adapter_specific) {
+            return Err(ReferenceError::Unsupported(format!(
+                "{} cannot render {format:?} at {samples}x MSAA",
+                gpu.describe()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The two ping-ponged peel targets (ids and depth: each pass reads the other's key) and
+/// their bind groups.
+struct LayerTargets {
+    ids: [wgpu::TextureView; 2],
+    depth: [wgpu::TextureView; 2],
+    /// `peel_groups[p]`: the peel bind group reading target `p` as the previous key.
+    peel_groups: [wgpu::BindGroup; 2],
+    /// `composite_groups[p]`: the compositing bind group reading target `p`'s ids.
+    composite_groups: [wgpu::BindGroup; 2],
+}
+
+impl LayerTargets {
+    fn new(
+        device: &wgpu::Device,
+        config: &PeelingConfig,
+        peel_layout: &wgpu::BindGroupLayout,
+        composite_layout: &wgpu::BindGroupLayout,
+        params: &wgpu::Buffer,
+    ) -> LayerTargets {
+        let (size, samples) = (config.size, config.samples);
+        let texture = |label, format, sample_count, usage| {
+            trisort_gpu::pipeline::texture_2d(device, label, size, sample_count, format, usage)
+        };
+        let peel_usage =
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let make_view = |t: wgpu::Texture| t.create_view(&Default::default());
+        let ids = [
+            make_view(texture("peeling ids a", ID_FORMAT, samples, peel_usage)),
+            make_view(texture("peeling ids b", ID_FORMAT, samples, peel_usage)),
+        ];
+        let depth = [
+            make_view(texture(
+                "peeling depth a",
+                DEPTH_FORMAT,
+                samples,
+                peel_usage,
+            )),
+            make_view(texture(
+                "peeling depth b",
+                DEPTH_FORMAT,
+                samples,
+                peel_usage,
+            )),
+        ];
+        let peel_group = |p: usize| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("peeling peel"),
+                layout: peel_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: params,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(16),
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&depth[p]),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&ids[p]),
+                    },
+                ],
+            })
+        };
+        let composite_group = |p: usize| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("peeling composite"),
+                layout: composite_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&ids[p]),
+                }],
+            })
+        };
+        let peel_groups = [peel_group(0), peel_group(1)];
+        let composite_groups = [composite_group(0), composite_group(1)];
+        LayerTargets {
+            ids,
+            depth,
+            peel_groups,
+            composite_groups,
+        }
+    }
+}
+
 impl<'g> PeelingRenderer<'g> {
     /// Uploads `geometry` with the path's `frames` for rendering as `config` says.
     ///
@@ -172,35 +298,8 @@ impl<'g> PeelingRenderer<'g> {
             max_layers,
             glass_opacity,
         } = config;
-        check_pattern(size, samples)?;
-        if mode == Mode::Saturate {
-            return Err(ReferenceError::Invalid(
-                "depth peeling renders blend and depth; saturate has no peeling renderer".into(),
-            ));
-        }
+        check_device(gpu, &config)?;
         let device = &gpu.device;
-        if !device.features().contains(wgpu::Features::PRIMITIVE_INDEX) {
-            return Err(ReferenceError::Unsupported(format!(
-                "{} lacks PRIMITIVE_INDEX (triangle ids in the fragment shader)",
-                gpu.describe()
-            )));
-        }
-        for format in [ID_FORMAT, DEPTH_FORMAT, COLOR_FORMAT] {
-            let supported = gpu
-                .adapter
-                .get_texture_format_features(format)
-                .flags
-                .sample_count_supported(samples);
-            let adapter_specific = device
-                .features()
-                .contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
-            if !supported || (samples > 1 && format == ID_FORMAT && !adapter_specific) {
-                return Err(ReferenceError::Unsupported(format!(
-                    "{} cannot render {format:?} at {samples}x MSAA",
-                    gpu.describe()
-                )));
-            }
-        }
         let triangles = u32::try_from(geometry.triangles.len())
             .map_err(|_| ReferenceError::Invalid("more than 2^32 triangles".into()))?;
         let view = View {
@@ -216,24 +315,22 @@ impl<'g> PeelingRenderer<'g> {
             label: Some("peeling"),
             source: wgpu::ShaderSource::Wgsl(trisort_gpu::peeling_shader(samples).into()),
         });
-        let multisampled = samples > 1;
-        let texture_entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled,
-            },
-            count: None,
-        };
         let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("peeling peel"),
             entries: &previous_key_entries(samples),
         });
         let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("peeling composite"),
-            entries: &[texture_entry(3, wgpu::TextureSampleType::Uint)],
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: samples > 1,
+                },
+                count: None,
+            }],
         });
         let peel_pipeline = |label, compare| {
             ScenePipeline {
@@ -279,92 +376,12 @@ impl<'g> PeelingRenderer<'g> {
             contents: &params,
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let texture = |label, format, sample_count, usage| {
-            trisort_gpu::pipeline::texture_2d(device, label, size, sample_count, format, usage)
-        };
-        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let peel_usage = attachment | wgpu::TextureUsages::TEXTURE_BINDING;
-        let make_view = |t: wgpu::Texture| t.create_view(&Default::default());
-        let ids = [
-            make_view(texture("peeling ids a", ID_FORMAT, samples, peel_usage)),
-            make_view(texture("peeling ids b", ID_FORMAT, samples, peel_usage)),
-        ];
-        let depth = [
-            make_view(texture(
-                "peeling depth a",
-                DEPTH_FORMAT,
-                samples,
-                peel_usage,
-            )),
-            make_view(texture(
-                "peeling depth b",
-                DEPTH_FORMAT,
-                samples,
-                peel_usage,
-            )),
-        ];
-        let peel_group = |p: usize| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("peeling peel"),
-                layout: &peel_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &params,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(16),
-                        }),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&depth[p]),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&ids[p]),
-                    },
-                ],
-            })
-        };
-        let composite_group = |p: usize| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("peeling composite"),
-                layout: &composite_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&ids[p]),
-                }],
-            })
-        };
-        let peel_groups = [peel_group(0), peel_group(1)];
-        let composite_groups = [composite_group(0), composite_group(1)];
-        let msaa = multisampled.then(|| {
-            make_view(texture(
-                "peeling frame (MSAA)",
-                COLOR_FORMAT,
-                samples,
-                attachment,
-            ))
-        });
-        let resolved = texture(
-            "peeling frame",
-            COLOR_FORMAT,
-            1,
-            attachment | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
-        let resolved_view = resolved.create_view(&Default::default());
-        let bytes_per_pixel = COLOR_FORMAT
-            .block_copy_size(None)
-            .expect("Rgba16Float has a texel size");
-        let row_bytes = (size.0 * bytes_per_pixel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("peeling frame readback"),
-            size: row_bytes as u64 * size.1 as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let layers = LayerTargets::new(device, &config, &peel_layout, &composite_layout, &params);
+        let target = FrameTarget::new(
+            &gpu.adapter,
+            device,
+            TargetConfig::readback(size, samples, Mode::Blend),
+        )?;
         let occlusion = device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("peeling layer count"),
             ty: wgpu::QueryType::Occlusion,
@@ -384,7 +401,6 @@ impl<'g> PeelingRenderer<'g> {
         });
         Ok(PeelingRenderer {
             gpu,
-            size,
             samples,
             mode,
             max_layers,
@@ -395,15 +411,11 @@ impl<'g> PeelingRenderer<'g> {
             back,
             composite,
             params_stride,
-            peel_groups,
-            composite_groups,
-            ids,
-            depth,
-            msaa,
-            resolved,
-            resolved_view,
-            row_bytes,
-            staging,
+            peel_groups: layers.peel_groups,
+            composite_groups: layers.composite_groups,
+            ids: layers.ids,
+            depth: layers.depth,
+            target,
             occlusion,
             occlusion_resolve,
             occlusion_staging,
@@ -420,7 +432,7 @@ impl<'g> PeelingRenderer<'g> {
 
     /// The resolved single-sample `Rgba16Float` frame [`PeelingRenderer::encode`] leaves.
     pub fn target(&self) -> &wgpu::Texture {
-        &self.resolved
+        self.target.resolved()
     }
 
     /// The number of layers frame `frame` needs: peels front to back with an occlusion query
@@ -635,24 +647,7 @@ impl<'g> PeelingRenderer<'g> {
         clear: Option<wgpu::Color>,
         resolve: bool,
     ) -> wgpu::RenderPass<'e> {
-        let (view, resolve_target, store) = match &self.msaa {
-            Some(msaa) if resolve => (msaa, Some(&self.resolved_view), wgpu::StoreOp::Discard),
-            Some(msaa) => (msaa, None, wgpu::StoreOp::Store),
-            None => (&self.resolved_view, None, wgpu::StoreOp::Store),
-        };
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("peeling composite"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target,
-                ops: wgpu::Operations {
-                    load: clear.map_or(wgpu::LoadOp::Load, wgpu::LoadOp::Clear),
-                    store,
-                },
-            })],
-            ..Default::default()
-        });
+        let mut pass = self.target.begin_pass_with(enc, clear, resolve, None);
         if let Some(p) = layer {
             if self.triangles > 0 {
                 pass.set_pipeline(&self.composite);
@@ -670,36 +665,11 @@ impl<'g> PeelingRenderer<'g> {
     /// submitted and read back as 8-bit sRGB.
     pub fn render(&self, frame: u32) -> Result<PeeledFrame, ReferenceError> {
         let (layers, truncated) = self.count(frame)?;
-        let device = &self.gpu.device;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("peeling frame"),
-        });
-        self.encode(&mut enc, frame, layers, None);
-        enc.copy_texture_to_buffer(
-            self.resolved.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &self.staging,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(self.row_bytes),
-                    rows_per_image: Some(self.size.1),
-                },
-            },
-            self.resolved.size(),
-        );
-        self.gpu.queue.submit([enc.finish()]);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(ReferenceError::Wgpu(e.to_string()));
-        }
-        let padded = self.gpu.map_read(&self.staging);
-        let row = self.size.0 as usize * 8;
-        let bytes: Vec<u8> = (0..self.size.1 as usize)
-            .flat_map(|y| &padded[y * self.row_bytes as usize..][..row])
-            .copied()
-            .collect();
+        let rgba8 = self.target.read_rgba8(self.gpu, Mode::Blend, |enc| {
+            self.encode(enc, frame, layers, None)
+        })?;
         Ok(PeeledFrame {
-            rgba8: quantize_rgba16f(&halves(&bytes), None),
+            rgba8,
             layers,
             truncated,
         })
