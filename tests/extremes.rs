@@ -10,8 +10,8 @@ use std::path::Path;
 
 use serde_json::json;
 use support::*;
-use trisort_format::fixtures::quad_triangles;
 use trisort_format::{Baked, FileKind, Recording};
+use trisort_testkit::fixtures::quad_triangles;
 
 // ---------------------------------------------------------------------------------------------
 // Scene and path writers.
@@ -36,7 +36,7 @@ fn part(material: usize, triangles: Vec<[[f32; 3]; 3]>) -> Part {
 }
 
 /// Two triangles spanning [x0,x1]×[y0,y1] at depth z, ids in this order (the corners of
-/// [`trisort_format::fixtures::quad`]).
+/// [`trisort_testkit::fixtures::quad`]).
 fn quad(x0: f32, x1: f32, y0: f32, y1: f32, z: f32) -> Vec<[[f32; 3]; 3]> {
     quad_triangles(x0, x1, y0, y1, z, z).to_vec()
 }

@@ -4,14 +4,15 @@
 //! on purpose fails).
 
 use glam::DVec3;
-use trisort_format::fixtures::{frame_at, material, quad, scene, settings};
 use trisort_format::{
     AlphaMode, Baked, FrameState, Geometry, Material, Phase, RecordSettings, Recording,
 };
+use trisort_gpu::Gpu;
 use trisort_player::Mode;
 use trisort_recorder::{record, RecordJob};
 use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier};
-use trisort_gpu::Gpu;
+use trisort_testkit::fixtures::{frame_at, material, quad, scene, settings};
+use trisort_testkit::gpu;
 
 // ---- scenes built here: camera at the origin looking down −Z ----
 
@@ -93,7 +94,7 @@ fn verify_all_modes(
 
 #[test]
 fn stacked_transparent_quads_verify_in_every_mode() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let mut g = scene(vec![
         material([0.9, 0.1, 0.1], 0.5),
         material([0.1, 0.9, 0.1], 0.6),
@@ -137,7 +138,7 @@ fn reference_config(mode: Mode) -> trisort_reference::ReferenceConfig {
 /// in ascending id order (the player drawing the whole scene in id order with `Less`).
 #[test]
 fn depth_reference_equals_the_plain_z_buffer_on_opaque_scenes() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let mut g = scene(vec![
         material([0.9, 0.1, 0.1], 1.0),
         material([0.1, 0.9, 0.1], 1.0),
@@ -168,7 +169,7 @@ fn depth_reference_equals_the_plain_z_buffer_on_opaque_scenes() {
 
 #[test]
 fn coplanar_quads_verify_in_every_mode() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let mut g = scene(vec![
         material([0.9, 0.2, 0.1], 0.5),
         material([0.1, 0.3, 0.9], 0.5),
@@ -189,7 +190,7 @@ fn coplanar_quads_verify_in_every_mode() {
 
 #[test]
 fn interpenetrating_pair_differs_only_on_unordered_pixels() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let mut g = scene(vec![
         material([0.9, 0.1, 0.1], 0.5),
         material([0.1, 0.2, 0.9], 0.5),
@@ -220,7 +221,7 @@ fn interpenetrating_pair_differs_only_on_unordered_pixels() {
 /// The demo car while its driver door opens (frames 8–20 of its default path).
 #[test]
 fn demo_car_door_opening_verifies_in_every_mode() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let car = trisort_scene::demo_car::demo_car(trisort_scene::demo_car::MIN_TRIANGLES);
     let path = trisort_paths::demo_default(&car);
     let frames: Vec<FrameState> = [8usize, 14, 20]
@@ -236,14 +237,14 @@ fn demo_car_door_opening_verifies_in_every_mode() {
 }
 
 fn real_scene(name: &str) -> Option<trisort_scene::Scene> {
-    let path = trisort_scene::test_scene(&format!("{name}/{name}.glb"))?;
+    let path = trisort_testkit::scene_path(&format!("{name}/{name}.glb"))?;
     Some(trisort_scene::load(&path).expect("scene loads"))
 }
 
 /// Bakes the shared scene `name` along the orbit `spec` at 96², 4×, and verifies every frame
 /// in every mode ([`verify_all_modes`]); skips without a GPU or without the scene.
 fn orbit_verifies_in_every_mode(name: &str, spec: &str) {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let Some(s) = real_scene(name) else {
         return;
     };
@@ -257,7 +258,7 @@ fn orbit_verifies_in_every_mode(name: &str, spec: &str) {
 /// CarConcept on tour frames around the opening driver door.
 #[test]
 fn car_concept_tour_range_verifies_in_every_mode() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let Some(car) = real_scene("CarConcept") else {
         return;
     };
@@ -296,7 +297,7 @@ fn alpha_blend_mode_test_verifies_in_every_mode() {
 /// it is not: what sorting buys.
 #[test]
 fn default_pipeline_is_exact_only_when_id_order_is_back_to_front() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let frames = [frame_at(DVec3::ZERO)];
     let view = trisort_gpu::scene_gpu::View {
         width: 64,
@@ -345,7 +346,7 @@ fn default_pipeline_is_exact_only_when_id_order_is_back_to_front() {
 /// differ. Recorder and player both evaluate at the pixel centre.
 #[test]
 fn sub_pixel_texture_alpha_verifies_in_every_mode() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let n = 64u32;
     let mut rgba8 = Vec::with_capacity((n * n * 4) as usize);
     for y in 0..n {
@@ -411,7 +412,7 @@ fn saturated_stack(front: f32) -> Geometry {
 /// colour, within 1/255 behind a mid-grey stack.
 #[test]
 fn layers_behind_saturation_stay_within_tolerance() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let g = saturated_stack(0.3);
     let frames = [frame_at(DVec3::ZERO)];
     let (rec, baked) = bake(&gpu, &g, &frames, settings(64, 4));
@@ -435,7 +436,7 @@ fn layers_behind_saturation_stay_within_tolerance() {
 /// keeps every quad and verifies.
 #[test]
 fn dark_stack_shows_the_saturation_residual() {
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let g = saturated_stack(0.01);
     let frames = [frame_at(DVec3::ZERO)];
     let (rec, baked) = bake(&gpu, &g, &frames, settings(64, 4));

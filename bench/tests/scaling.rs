@@ -5,7 +5,6 @@ use trisort_bench::scaling::{
     self, growth, growth_exponent, path_spec, ScalingConfig, ScalingRow, AXIS_FRAMES,
     AXIS_FRAMES_SEGMENTED, AXIS_SYNTHETIC, AXIS_TRIANGLES,
 };
-use trisort_gpu::Gpu;
 
 #[test]
 fn slope_of_a_power_law() {
@@ -71,7 +70,7 @@ fn check_row(r: &ScalingRow) {
 
 #[test]
 fn quick_configuration_runs_and_writes_consistent_outputs() {
-    let Some(gpu) = Gpu::for_tests() else {
+    let Some(gpu) = trisort_testkit::gpu() else {
         return;
     };
     let config = ScalingConfig::quick();

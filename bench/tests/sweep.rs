@@ -2,11 +2,10 @@
 //! what DESIGN guarantees at the recorded pattern.
 
 use trisort_bench::sweep::{run, Factor, SweepConfig, SweepPoint, CSV_COLUMNS};
-use trisort_gpu::Gpu;
 
 #[test]
 fn tiny_sweep_writes_consistent_outputs() {
-    let Some(gpu) = Gpu::for_tests() else {
+    let Some(gpu) = trisort_testkit::gpu() else {
         return;
     };
     let scene = trisort_scene::demo_car(10_000);
@@ -164,7 +163,7 @@ fn tiny_sweep_writes_consistent_outputs() {
 
 #[test]
 fn bad_configurations_are_refused_before_any_work() {
-    let Some(gpu) = Gpu::for_tests() else {
+    let Some(gpu) = trisort_testkit::gpu() else {
         return;
     };
     let scene = trisort_scene::demo_car(2_000);

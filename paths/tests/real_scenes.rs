@@ -10,10 +10,11 @@ use common::eye_forward;
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use trisort_format::world_transforms;
 use trisort_paths::{load, PathOptions, Timeline};
-use trisort_scene::{test_scene, Scene};
+use trisort_scene::Scene;
+use trisort_testkit::scene_path;
 
 fn import(rel: &str) -> Option<Scene> {
-    let path = test_scene(rel)?;
+    let path = scene_path(rel)?;
     Some(trisort_scene::load(&path).unwrap_or_else(|e| panic!("{e}")))
 }
 

@@ -6,18 +6,18 @@ mod support;
 
 use support::*;
 use trisort_format::DrawIndexedIndirectArgs;
+use trisort_gpu::Gpu;
 use trisort_player::{
     Call, CallLog, DrawPath, HeadlessConfig, HeadlessRenderer, Mode, Player, PlayerConfig,
     PlayerError, BACKGROUND,
 };
-use trisort_gpu::Gpu;
 
 fn gpu() -> Option<Gpu> {
     std::env::set_var(
         "XDG_RUNTIME_DIR",
         std::env::var("XDG_RUNTIME_DIR").unwrap_or("/tmp".into()),
     );
-    Gpu::for_tests()
+    trisort_testkit::gpu()
 }
 
 fn config(mode: Mode, draw_path: DrawPath) -> PlayerConfig {

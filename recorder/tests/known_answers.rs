@@ -2,13 +2,12 @@
 //! −Z, axis-aligned quads facing it.
 
 use glam::DVec3;
-use trisort_format::fixtures::{flat_quad, frame_at, material, scene, settings, tri};
 use trisort_format::{FrameState, Geometry, Phase, RecordSettings, Recording};
 use trisort_recorder::{record, RecordJob};
-use trisort_gpu::Gpu;
+use trisort_testkit::fixtures::{flat_quad, frame_at, material, scene, settings, tri};
 
 fn run(g: &Geometry, frames: &[FrameState], settings: RecordSettings) -> Option<Recording> {
-    let gpu = Gpu::for_tests()?;
+    let gpu = trisort_testkit::gpu()?;
     let job = RecordJob {
         geometry: g,
         frames,

@@ -3,7 +3,7 @@
 use glam::{DMat4, DVec3};
 use trisort_format::{Geometry, Node, Phase, RecordSettings};
 use trisort_recorder::{record, RecordJob};
-use trisort_gpu::Gpu;
+use trisort_testkit::gpu;
 
 /// `copies` copies of `g` on a grid, each under a new root node translated by `spacing`.
 fn instanced(g: &Geometry, copies: u32, spacing: f64) -> Geometry {
@@ -46,10 +46,10 @@ fn instanced(g: &Geometry, copies: u32, spacing: f64) -> Geometry {
 
 #[test]
 fn five_million_triangles_record_one_frame() {
-    let Some(path) = trisort_scene::test_scene("CarConcept/CarConcept.glb") else {
+    let Some(path) = trisort_testkit::scene_path("CarConcept/CarConcept.glb") else {
         return;
     };
-    let Some(gpu) = Gpu::for_tests() else { return };
+    let Some(gpu) = gpu() else { return };
     let car = trisort_scene::load(&path).unwrap();
     let scene = trisort_scene::Scene {
         geometry: instanced(&car.geometry, 24, 6.0),

@@ -12,13 +12,14 @@
 //! compared outside the test suite (GlassVaseFlowers, AlphaBlendModeTest, CarConcept: equal).
 
 use glam::DVec3;
-use trisort_format::fixtures::{frame_at, material, scene, split_quad, tri};
 use trisort_format::{FrameState, Geometry};
+use trisort_gpu::Gpu;
 use trisort_player::Mode;
 use trisort_reference::{
     ExactReference, OitConfig, OitFrame, OitRenderer, ReferenceConfig, ReferenceError,
 };
-use trisort_gpu::Gpu;
+use trisort_testkit::fixtures::{frame_at, material, scene, split_quad, tri};
+use trisort_testkit::gpu;
 
 // ---- scenes built here: camera at the origin looking down −Z ----
 
@@ -31,10 +32,6 @@ fn frames() -> Vec<FrameState> {
 }
 
 // ---- comparison ----
-
-fn gpu() -> Option<Gpu> {
-    Gpu::for_tests()
-}
 
 fn reference<'g>(
     gpu: &'g Gpu,

@@ -165,37 +165,3 @@ pub use demo_car::{demo_car, DEFAULT_TRIANGLES, DOOR_NODE, DOOR_WINDOW_NODE};
 pub use error::SceneError;
 pub use export::{export_glb, ExportError};
 pub use gltf_import::{load, load_slice};
-
-/// Environment variable naming the folder of the shared test scenes.
-pub const SCENES_ENV: &str = "TRISORT_SCENES";
-/// Environment variable that, when set to `1` (CI sets it), turns a missing test scene into a
-/// test failure instead of a skip.
-pub const REQUIRE_SCENES_ENV: &str = "TRISORT_REQUIRE_SCENES";
-
-/// Locates a shared test scene for tests and benchmarks: `$TRISORT_SCENES/<rel>`, by default
-/// `<workspace>/../shared/scenes/<rel>`.
-///
-/// Returns `None` (the caller skips, printing why) when the file is missing, unless
-/// `TRISORT_REQUIRE_SCENES=1`, in which case it panics: CI must never skip a real-scene test.
-pub fn test_scene(rel: &str) -> Option<std::path::PathBuf> {
-    let dir = std::env::var_os(SCENES_ENV)
-        .map(std::path::PathBuf::from)
-        .unwrap_or_else(|| {
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes")
-        });
-    let path = dir.join(rel);
-    if path.is_file() {
-        return Some(path);
-    }
-    if std::env::var(REQUIRE_SCENES_ENV).as_deref() == Ok("1") {
-        panic!(
-            "test scene {} is missing and {REQUIRE_SCENES_ENV}=1",
-            path.display()
-        );
-    }
-    eprintln!(
-        "skipping: test scene {} not found (set {SCENES_ENV})",
-        path.display()
-    );
-    None
-}

@@ -2,11 +2,12 @@
 
 use glam::{DMat4, Vec3};
 use trisort_format::{world_transforms, AlphaMode, NodePose};
-use trisort_scene::{load, test_scene, Property, Scene};
+use trisort_scene::{load, Property, Scene};
+use trisort_testkit::scene_path;
 
-/// Imports a shared scene, or `None` to skip (see [`test_scene`]).
+/// Imports a shared scene, or `None` to skip (see [`scene_path`]).
 fn import(rel: &str) -> Option<Scene> {
-    let path = test_scene(rel)?;
+    let path = scene_path(rel)?;
     Some(load(&path).unwrap_or_else(|e| panic!("{e}")))
 }
 

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use glam::{DMat3, DVec3, Vec3};
 use serde_json::{json, Value};
 use trisort_format::{world_transforms, AlphaMode};
-use trisort_scene::{load, load_slice, test_scene, Interpolation, Property, Scene, SceneError};
+use trisort_scene::{load, load_slice, Interpolation, Property, Scene, SceneError};
+use trisort_testkit::scene_path;
 
 fn base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -569,7 +570,7 @@ fn corrupted_bytes_never_panic() {
 
 #[test]
 fn truncated_real_glb_is_an_error() {
-    let Some(path) = test_scene("CesiumMilkTruck/CesiumMilkTruck.glb") else {
+    let Some(path) = scene_path("CesiumMilkTruck/CesiumMilkTruck.glb") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();

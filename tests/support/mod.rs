@@ -55,12 +55,12 @@ pub fn run_json(dir: &Path, args: &[&str]) -> serde_json::Value {
 
 /// A shared scene file, or `None` to skip (unless TRISORT_REQUIRE_SCENES=1).
 pub fn scene(name: &str) -> Option<String> {
-    trisort_scene::test_scene(&format!("{name}/{name}.glb")).map(|p| p.display().to_string())
+    trisort_testkit::scene_path(&format!("{name}/{name}.glb")).map(|p| p.display().to_string())
 }
 
 /// Whether GPU tests can run here; panics when a GPU is required (CI) but missing.
 pub fn gpu_available() -> bool {
-    trisort_gpu::Gpu::for_tests().is_some()
+    trisort_testkit::gpu().is_some()
 }
 
 /// A fresh temporary directory for a test that needs a GPU, or `None` to skip the test where

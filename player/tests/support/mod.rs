@@ -3,11 +3,11 @@
 #![allow(dead_code)]
 
 use glam::{DMat4, DVec3};
-use trisort_format::fixtures::{flat_quad, scene};
 use trisort_format::{
     AlphaMode, Baked, Camera, DeviceInfo, DrawIndexedIndirectArgs, FrameState, FrameWindow,
     Geometry, Material, RecordSettings, Vertex,
 };
+use trisort_testkit::fixtures::{flat_quad, scene};
 
 /// Recorded image size (square).
 pub const SIZE: u32 = 32;

@@ -12,7 +12,7 @@
 //!
 //! ```
 //! use glam::DVec3;
-//! use trisort_format::fixtures::{frame_at, material, quad, scene};
+//! use trisort_testkit::fixtures::{frame_at, material, quad, scene};
 //!
 //! // A red half-transparent quad in front of an opaque grey one.
 //! let mut g = scene(vec![material([0.9, 0.1, 0.1], 0.5), material([0.5; 3], 1.0)]);
@@ -25,7 +25,9 @@
 
 use glam::{DMat4, DVec3};
 
-use crate::{AlphaMode, Camera, FrameState, Geometry, Material, Node, RecordSettings, Vertex};
+use trisort_format::{
+    AlphaMode, Camera, FrameState, Geometry, Material, Node, RecordSettings, Vertex,
+};
 
 /// Adds a quad with corners (x0, y0, z0), (x1, y0, z1), (x1, y1, z1), (x0, y1, z0), facing +Z:
 /// four shared vertices (normal +Z, uv 0, node 0) and two triangles, (0, 1, 2) and (0, 2, 3),

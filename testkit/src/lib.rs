@@ -1,0 +1,70 @@
+//! Test-only helpers shared by trisort's test suites; a dev-dependency of the workspace's
+//! crates, never a dependency, so the shipping libraries carry no test code.
+//!
+//! - [`gpu`] (feature `gpu`): a device, or a skip where there is none, unless
+//!   `TRISORT_REQUIRE_GPU=1` (CI) makes that a failure;
+//! - [`scene_path`]: a shared test scene, or a skip where it is missing, unless
+//!   `TRISORT_REQUIRE_SCENES=1` (CI) makes that a failure;
+//! - [`fixtures`]: small hand-built scenes with known answers.
+//!
+//! A crate's own unit tests (`#[cfg(test)]` in its `src/`) cannot use this crate where this
+//! crate depends on it (they would see a second copy of its types): `trisort-format`'s and
+//! `trisort-gpu`'s do without it.
+#![deny(missing_docs)]
+
+pub mod fixtures;
+
+use std::path::{Path, PathBuf};
+
+/// Environment variable that, when `1` (CI sets it), turns a missing GPU adapter into a test
+/// failure instead of a skip.
+pub const REQUIRE_GPU_ENV: &str = "TRISORT_REQUIRE_GPU";
+
+/// Environment variable naming the folder of the shared test scenes.
+pub const SCENES_ENV: &str = "TRISORT_SCENES";
+
+/// Environment variable that, when set to `1` (CI sets it), turns a missing test scene into a
+/// test failure instead of a skip.
+pub const REQUIRE_SCENES_ENV: &str = "TRISORT_REQUIRE_SCENES";
+
+/// A device for a GPU test, or `None` (the test skips, saying why) when there is no adapter,
+/// unless `TRISORT_REQUIRE_GPU=1`, in which case a missing adapter panics.
+#[cfg(feature = "gpu")]
+pub fn gpu() -> Option<trisort_gpu::Gpu> {
+    match trisort_gpu::Gpu::new() {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var(REQUIRE_GPU_ENV).as_deref() == Ok("1") => {
+            panic!("{e} and {REQUIRE_GPU_ENV}=1")
+        }
+        Err(e) => {
+            eprintln!("skipping GPU test: {e}");
+            None
+        }
+    }
+}
+
+/// Locates a shared test scene: `$TRISORT_SCENES/<rel>`, by default
+/// `<workspace>/../shared/scenes/<rel>`.
+///
+/// Returns `None` (the caller skips, printing why) when the file is missing, unless
+/// `TRISORT_REQUIRE_SCENES=1`, in which case it panics: CI must never skip a real-scene test.
+pub fn scene_path(rel: &str) -> Option<PathBuf> {
+    let dir = std::env::var_os(SCENES_ENV)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes"));
+    let path = dir.join(rel);
+    if path.is_file() {
+        return Some(path);
+    }
+    if std::env::var(REQUIRE_SCENES_ENV).as_deref() == Ok("1") {
+        panic!(
+            "test scene {} is missing and {REQUIRE_SCENES_ENV}=1",
+            path.display()
+        );
+    }
+    eprintln!(
+        "skipping: test scene {} not found (set {SCENES_ENV})",
+        path.display()
+    );
+    None
+}
