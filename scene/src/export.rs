@@ -23,7 +23,7 @@
 use std::path::{Path, PathBuf};
 
 use serde_json::{json, Map, Value};
-use trisort_format::{AlphaMode, Material};
+use trisort_format::{AlphaMode, Geometry, Material};
 
 use crate::Scene;
 
@@ -310,15 +310,73 @@ fn material_json(m: &Material, extensions: &mut Vec<&'static str>) -> Value {
     out
 }
 
+/// Triangles of one node and one material, in ascending id order: ((node, material), ids).
+type Group = ((u32, u32), Vec<u32>);
+
 /// Encodes the whole `.glb` file in memory. `path` only names the file in errors.
 fn encode_glb(scene: &Scene, path: &Path) -> Result<Vec<u8>, ExportError> {
     validate(scene, path)?;
     let g = &scene.geometry;
     let mut b = Builder::default();
+    let groups = groups(g);
+    let meshes = meshes(&mut b, g, &groups);
+    let (nodes, roots) = nodes(g, &groups);
 
-    // Triangles grouped by (node, material), groups in order of first appearance.
+    let mut extensions = Vec::new();
+    let materials: Vec<Value> = g
+        .materials
+        .iter()
+        .map(|m| material_json(m, &mut extensions))
+        .collect();
+    let (images, textures) = images(&mut b, g, path)?;
+
+    let mut root = Map::new();
+    root.insert(
+        "asset".into(),
+        json!({
+            "version": "2.0",
+            "generator": format!("trisort {}", trisort_format::TOOL_VERSION),
+        }),
+    );
+    let put = |root: &mut Map<String, Value>, key: &str, list: Vec<Value>| {
+        if !list.is_empty() {
+            root.insert(key.into(), Value::Array(list));
+        }
+    };
+    put(&mut root, "accessors", std::mem::take(&mut b.accessors));
+    put(&mut root, "bufferViews", std::mem::take(&mut b.views));
+    put(&mut root, "meshes", meshes);
+    put(&mut root, "materials", materials);
+    put(&mut root, "images", images);
+    put(&mut root, "textures", textures.clone());
+    if !textures.is_empty() {
+        put(
+            &mut root,
+            "samplers",
+            vec![json!({ "magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497 })],
+        );
+    }
+    put(&mut root, "nodes", nodes);
+    if !roots.is_empty() {
+        put(&mut root, "scenes", vec![json!({ "nodes": roots })]);
+        root.insert("scene".into(), json!(0));
+    }
+    put(
+        &mut root,
+        "extensionsUsed",
+        extensions.iter().map(|e| json!(e)).collect(),
+    );
+    pad4(&mut b.bin, 0);
+    if !b.bin.is_empty() {
+        root.insert("buffers".into(), json!([{ "byteLength": b.bin.len() }]));
+    }
+    glb(Value::Object(root), &b.bin, path)
+}
+
+/// Triangles grouped by (node, material), groups in order of first appearance.
+fn groups(g: &Geometry) -> Vec<Group> {
     let mut group_of: std::collections::HashMap<(u32, u32), usize> = Default::default();
-    let mut groups: Vec<((u32, u32), Vec<u32>)> = Vec::new();
+    let mut groups: Vec<Group> = Vec::new();
     for (t, tri) in g.triangles.iter().enumerate() {
         let v = &g.vertices[tri[0] as usize];
         let key = (v.node, v.material);
@@ -328,10 +386,14 @@ fn encode_glb(scene: &Scene, path: &Path) -> Result<Vec<u8>, ExportError> {
         });
         groups[k].1.push(t as u32);
     }
+    groups
+}
 
+/// One mesh per group, its vertices and indices appended to the binary chunk.
+fn meshes(b: &mut Builder, g: &Geometry, groups: &[Group]) -> Vec<Value> {
     let mut meshes = Vec::new();
     let mut remap = vec![u32::MAX; g.vertices.len()];
-    for ((node, material), tris) in &groups {
+    for ((node, material), tris) in groups {
         let mut used: Vec<u32> = Vec::new();
         let mut indices = Vec::with_capacity(tris.len() * 3);
         for &t in tris {
@@ -374,8 +436,12 @@ fn encode_glb(scene: &Scene, path: &Path) -> Result<Vec<u8>, ExportError> {
             }],
         }));
     }
+    meshes
+}
 
-    // Nodes: the scene's, then one child per group for nodes with several groups.
+/// The glTF nodes (the scene's, then one child per group for nodes with several groups) and
+/// the root node indices.
+fn nodes(g: &Geometry, groups: &[Group]) -> (Vec<Value>, Vec<usize>) {
     let mut nodes: Vec<Value> = g
         .nodes
         .iter()
@@ -394,7 +460,7 @@ fn encode_glb(scene: &Scene, path: &Path) -> Result<Vec<u8>, ExportError> {
         }
     }
     let mut groups_per_node = vec![0usize; g.nodes.len()];
-    for ((node, _), _) in &groups {
+    for ((node, _), _) in groups {
         groups_per_node[*node as usize] += 1;
     }
     for (mesh, ((node, material), _)) in groups.iter().enumerate() {
@@ -417,14 +483,15 @@ fn encode_glb(scene: &Scene, path: &Path) -> Result<Vec<u8>, ExportError> {
     let roots: Vec<usize> = (0..g.nodes.len())
         .filter(|&k| g.nodes[k].parent.is_none())
         .collect();
+    (nodes, roots)
+}
 
-    let mut extensions = Vec::new();
-    let materials: Vec<Value> = g
-        .materials
-        .iter()
-        .map(|m| material_json(m, &mut extensions))
-        .collect();
-
+/// Every texture as an embedded PNG image, and the glTF textures naming them.
+fn images(
+    b: &mut Builder,
+    g: &Geometry,
+    path: &Path,
+) -> Result<(Vec<Value>, Vec<Value>), ExportError> {
     let mut images = Vec::new();
     let mut textures = Vec::new();
     for (k, t) in g.textures.iter().enumerate() {
@@ -442,55 +509,17 @@ fn encode_glb(scene: &Scene, path: &Path) -> Result<Vec<u8>, ExportError> {
         images.push(image);
         textures.push(json!({ "sampler": 0, "source": k }));
     }
+    Ok((images, textures))
+}
 
-    let mut root = Map::new();
-    root.insert(
-        "asset".into(),
-        json!({
-            "version": "2.0",
-            "generator": format!("trisort {}", trisort_format::TOOL_VERSION),
-        }),
-    );
-    let put = |root: &mut Map<String, Value>, key: &str, list: Vec<Value>| {
-        if !list.is_empty() {
-            root.insert(key.into(), Value::Array(list));
-        }
-    };
-    put(&mut root, "accessors", std::mem::take(&mut b.accessors));
-    put(&mut root, "bufferViews", std::mem::take(&mut b.views));
-    put(&mut root, "meshes", meshes);
-    put(&mut root, "materials", materials);
-    put(&mut root, "images", images);
-    put(&mut root, "textures", textures.clone());
-    if !textures.is_empty() {
-        put(
-            &mut root,
-            "samplers",
-            vec![json!({ "magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497 })],
-        );
-    }
-    put(&mut root, "nodes", nodes);
-    if !roots.is_empty() {
-        put(&mut root, "scenes", vec![json!({ "nodes": roots })]);
-        root.insert("scene".into(), json!(0));
-    }
-    put(
-        &mut root,
-        "extensionsUsed",
-        extensions.iter().map(|e| json!(e)).collect(),
-    );
-    pad4(&mut b.bin, 0);
-    if !b.bin.is_empty() {
-        root.insert("buffers".into(), json!([{ "byteLength": b.bin.len() }]));
-    }
-
-    let mut json_bytes =
-        serde_json::to_vec(&Value::Object(root)).map_err(|source| ExportError::Json {
-            path: path.to_path_buf(),
-            source,
-        })?;
+/// The GLB container: header, JSON chunk (space-padded) and binary chunk (when not empty).
+fn glb(root: Value, bin: &[u8], path: &Path) -> Result<Vec<u8>, ExportError> {
+    let mut json_bytes = serde_json::to_vec(&root).map_err(|source| ExportError::Json {
+        path: path.to_path_buf(),
+        source,
+    })?;
     pad4(&mut json_bytes, b' ');
-    let bin_chunk = if b.bin.is_empty() { 0 } else { 8 + b.bin.len() };
+    let bin_chunk = if bin.is_empty() { 0 } else { 8 + bin.len() };
     let total = 12 + 8 + json_bytes.len() as u64 + bin_chunk as u64;
     if total > u64::from(u32::MAX) {
         return Err(ExportError::TooLarge {
@@ -509,10 +538,10 @@ fn encode_glb(scene: &Scene, path: &Path) -> Result<Vec<u8>, ExportError> {
         out.extend_from_slice(&word.to_le_bytes());
     }
     out.extend_from_slice(&json_bytes);
-    if !b.bin.is_empty() {
-        out.extend_from_slice(&(b.bin.len() as u32).to_le_bytes());
+    if !bin.is_empty() {
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
         out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
-        out.extend_from_slice(&b.bin);
+        out.extend_from_slice(bin);
     }
     debug_assert_eq!(out.len() as u64, total);
     Ok(out)

@@ -5,6 +5,8 @@
 //! must not depend on `gltf`.
 #![deny(missing_docs)]
 
+use std::sync::OnceLock;
+
 use serde::{Deserialize, Serialize};
 use trisort_format::Geometry;
 
@@ -24,7 +26,17 @@ pub struct Scene {
     pub stats: SceneStats,
     /// Warnings and notes from import (skipped primitives, ignored extensions, …).
     pub notes: Vec<String>,
+    /// [`Scene::hash`], computed on its first call. Leave it empty (`Default::default()`,
+    /// which `..Scene::default()` gives) when building a scene by hand or from another
+    /// scene's parts, and change `geometry` after a `hash()` only through
+    /// [`Scene::geometry_mut`], which empties it.
+    pub hash_cache: HashCache,
 }
+
+/// The cached value of [`Scene::hash`]: empty until the first call. Public only so that
+/// scenes can still be built with struct literals; it has nothing to set.
+#[derive(Clone, Debug, Default)]
+pub struct HashCache(OnceLock<trisort_format::Hash>);
 
 /// Which node property an animation channel drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -116,9 +128,30 @@ pub struct SceneStats {
 impl Scene {
     /// A stable hash of the geometry (vertices, triangles, materials, textures, nodes): the
     /// scene identity stored in recordings and baked files.
+    ///
+    /// Computed once, on the first call, and kept in [`Scene::hash_cache`]; later calls return
+    /// the kept value. Builds with debug assertions (the test suite) recompute it on every
+    /// later call and panic if `geometry` changed behind the cache's back.
     pub fn hash(&self) -> trisort_format::Hash {
-        let bytes = postcard::to_stdvec(&self.geometry).expect("geometry serializes");
-        trisort_format::hash_bytes(&bytes)
+        if let Some(&hash) = self.hash_cache.0.get() {
+            debug_assert!(
+                hash == geometry_hash(&self.geometry),
+                "scene {:?}: geometry changed after Scene::hash without Scene::geometry_mut",
+                self.name
+            );
+            return hash;
+        }
+        *self
+            .hash_cache
+            .0
+            .get_or_init(|| geometry_hash(&self.geometry))
+    }
+
+    /// The geometry, to change it: empties the cache of [`Scene::hash`] so that the next call
+    /// hashes the changed geometry.
+    pub fn geometry_mut(&mut self) -> &mut Geometry {
+        self.hash_cache = HashCache::default();
+        &mut self.geometry
     }
 
     /// World-space axis-aligned bounding box of all triangles at the rest pose, as
@@ -156,6 +189,12 @@ impl Scene {
     }
 }
 
+/// The hash behind [`Scene::hash`]: BLAKE3 of the geometry's postcard encoding.
+fn geometry_hash(geometry: &Geometry) -> trisort_format::Hash {
+    let bytes = postcard::to_stdvec(geometry).expect("geometry serializes");
+    trisort_format::hash_bytes(&bytes)
+}
+
 pub mod demo_car;
 mod error;
 pub mod export;
@@ -165,3 +204,43 @@ pub use demo_car::{demo_car, DEFAULT_TRIANGLES, DOOR_NODE, DOOR_WINDOW_NODE};
 pub use error::SceneError;
 pub use export::{export_glb, ExportError};
 pub use gltf_import::{load, load_slice};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one_node_scene() -> Scene {
+        let mut scene = Scene::default();
+        scene.geometry.nodes.push(trisort_format::Node {
+            name: "n".into(),
+            parent: None,
+            rest: glam::DMat4::IDENTITY.to_cols_array(),
+        });
+        scene
+    }
+
+    #[test]
+    fn hash_is_cached_and_geometry_mut_empties_the_cache() {
+        let mut scene = one_node_scene();
+        let first = scene.hash();
+        assert_eq!(first, geometry_hash(&scene.geometry));
+        assert_eq!(scene.hash_cache.0.get(), Some(&first));
+        assert_eq!(scene.hash(), first);
+        assert_eq!(scene.clone().hash(), first);
+        scene.geometry_mut().nodes[0].name = "m".into();
+        assert!(scene.hash_cache.0.get().is_none());
+        let second = scene.hash();
+        assert_ne!(second, first);
+        assert_eq!(second, geometry_hash(&scene.geometry));
+    }
+
+    #[cfg(debug_assertions)]
+    #[test]
+    #[should_panic(expected = "geometry changed after Scene::hash")]
+    fn a_stale_hash_panics_in_debug_builds() {
+        let mut scene = one_node_scene();
+        scene.hash();
+        scene.geometry.nodes[0].name = "m".into();
+        scene.hash();
+    }
+}

@@ -1,0 +1,283 @@
+//! The file container: splitting a `.glb` into its chunks, parsing the JSON, reading buffers
+//! (GLB binary chunk, external files, `data:` URIs) and noting extensions the importer ignores.
+
+use std::path::{Path, PathBuf};
+
+use super::Importer;
+use crate::SceneError;
+
+/// Extensions whose content the importer uses.
+const HANDLED_EXTENSIONS: &[&str] = &[
+    "KHR_materials_transmission",
+    "KHR_materials_emissive_strength",
+    "KHR_mesh_quantization",
+];
+
+/// Parses a file into its glTF document and, for GLB, its binary chunk.
+pub(super) fn parse<'a>(
+    bytes: &'a [u8],
+    file: &Path,
+) -> Result<(gltf::Document, Option<&'a [u8]>), SceneError> {
+    let (json, bin) = split_container(bytes, file)?;
+    let json = json.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json);
+    let root = gltf::json::Root::from_slice(json).map_err(|e| SceneError::Malformed {
+        file: file.to_path_buf(),
+        problem: format!("invalid JSON: {e}"),
+    })?;
+    // gltf-json's validation indexes the POSITION accessor before checking that it exists
+    // (gltf-json 1.4.1, mesh.rs); check it first so a dangling index is an error, not a panic.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    return Err(SceneError::Malformed {
+                        file: file.to_path_buf(),
+                        problem: format!(
+                            "mesh {m} primitive {p}: attribute {semantic:?} names accessor {}, \
+                             the file has {}",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    });
+                }
+            }
+        }
+    }
+    let doc = gltf::Document::from_json(root).map_err(|e| SceneError::Malformed {
+        file: file.to_path_buf(),
+        problem: e.to_string(),
+    })?;
+    Ok((doc, bin))
+}
+
+/// Splits a file into its JSON text and, for GLB, its binary chunk.
+fn split_container<'a>(
+    bytes: &'a [u8],
+    file: &Path,
+) -> Result<(&'a [u8], Option<&'a [u8]>), SceneError> {
+    let malformed = |problem: String| SceneError::Malformed {
+        file: file.to_path_buf(),
+        problem,
+    };
+    let is_glb_name = file
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if !bytes.starts_with(b"glTF") {
+        if is_glb_name {
+            return Err(malformed(
+                "not a binary glTF file (it does not start with the magic \"glTF\")".into(),
+            ));
+        }
+        return Ok((bytes, None));
+    }
+    if bytes.len() < 12 {
+        return Err(malformed(format!(
+            "truncated: {} bytes, shorter than the 12-byte GLB header",
+            bytes.len()
+        )));
+    }
+    let word =
+        |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    let version = word(4);
+    if version != 2 {
+        return Err(malformed(format!("GLB version {version}, expected 2")));
+    }
+    let length = word(8) as usize;
+    if length > bytes.len() {
+        return Err(malformed(format!(
+            "truncated: the GLB header declares {length} bytes, the file has {}",
+            bytes.len()
+        )));
+    }
+    if length < 12 {
+        return Err(malformed(format!(
+            "the GLB header declares a length of {length} bytes, less than the header itself"
+        )));
+    }
+    let mut json = None;
+    let mut bin = None;
+    let mut at = 12;
+    while at < length {
+        if length - at < 8 {
+            return Err(malformed(format!("truncated chunk header at byte {at}")));
+        }
+        let chunk_len = word(at) as usize;
+        let kind = &bytes[at + 4..at + 8];
+        let start = at + 8;
+        if chunk_len > length - start {
+            return Err(malformed(format!(
+                "truncated: the chunk at byte {at} declares {chunk_len} bytes, {} remain",
+                length - start
+            )));
+        }
+        let data = &bytes[start..start + chunk_len];
+        match (json.is_none(), kind) {
+            (true, b"JSON") => json = Some(data),
+            (true, _) => return Err(malformed("the first GLB chunk is not JSON".into())),
+            (false, b"BIN\0") if bin.is_none() => bin = Some(data),
+            // Unknown chunks must be ignored (glTF 2.0 § 4.4.3.1).
+            _ => {}
+        }
+        at = start + chunk_len;
+    }
+    match json {
+        Some(json) => Ok((json, bin)),
+        None => Err(malformed("the GLB file has no JSON chunk".into())),
+    }
+}
+
+/// Standard base64 (also accepting the URL-safe alphabet), padding optional, whitespace
+/// ignored. `None` on any other character.
+fn base64_decode(text: &str) -> Option<Vec<u8>> {
+    let mut out = Vec::with_capacity(text.len() / 4 * 3 + 3);
+    let mut acc: u32 = 0;
+    let mut bits = 0;
+    for &c in text.as_bytes() {
+        let v = match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' | b'-' => 62,
+            b'/' | b'_' => 63,
+            b'=' => break,
+            b' ' | b'\n' | b'\r' | b'\t' => continue,
+            _ => return None,
+        };
+        acc = (acc << 6) | u32::from(v);
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+            acc &= (1 << bits) - 1;
+        }
+    }
+    Some(out)
+}
+
+/// Decodes `%XX` escapes of a relative URI. `None` for a bad escape or non-UTF-8 result.
+fn percent_decode(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = bytes.get(i + 1..i + 3)?;
+            let hex = std::str::from_utf8(hex).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// Reads the bytes a URI names: a base64 `data:` URI, or a path relative to `base`.
+/// The error is a sentence without the glTF file's name.
+pub(super) fn read_uri(uri: &str, base: Option<&Path>) -> Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let Some((_, payload)) = rest.split_once(";base64,") else {
+            return Err("data: URI is not base64-encoded".into());
+        };
+        return base64_decode(payload).ok_or_else(|| "data: URI holds invalid base64".into());
+    }
+    let scheme = uri.split(['/', '\\']).next().unwrap_or("");
+    if scheme.contains(':') {
+        return Err(format!(
+            "unsupported URI scheme in {uri:?} (only relative paths and data: URIs)"
+        ));
+    }
+    let rel = percent_decode(uri).ok_or_else(|| format!("URI {uri:?} has a bad %-escape"))?;
+    let path = match base {
+        Some(base) => base.join(rel),
+        None => PathBuf::from(rel),
+    };
+    std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+}
+
+impl Importer<'_> {
+    pub(super) fn load_buffers(&mut self, bin: Option<&[u8]>) -> Result<(), SceneError> {
+        let mut bin = bin;
+        for buffer in self.doc.buffers() {
+            let err = |problem: String| SceneError::Buffer {
+                file: self.file.clone(),
+                buffer: buffer.index(),
+                problem,
+            };
+            let data = match buffer.source() {
+                gltf::buffer::Source::Bin => bin
+                    .take()
+                    .ok_or_else(|| {
+                        err(
+                            "has no URI and there is no (unused) GLB binary chunk to hold it"
+                                .into(),
+                        )
+                    })?
+                    .to_vec(),
+                gltf::buffer::Source::Uri(uri) => {
+                    read_uri(uri, self.base.as_deref()).map_err(err)?
+                }
+            };
+            if data.len() < buffer.length() {
+                return Err(err(format!(
+                    "holds {} bytes, {} declared (truncated?)",
+                    data.len(),
+                    buffer.length()
+                )));
+            }
+            self.buffers.push(data);
+        }
+        Ok(())
+    }
+
+    /// Notes every extension the file uses that the importer ignores, and what is lost.
+    pub(super) fn note_ignored_extensions(&mut self) {
+        for ext in self.doc.extensions_used() {
+            if !HANDLED_EXTENSIONS.contains(&ext) {
+                let what = match ext {
+                    "KHR_texture_transform" => {
+                        "textures are sampled with untransformed coordinates"
+                    }
+                    "KHR_materials_variants" => "each primitive keeps its default material",
+                    "KHR_materials_volume" => "glass thickness and attenuation are not modelled",
+                    _ => "not supported",
+                };
+                self.notes.push(format!("extension {ext} ignored: {what}"));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_round_trips_known_text() {
+        assert_eq!(base64_decode("aGVsbG8=").unwrap(), b"hello");
+        assert_eq!(base64_decode("aGVsbG8h").unwrap(), b"hello!");
+        assert_eq!(base64_decode("aGk").unwrap(), b"hi");
+        assert!(base64_decode("a*b").is_none());
+    }
+
+    #[test]
+    fn percent_escapes_decode() {
+        assert_eq!(percent_decode("a%20b.bin").unwrap(), "a b.bin");
+        assert!(percent_decode("bad%2").is_none());
+        assert!(percent_decode("%FF").is_none());
+    }
+
+    #[test]
+    fn glb_header_lies_are_errors() {
+        let file = Path::new("x.glb");
+        let mut glb = b"glTF".to_vec();
+        glb.extend(2u32.to_le_bytes());
+        glb.extend(4u32.to_le_bytes());
+        assert!(split_container(&glb, file).is_err());
+        glb[8..12].copy_from_slice(&1000u32.to_le_bytes());
+        assert!(split_container(&glb, file).is_err());
+        glb[8..12].copy_from_slice(&12u32.to_le_bytes());
+        assert!(split_container(&glb, file).is_err(), "no JSON chunk");
+    }
+}

@@ -1,0 +1,207 @@
+//! glTF 2.0 import: [`load`] turns a `.glb` or `.gltf` file into a [`Scene`].
+//!
+//! # What is imported
+//!
+//! - **Geometry**: every mesh instance of the default scene (scene 0 when the file names no
+//!   default), instancing expanded: a mesh used by two nodes gives two sets of vertices and
+//!   triangles. Positions and normals stay in the local space of the node that carries the mesh,
+//!   and [`Vertex::node`](trisort_format::Vertex::node) is that node, so rigid animation moves
+//!   its triangles. Triangle strips and fans become lists; points and lines are skipped with a
+//!   note. Under a node whose *world* rest transform has a negative determinant, the winding of
+//!   every triangle is flipped (its last two indices swapped) so that front faces stay
+//!   counter-clockwise in world space. Normals come from the file (renormalised); a primitive
+//!   without normals gets flat normals, as the glTF specification requires: each of its
+//!   triangles gets three vertices of its own carrying its face normal.
+//! - **Nodes**: *all* nodes of the file, reordered so that parents precede children: a
+//!   depth-first pre-order walk (children in file order) from the scene's root nodes, then
+//!   from the remaining root nodes in file order.
+//!   [`Node::rest`](trisort_format::Node::rest) is the node's local matrix (its `matrix`, or
+//!   translation · rotation · scale) in f64. Animations and cameras refer to the new indices.
+//! - **Materials**: every material of the file at its own index, then one default material
+//!   (glTF's defaults) when some primitive has none: base colour factor and texture, alpha mode
+//!   and cutoff, double-sidedness, emissive × `KHR_materials_emissive_strength`, and the
+//!   `KHR_materials_transmission` factor. Other extensions are ignored with one note each.
+//! - **Textures**: only base-colour textures, decoded (PNG or JPEG) to RGBA8, one per image
+//!   (two textures sharing an image share one [`Texture`](trisort_format::Texture)), in order
+//!   of first use by the materials. [`Vertex::uv`](trisort_format::Vertex::uv) holds the
+//!   texture coordinate set the material's base-colour texture names (`TEXCOORD_0` almost
+//!   always; another set is noted) and is zero for untextured materials.
+//! - **Animations**: translation, rotation and scale channels with their times and flattened
+//!   values (LINEAR, STEP, CUBICSPLINE); morph-weight channels are skipped with a note.
+//! - **Cameras**: perspective cameras on nodes of the scene; orthographic ones are noted and
+//!   skipped.
+//!
+//! # Triangle ids
+//!
+//! A triangle's index in [`Geometry::triangles`] is its id. Ids are assigned in this order:
+//! nodes in the order of [`Geometry::nodes`] (depth-first scene order, see above) restricted
+//! to nodes of the scene; within a node, the primitives of its mesh in file order; within a
+//! primitive, triangles in index order (for strips and fans, in the order the specification
+//! derives them). The same file always gives the same ids.
+//!
+//! # Errors
+//!
+//! No file should make the importer panic, and no `catch_unwind` hides one: the GLB container
+//! and every accessor are parsed and bounds-checked here. The `gltf` crate is used for JSON
+//! parsing, validation and document navigation only: its accessor readers and GLB parser can
+//! panic on hostile data and are not used, and where its validation leaves gaps that its
+//! navigation then unwraps (POSITION indices, animation channel targets, image sources, camera
+//! parameters, in gltf 1.4.1) the JSON is checked or read directly. The tests mutate every byte
+//! of a GLB and every number and member of a rich document to hold this.
+//!
+//! Errors: a skin on a node of the scene, morph targets on a mesh of the scene, NaN or infinite
+//! positions, node cycles or nodes with two parents, accessors outside their data, missing or
+//! short buffers, and base-colour images that cannot be read or decoded; see [`SceneError`].
+//! Meshes outside the imported scene are not read, so they cannot fail the import; all nodes,
+//! materials, base-colour images and animations are.
+//!
+//! `stats.materials` counts the file's materials (not the appended default one);
+//! `stats.primitives` counts the triangle primitives of all meshes of the file, once per mesh.
+
+mod accessors;
+mod animations;
+mod cameras;
+mod container;
+mod materials;
+mod nodes;
+mod primitives;
+
+use std::path::{Path, PathBuf};
+
+use gltf::mesh::Mode;
+use trisort_format::Geometry;
+
+use crate::{Animation, Scene, SceneCamera, SceneError, SceneStats};
+
+/// Imports a `.glb` or `.gltf` file (external buffers and images are resolved relative to its
+/// folder).
+///
+/// The scene is named after the file stem. See the [module documentation](self) for what is
+/// imported, the node and triangle orders, and the errors.
+pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    load_slice(&bytes, path)
+}
+
+/// Imports glTF (binary or JSON) from memory. `file` is where the bytes came from: it names the
+/// scene (its stem) and the errors, and its folder resolves relative URIs. Same semantics as
+/// [`load`].
+pub fn load_slice(bytes: &[u8], file: &Path) -> Result<Scene, SceneError> {
+    let (doc, bin) = container::parse(bytes, file)?;
+    let mut importer = Importer {
+        file: file.to_path_buf(),
+        base: file.parent().map(Path::to_path_buf),
+        doc: &doc,
+        buffers: Vec::new(),
+        notes: Vec::new(),
+    };
+    importer.load_buffers(bin)?;
+    importer.run()
+}
+
+/// `kind index "name"`, or `kind index` for unnamed objects.
+fn label(kind: &str, index: usize, name: Option<&str>) -> String {
+    match name {
+        Some(name) => format!("{kind} {index} {name:?}"),
+        None => format!("{kind} {index}"),
+    }
+}
+
+fn mesh_label(mesh: &gltf::Mesh) -> String {
+    label("mesh", mesh.index(), mesh.name())
+}
+
+fn node_label(node: &gltf::Node) -> String {
+    label("node", node.index(), node.name())
+}
+
+/// One import in progress: the file, its document and buffers, and the notes so far.
+struct Importer<'d> {
+    /// The file, for errors.
+    file: PathBuf,
+    /// Folder that relative URIs are resolved against.
+    base: Option<PathBuf>,
+    doc: &'d gltf::Document,
+    /// Every buffer's bytes, by buffer index.
+    buffers: Vec<Vec<u8>>,
+    /// Warnings and notes for [`Scene::notes`].
+    notes: Vec<String>,
+}
+
+impl<'d> Importer<'d> {
+    fn malformed(&self, problem: String) -> SceneError {
+        SceneError::Malformed {
+            file: self.file.clone(),
+            problem,
+        }
+    }
+
+    /// Imports the document in this order, which is also the order of its errors and notes:
+    /// nodes, materials (with their images), the geometry of the scene, animations, cameras,
+    /// ignored extensions.
+    fn run(mut self) -> Result<Scene, SceneError> {
+        let file_nodes: Vec<gltf::Node> = self.doc.nodes().collect();
+        let (tree, nodes) = self.node_tree(&file_nodes)?;
+        let materials = self.materials()?;
+        let (geometry, zero_area_triangles) =
+            self.geometry(&file_nodes, &tree, nodes, materials)?;
+        let animations = self.animations(&tree.new_index)?;
+        let cameras = self.cameras(&tree.order, &tree.in_scene, &file_nodes);
+        self.note_ignored_extensions();
+
+        let stats = stats(
+            self.doc,
+            &geometry,
+            zero_area_triangles,
+            &animations,
+            &cameras,
+        );
+        let name = self
+            .file
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Ok(Scene {
+            name,
+            geometry,
+            animations,
+            cameras,
+            stats,
+            notes: self.notes,
+            hash_cache: Default::default(),
+        })
+    }
+}
+
+/// The counts `inspect` reports (see the module documentation for what they count).
+fn stats(
+    doc: &gltf::Document,
+    geometry: &Geometry,
+    zero_area_triangles: u64,
+    animations: &[Animation],
+    cameras: &[SceneCamera],
+) -> SceneStats {
+    SceneStats {
+        triangles: geometry.triangles.len() as u64,
+        zero_area_triangles,
+        meshes: doc.meshes().len() as u64,
+        primitives: doc
+            .meshes()
+            .flat_map(|m| m.primitives())
+            .filter(|p| {
+                matches!(
+                    p.mode(),
+                    Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+                )
+            })
+            .count() as u64,
+        nodes: geometry.nodes.len() as u64,
+        materials: doc.materials().len() as u64,
+        textures: geometry.textures.len() as u64,
+        animations: animations.len() as u64,
+        cameras: cameras.len() as u64,
+    }
+}

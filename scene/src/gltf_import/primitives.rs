@@ -1,0 +1,360 @@
+//! Mesh primitives: reading triangle primitives once and instancing them per node.
+
+use std::collections::hash_map::Entry;
+use std::collections::{BTreeMap, HashMap};
+
+use glam::DVec3;
+use gltf::accessor::Dimensions;
+use gltf::mesh::Mode;
+use gltf::Semantic;
+use trisort_format::{Geometry, Node, Vertex};
+
+use super::materials::Materials;
+use super::nodes::NodeTree;
+use super::{mesh_label, node_label, Importer};
+use crate::SceneError;
+
+/// Primitives that are not triangles, by kind ("points", "lines"): where they are, for one
+/// note per kind.
+type Skipped = BTreeMap<&'static str, Vec<String>>;
+
+/// The triangles of one mesh primitive, read once and instanced per node.
+struct PrimitiveData {
+    positions: Vec<[f32; 3]>,
+    /// Unit normals from the file; `None` means flat normals are generated.
+    normals: Option<Vec<[f32; 3]>>,
+    /// Texture coordinates of the material's base-colour set, if textured.
+    uvs: Option<Vec<[f32; 2]>>,
+    triangles: Vec<[u32; 3]>,
+    zero_area: u64,
+    material: u32,
+}
+
+impl Importer<'_> {
+    /// The geometry of the imported scene: every mesh instance of its nodes in node order
+    /// (the triangle id order of the module documentation), with the file's nodes, materials
+    /// and textures. Returns it with its number of zero-area triangles.
+    pub(super) fn geometry(
+        &mut self,
+        file_nodes: &[gltf::Node],
+        tree: &NodeTree,
+        nodes: Vec<Node>,
+        mut materials: Materials,
+    ) -> Result<(Geometry, u64), SceneError> {
+        let world = trisort_format::world_transforms(&nodes, &[]);
+        let mut geometry = Geometry {
+            nodes,
+            ..Geometry::default()
+        };
+        // Each primitive is read once (`None`: skipped, noted once) and instanced per node.
+        let mut primitive_cache: HashMap<(usize, usize), Option<PrimitiveData>> = HashMap::new();
+        let mut skipped = Skipped::new();
+        let mut zero_area_triangles = 0u64;
+        for &n in &tree.order {
+            let node = &file_nodes[n];
+            if !tree.in_scene[n] {
+                continue;
+            }
+            if let Some(skin) = node.skin() {
+                return Err(SceneError::Skinned {
+                    file: self.file.clone(),
+                    node: node_label(node),
+                    skin: skin.index(),
+                });
+            }
+            let Some(mesh) = node.mesh() else { continue };
+            let new_node = tree.new_index[n];
+            let flip = world[new_node as usize].determinant() < 0.0;
+            for prim in mesh.primitives() {
+                let key = (mesh.index(), prim.index());
+                if let Entry::Vacant(slot) = primitive_cache.entry(key) {
+                    slot.insert(self.read_once(&mesh, &prim, &mut materials, &mut skipped)?);
+                }
+                let Some(Some(data)) = primitive_cache.get(&key) else {
+                    continue;
+                };
+                zero_area_triangles += data.zero_area;
+                instance(&mut geometry, data, new_node, flip).map_err(|problem| {
+                    SceneError::Unsupported {
+                        file: self.file.clone(),
+                        problem,
+                    }
+                })?;
+            }
+        }
+        self.note_skipped(&skipped);
+        geometry.materials = materials.list;
+        geometry.textures = materials.textures;
+        Ok((geometry, zero_area_triangles))
+    }
+
+    /// Reads a primitive the first time a node instances it: `None` for points and lines
+    /// (listed in `skipped`) and for a primitive without positions (noted).
+    fn read_once(
+        &mut self,
+        mesh: &gltf::Mesh,
+        prim: &gltf::Primitive,
+        materials: &mut Materials,
+        skipped: &mut Skipped,
+    ) -> Result<Option<PrimitiveData>, SceneError> {
+        let kind = match prim.mode() {
+            Mode::Points => Some("points"),
+            Mode::Lines | Mode::LineLoop | Mode::LineStrip => Some("lines"),
+            _ => None,
+        };
+        if let Some(kind) = kind {
+            skipped.entry(kind).or_default().push(format!(
+                "{} primitive {}",
+                mesh_label(mesh),
+                prim.index()
+            ));
+            return Ok(None);
+        }
+        let material = materials.of(prim);
+        self.primitive(mesh, prim, material, materials.uv_set[material as usize])
+    }
+
+    /// One note per kind of skipped primitive, naming the first few.
+    fn note_skipped(&mut self, skipped: &Skipped) {
+        for (kind, list) in skipped {
+            let shown: Vec<&str> = list.iter().take(4).map(String::as_str).collect();
+            let more = if list.len() > shown.len() {
+                ", …"
+            } else {
+                ""
+            };
+            self.notes.push(format!(
+                "skipped {} {kind} primitive(s) (only triangles are drawn): {}{more}",
+                list.len(),
+                shown.join(", ")
+            ));
+        }
+    }
+
+    /// Reads one triangle primitive; `None` (with a note) when it has no positions.
+    fn primitive(
+        &mut self,
+        mesh: &gltf::Mesh,
+        prim: &gltf::Primitive,
+        material: u32,
+        uv_set: Option<u32>,
+    ) -> Result<Option<PrimitiveData>, SceneError> {
+        let where_ = format!("{} primitive {}", mesh_label(mesh), prim.index());
+        if prim.morph_targets().next().is_some() {
+            return Err(SceneError::MorphTargets {
+                file: self.file.clone(),
+                mesh: mesh_label(mesh),
+                primitive: prim.index(),
+            });
+        }
+        let Some(pos_acc) = prim.get(&Semantic::Positions) else {
+            self.notes
+                .push(format!("skipped {where_}: it has no POSITION attribute"));
+            return Ok(None);
+        };
+        let positions = self.read_vec3(&pos_acc, &format!("{where_} POSITION"))?;
+        if let Some(vertex) = positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(SceneError::NonFinitePosition {
+                file: self.file.clone(),
+                mesh: mesh_label(mesh),
+                primitive: prim.index(),
+                accessor: pos_acc.index(),
+                vertex,
+            });
+        }
+        let n = positions.len();
+        let count_mismatch = |acc: &gltf::Accessor, what: &str, got: usize| SceneError::Accessor {
+            file: self.file.clone(),
+            accessor: acc.index(),
+            usage: format!("{where_} {what}"),
+            problem: format!("{got} elements, POSITION has {n}"),
+        };
+        let normals = match prim.get(&Semantic::Normals) {
+            Some(acc) => {
+                let normals = self.read_vec3(&acc, &format!("{where_} NORMAL"))?;
+                if normals.len() != n {
+                    return Err(count_mismatch(&acc, "NORMAL", normals.len()));
+                }
+                Some(normals.into_iter().map(unit).collect())
+            }
+            None => None,
+        };
+        let uvs = match uv_set {
+            None => None,
+            Some(set) => match prim.get(&Semantic::TexCoords(set)) {
+                Some(acc) => {
+                    let what = format!("TEXCOORD_{set}");
+                    let flat =
+                        self.read_floats(&acc, &format!("{where_} {what}"), &[Dimensions::Vec2])?;
+                    if flat.len() != 2 * n {
+                        return Err(count_mismatch(&acc, &what, flat.len() / 2));
+                    }
+                    Some(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+                }
+                None => {
+                    self.notes.push(format!(
+                        "{where_} has a textured material but no TEXCOORD_{set}; its uv is zero"
+                    ));
+                    None
+                }
+            },
+        };
+        let indices: Vec<u32> = match prim.indices() {
+            Some(acc) => {
+                let usage = format!("{where_} indices");
+                let indices = self.read_indices(&acc, &usage)?;
+                if let Some(k) = indices.iter().position(|&i| i as usize >= n) {
+                    return Err(SceneError::Accessor {
+                        file: self.file.clone(),
+                        accessor: acc.index(),
+                        usage,
+                        problem: format!(
+                            "index {} at position {k} is out of range ({n} vertices)",
+                            indices[k]
+                        ),
+                    });
+                }
+                indices
+            }
+            None => (0..n as u32).collect(),
+        };
+        let triangles = match prim.mode() {
+            Mode::Triangles => {
+                let rest = indices.len() % 3;
+                if rest != 0 {
+                    self.notes.push(format!(
+                        "{where_}: {} indices is not a multiple of 3; the last {rest} ignored",
+                        indices.len(),
+                    ));
+                }
+                indices
+                    .chunks_exact(3)
+                    .map(|t| [t[0], t[1], t[2]])
+                    .collect()
+            }
+            Mode::TriangleStrip => strip_triangles(&indices),
+            Mode::TriangleFan => fan_triangles(&indices),
+            _ => Vec::new(),
+        };
+        let zero_area = triangles
+            .iter()
+            .filter(|t| is_zero_area(&positions, t))
+            .count() as u64;
+        Ok(Some(PrimitiveData {
+            positions,
+            normals,
+            uvs,
+            triangles,
+            zero_area,
+            material,
+        }))
+    }
+}
+
+/// The normal scaled to unit length; zero when it is zero or not finite.
+fn unit(n: [f32; 3]) -> [f32; 3] {
+    let v = glam::Vec3::from(n);
+    let len = v.length();
+    if len > 0.0 && len.is_finite() {
+        (v / len).into()
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Triangles of a strip: triangle i is (v_i, v_{i+1+i%2}, v_{i+2-i%2}) (glTF 2.0 § 3.7.2.1).
+fn strip_triangles(v: &[u32]) -> Vec<[u32; 3]> {
+    (0..v.len().saturating_sub(2))
+        .map(|i| [v[i], v[i + 1 + i % 2], v[i + 2 - i % 2]])
+        .collect()
+}
+
+/// Triangles of a fan: triangle i is (v_{i+1}, v_{i+2}, v_0) (glTF 2.0 § 3.7.2.1).
+fn fan_triangles(v: &[u32]) -> Vec<[u32; 3]> {
+    (0..v.len().saturating_sub(2))
+        .map(|i| [v[i + 1], v[i + 2], v[0]])
+        .collect()
+}
+
+/// Unnormalised face normal in f64: exact zero iff the triangle has zero area (the products of
+/// f32 differences are exact in f64).
+fn face_cross(positions: &[[f32; 3]], t: &[u32; 3]) -> DVec3 {
+    let p = |i: u32| glam::Vec3::from(positions[i as usize]).as_dvec3();
+    let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+    (b - a).cross(c - a)
+}
+
+/// A triangle with a repeated index or exactly zero area in local space.
+fn is_zero_area(positions: &[[f32; 3]], t: &[u32; 3]) -> bool {
+    t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || face_cross(positions, t) == DVec3::ZERO
+}
+
+/// Appends one instance of a primitive for `node`, flipping the winding when `flip`.
+fn instance(
+    geometry: &mut Geometry,
+    data: &PrimitiveData,
+    node: u32,
+    flip: bool,
+) -> Result<(), String> {
+    let base = geometry.vertices.len();
+    let added = match data.normals {
+        Some(_) => data.positions.len(),
+        None => 3 * data.triangles.len(),
+    };
+    if base + added > u32::MAX as usize {
+        return Err("more than 2^32 vertices after expanding instances".to_string());
+    }
+    let vertex = |i: u32, normal: [f32; 3]| Vertex {
+        position: data.positions[i as usize],
+        normal,
+        uv: data.uvs.as_ref().map_or([0.0; 2], |uv| uv[i as usize]),
+        material: data.material,
+        node,
+    };
+    let order = |t: [u32; 3]| if flip { [t[0], t[2], t[1]] } else { t };
+    match &data.normals {
+        Some(normals) => {
+            geometry
+                .vertices
+                .extend((0..data.positions.len() as u32).map(|i| vertex(i, normals[i as usize])));
+            let base = base as u32;
+            geometry.triangles.extend(
+                data.triangles
+                    .iter()
+                    .map(|t| order([t[0] + base, t[1] + base, t[2] + base])),
+            );
+        }
+        None => {
+            for t in &data.triangles {
+                let n = face_cross(&data.positions, t)
+                    .normalize_or_zero()
+                    .as_vec3()
+                    .into();
+                let first = geometry.vertices.len() as u32;
+                geometry.vertices.extend(t.iter().map(|&i| vertex(i, n)));
+                geometry
+                    .triangles
+                    .push(order([first, first + 1, first + 2]));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_alternate_winding_and_fans_pivot() {
+        assert_eq!(
+            strip_triangles(&[0, 1, 2, 3, 4]),
+            vec![[0, 1, 2], [1, 3, 2], [2, 3, 4]]
+        );
+        assert_eq!(fan_triangles(&[0, 1, 2, 3]), vec![[1, 2, 0], [2, 3, 0]]);
+        assert!(strip_triangles(&[0, 1]).is_empty());
+    }
+}
