@@ -17,6 +17,7 @@ pub mod camera;
 pub mod container;
 pub mod geometry;
 pub mod mode;
+pub mod options;
 pub mod recording;
 
 pub use baked::{Baked, DrawIndexedIndirectArgs, FrameWindow, MatrixCell, MergeInfo, MergeStats};
@@ -24,7 +25,12 @@ pub use camera::{world_transforms, Camera, FrameState, NodePose};
 pub use container::{read_file, write_file_atomic, FileKind, FormatError, FORMAT_VERSION};
 pub use geometry::{AlphaMode, Geometry, Material, Node, Texture, Vertex};
 pub use mode::{Mode, ParseModeError};
-pub use recording::{DeviceInfo, Edge, FrameRecord, Phase, RecordSettings, Recording};
+pub use options::{
+    Bridge, Choice, Choosable, Layout, OptionValue, ParseOptionError, Seeding, Strategy,
+};
+pub use recording::{
+    DeviceInfo, Edge, FrameRecord, Phase, RecordSettings, Recording, SettingsError,
+};
 
 /// The version of the trisort tool that wrote a file (stored in every file).
 pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -16,7 +16,8 @@ pub struct RecordSettings {
     pub height: u32,
     /// MSAA sample count (1 or 4; 4 uses the standard sample positions).
     pub samples: u32,
-    /// Accumulated opacity at which a sample counts as saturated (default 0.998).
+    /// Accumulated opacity at which a sample counts as saturated (default
+    /// [`RecordSettings::DEFAULT_SATURATION`]).
     pub saturation: f32,
     /// Opacity at which transmissive glass is recorded (default 0: see-through).
     pub glass_opacity: f32,
@@ -24,17 +25,85 @@ pub struct RecordSettings {
     pub max_layers: u32,
 }
 
+impl RecordSettings {
+    /// The default size (width, height): `record --size 512x512`.
+    pub const DEFAULT_SIZE: (u32, u32) = (512, 512);
+    /// The default MSAA sample count.
+    pub const DEFAULT_SAMPLES: u32 = 4;
+    /// The default saturation threshold.
+    pub const DEFAULT_SATURATION: f32 = 0.998;
+    /// The default glass opacity (see-through).
+    pub const DEFAULT_GLASS_OPACITY: f32 = 0.0;
+    /// The default bound on peel layers per frame.
+    pub const DEFAULT_MAX_LAYERS: u32 = 256;
+    /// The largest width or height [`RecordSettings::validate`] accepts.
+    pub const MAX_SIDE: u32 = 16384;
+
+    /// The settings at `size` (width, height) and `samples`, every other setting at its
+    /// default.
+    pub fn new(size: (u32, u32), samples: u32) -> RecordSettings {
+        RecordSettings {
+            width: size.0,
+            height: size.1,
+            samples,
+            ..RecordSettings::default()
+        }
+    }
+
+    /// Checks that the settings can be recorded: size 1..=[`RecordSettings::MAX_SIDE`], 1 or
+    /// 4 samples, saturation in (0, 1], glass opacity in [0, 1], at least one layer.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        let s = self;
+        if s.width == 0 || s.height == 0 || s.width > Self::MAX_SIDE || s.height > Self::MAX_SIDE {
+            return Err(SettingsError::Size(s.width, s.height));
+        }
+        if s.samples != 1 && s.samples != 4 {
+            return Err(SettingsError::Samples(s.samples));
+        }
+        if !(s.saturation > 0.0 && s.saturation <= 1.0) {
+            return Err(SettingsError::Saturation(s.saturation));
+        }
+        if !(0.0..=1.0).contains(&s.glass_opacity) {
+            return Err(SettingsError::GlassOpacity(s.glass_opacity));
+        }
+        if s.max_layers == 0 {
+            return Err(SettingsError::MaxLayers);
+        }
+        Ok(())
+    }
+}
+
 impl Default for RecordSettings {
     fn default() -> Self {
         RecordSettings {
-            width: 512,
-            height: 512,
-            samples: 4,
-            saturation: 0.998,
-            glass_opacity: 0.0,
-            max_layers: 256,
+            width: Self::DEFAULT_SIZE.0,
+            height: Self::DEFAULT_SIZE.1,
+            samples: Self::DEFAULT_SAMPLES,
+            saturation: Self::DEFAULT_SATURATION,
+            glass_opacity: Self::DEFAULT_GLASS_OPACITY,
+            max_layers: Self::DEFAULT_MAX_LAYERS,
         }
     }
+}
+
+/// Recording settings that cannot be recorded ([`RecordSettings::validate`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SettingsError {
+    /// A side is 0 or above [`RecordSettings::MAX_SIDE`].
+    #[error("size {0}x{1} is out of range (1..{max})", max = RecordSettings::MAX_SIDE)]
+    Size(u32, u32),
+    /// Not 1 or 4 samples.
+    #[error("{0} samples: only 1 and 4 are supported")]
+    Samples(u32),
+    /// Saturation outside (0, 1].
+    #[error("saturation {0} must be in (0, 1]")]
+    Saturation(f32),
+    /// Glass opacity outside [0, 1].
+    #[error("glass opacity {0} must be in [0, 1]")]
+    GlassOpacity(f32),
+    /// No layer allowed.
+    #[error("max layers must be at least 1")]
+    MaxLayers,
 }
 
 /// The device a recording was made on.
