@@ -5,17 +5,16 @@
 //! message naming the file and the problem, no panic, and no file left behind: no output, no temporary file, no
 //! partial folder.
 
-mod support;
-
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
-use support::*;
 use trisort_format::container::{encode, FileKind};
 use trisort_format::{Baked, DeviceInfo, Phase, RecordSettings, Recording};
 use trisort_merger::synth::{split_frames, turntable, Turntable};
 use trisort_merger::{merge, MergeOptions};
+
+use crate::support::*;
 
 /// Every file under `dir`, relative, recursively.
 fn files(dir: &Path) -> BTreeSet<PathBuf> {

@@ -1,9 +1,7 @@
 //! End to end through the real binary: bake → verify → play on the demo car and CarConcept,
 //! and `trisort demo` with `--export-scene`.
 
-mod support;
-
-use support::*;
+use crate::support::*;
 
 fn pngs(dir: &std::path::Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
@@ -20,21 +18,9 @@ fn demo_car_bakes_verifies_and_plays() {
     let Some(dir) = gpu_tempdir() else {
         return;
     };
-    let v = run_json(
-        dir.path(),
-        &[
-            "bake",
-            "demo:10000",
-            "--path",
-            "orbit:frames=6,degrees=120",
-            "--size",
-            "96x96",
-            "--samples",
-            "4",
-            "-o",
-            "car.baked",
-        ],
-    );
+    let bake =
+        "bake demo:10000 --path orbit:frames=6,degrees=120 --size 96x96 --samples 4 -o car.baked";
+    let v = run_json(dir.path(), &args(bake));
     for key in [
         "frames",
         "unique_visible",
@@ -90,22 +76,14 @@ fn car_concept_bakes_and_plays_a_few_frames() {
     let Some(dir) = gpu_tempdir() else {
         return;
     };
-    run(
-        dir.path(),
-        &[
-            "bake",
-            &car,
-            "--path",
-            "orbit:frames=4,degrees=40",
-            "--size",
-            "128x128",
-            "--samples",
-            "4",
-            "-o",
-            "car.baked",
-        ],
-        true,
+    let bake = bake_args(
+        &car,
+        "orbit:frames=4,degrees=40",
+        "128x128",
+        "4",
+        "car.baked",
     );
+    run(dir.path(), &bake, true);
     run(
         dir.path(),
         &["verify", "car.baked", "--recording", "car.baked.rec"],
@@ -113,20 +91,8 @@ fn car_concept_bakes_and_plays_a_few_frames() {
     );
     for mode in ["blend", "depth", "saturate"] {
         let out = format!("frames-{mode}");
-        run(
-            dir.path(),
-            &[
-                "play",
-                "car.baked",
-                "--mode",
-                mode,
-                "--frames",
-                "1..3",
-                "--out-dir",
-                &out,
-            ],
-            true,
-        );
+        let play = format!("play car.baked --mode {mode} --frames 1..3 --out-dir {out}");
+        run(dir.path(), &args(&play), true);
         assert_eq!(
             pngs(&dir.path().join(&out)),
             vec!["frame-00001.png", "frame-00002.png"]
@@ -149,21 +115,8 @@ fn demo_exports_a_scene_that_imports_back_with_the_same_triangles() {
     let Some(dir) = gpu_tempdir() else {
         return;
     };
-    let out = run(
-        dir.path(),
-        &[
-            "demo",
-            "--triangles",
-            "10000",
-            "--size",
-            "64x64",
-            "--out-dir",
-            "out",
-            "--export-scene",
-            "car.glb",
-        ],
-        true,
-    );
+    let demo = "demo --triangles 10000 --size 64x64 --out-dir out --export-scene car.glb";
+    let out = run(dir.path(), &args(demo), true);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("index triangles")

@@ -2,11 +2,9 @@
 //! glass (where the default pipeline's unsorted transparency is visibly wrong), its JSON
 //! contract (DESIGN § CLI contract), its files, the reuse of its bakes, and its errors.
 
-mod support;
-
 use std::path::Path;
 
-use support::*;
+use crate::support::*;
 
 const PATH: &str = "orbit:frames=4,degrees=90,elevation=20,distance=6";
 
@@ -28,27 +26,12 @@ fn bench_table_on_the_demo_car() {
     let Some(dir) = gpu_tempdir() else {
         return;
     };
+    let bench = format!(
+        "bench demo:10000 --path {PATH} --size 64x64 --samples 4,1 \
+         --mode blend,depth,saturate --repeats 2 --glass-opacity 0.5 --out bench"
+    );
+    let v = run_json(dir.path(), &args(&bench));
     let out = dir.path().join("bench");
-    let out_s = out.display().to_string();
-    let args = [
-        "bench",
-        "demo:10000",
-        "--path",
-        PATH,
-        "--size",
-        "64x64",
-        "--samples",
-        "4,1",
-        "--mode",
-        "blend,depth,saturate",
-        "--repeats",
-        "2",
-        "--glass-opacity",
-        "0.5",
-        "--out",
-        &out_s,
-    ];
-    let v = run_json(dir.path(), &args);
 
     // The contract's keys, for every method, at the headline group (4×, blend).
     assert!(v["device"].as_str().is_some_and(|d| !d.is_empty()));
@@ -158,7 +141,7 @@ fn bench_table_on_the_demo_car() {
     no_temp_files(&out);
 
     // A second run reuses both bakes.
-    let again = run(dir.path(), &args[..args.len()], true);
+    let again = run(dir.path(), &args(&bench), true);
     let stderr = String::from_utf8_lossy(&again.stderr);
     assert_eq!(stderr.matches("reusing").count(), 2, "{stderr}");
 }
@@ -180,18 +163,8 @@ fn bench_rejects_bad_options() {
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--samples takes 1 and/or 4"), "{err}");
-    let out = run(
-        dir.path(),
-        &[
-            "bench",
-            "demo:10000",
-            "--path",
-            PATH,
-            "--methods",
-            "zbuffer",
-        ],
-        false,
-    );
+    let methods = format!("bench demo:10000 --path {PATH} --methods zbuffer");
+    let out = run(dir.path(), &args(&methods), false);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown method `zbuffer`"));
     let out = run(dir.path(), &["bench", "nowhere.glb", "--path", PATH], false);
@@ -204,28 +177,12 @@ fn bench_sweep_through_the_cli() {
     let Some(dir) = gpu_tempdir() else {
         return;
     };
-    let out = dir.path().join("sweep");
-    let out_s = out.display().to_string();
-    let v = run_json(
-        dir.path(),
-        &[
-            "bench",
-            "demo:10000",
-            "--path",
-            PATH,
-            "--size",
-            "48x48",
-            "--samples",
-            "4",
-            "--max-frames",
-            "2",
-            "--sweep",
-            "--sweep-factors",
-            "bridge,segment",
-            "--out",
-            &out_s,
-        ],
+    let sweep = format!(
+        "bench demo:10000 --path {PATH} --size 48x48 --samples 4 --max-frames 2 \
+         --sweep --sweep-factors bridge,segment --out sweep"
     );
+    let v = run_json(dir.path(), &args(&sweep));
+    let out = dir.path().join("sweep");
     let points = v["points"].as_array().expect("points");
     let factors: std::collections::BTreeSet<&str> = points
         .iter()
@@ -248,22 +205,9 @@ fn bench_scaling_through_the_cli() {
     let Some(dir) = gpu_tempdir() else {
         return;
     };
+    let scaling = "bench demo --path demo --scaling frames --quick --out scaling";
+    let v = run_json(dir.path(), &args(scaling));
     let out = dir.path().join("scaling");
-    let out_s = out.display().to_string();
-    let v = run_json(
-        dir.path(),
-        &[
-            "bench",
-            "demo",
-            "--path",
-            "demo",
-            "--scaling",
-            "frames",
-            "--quick",
-            "--out",
-            &out_s,
-        ],
-    );
     assert_eq!(v["axis"], "frames");
     let rows = v["rows"].as_array().expect("rows");
     assert!(rows.len() >= 3, "{v}");
@@ -284,29 +228,10 @@ fn bench_leaves_out_a_rival_the_device_cannot_run() {
     let Some(dir) = gpu_tempdir() else {
         return;
     };
-    let out_s = dir.path().join("big").display().to_string();
-    let v = run_json(
-        dir.path(),
-        &[
-            "bench",
-            "demo:10000",
-            "--path",
-            "orbit:frames=1,degrees=0,elevation=20,distance=6",
-            "--size",
-            "1100x1100",
-            "--samples",
-            "4",
-            "--mode",
-            "blend",
-            "--methods",
-            "merged,oit",
-            "--repeats",
-            "1",
-            "--no-unvalidated",
-            "--out",
-            &out_s,
-        ],
-    );
+    let big = "bench demo:10000 --path orbit:frames=1,degrees=0,elevation=20,distance=6 \
+               --size 1100x1100 --samples 4 --mode blend --methods merged,oit --repeats 1 \
+               --no-unvalidated --out big";
+    let v = run_json(dir.path(), &args(big));
     let g = &v["groups"][0];
     let limit = g["skipped"].as_array().expect("skipped");
     if limit.is_empty() {

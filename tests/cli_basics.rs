@@ -1,8 +1,6 @@
 //! The CLI's contract: subcommands, scene inspection counts, clear errors.
 
-mod support;
-
-use support::*;
+use crate::support::*;
 
 #[test]
 fn help_lists_every_subcommand() {

@@ -11,38 +11,23 @@
 //! message) the way the kill below does — frames already stored in `OUT.partial/` stay, as
 //! the kill test shows, and a rerun resumes from them.
 
-mod support;
-
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use support::*;
+use crate::support::*;
 
 const SCENE: &str = "demo:200000";
 const PATH: &str = "orbit:frames=8,elevation=15";
 
-fn bake_args(out: &str) -> Vec<String> {
-    [
-        "bake",
-        SCENE,
-        "--path",
-        PATH,
-        "--size",
-        "64x64",
-        "--samples",
-        "4",
-        "-o",
-        out,
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect()
+/// The bake every test here runs, writing `out`.
+fn bake(out: &str) -> Vec<&str> {
+    bake_args(SCENE, PATH, "64x64", "4", out)
 }
 
 fn run_bake(dir: &Path, out: &str, threads: &str) -> std::process::Output {
     let out = trisort(dir)
         .env("RAYON_NUM_THREADS", threads)
-        .args(bake_args(out))
+        .args(bake(out))
         .output()
         .unwrap();
     assert!(
@@ -84,7 +69,7 @@ fn an_interrupted_bake_resumes_to_identical_bytes() {
     let d = dir.path();
     run_bake(d, "clean.baked", "2");
     let mut child = trisort(d)
-        .args(bake_args("resumed.baked"))
+        .args(bake("resumed.baked"))
         .stderr(std::process::Stdio::null())
         .stdout(std::process::Stdio::null())
         .spawn()
@@ -114,10 +99,7 @@ fn an_interrupted_bake_resumes_to_identical_bytes() {
             }
         }
     }
-    let out = trisort(d)
-        .args(bake_args("resumed.baked"))
-        .output()
-        .unwrap();
+    let out = trisort(d).args(bake("resumed.baked")).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(!err.contains("panicked"), "{err}");

@@ -4,11 +4,10 @@
 //! `trisort merge --segment 100`, and checked by `trisort verify`. Structural bounds are
 //! asserted; time and memory are measured in BENCHMARKS.md § Long paths, never here.
 
-mod support;
-
-use support::*;
 use trisort_format::{Baked, FileKind};
 use trisort_merger::synth::{split_frames, turntable, Turntable};
+
+use crate::support::*;
 
 const FRAMES: u32 = 10_000;
 

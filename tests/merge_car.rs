@@ -2,13 +2,12 @@
 //! CarConcept, 12 frames of an orbit at 128×128, merged with every strategy × layout, each
 //! checked by the independent validator; the matrix picture of a baked file.
 
-mod support;
-
 use std::path::Path;
 
-use support::*;
 use trisort_format::{Baked, FileKind, Recording};
 use trisort_merger::{LayoutChoice, MergeOptions, StrategyChoice};
+
+use crate::support::*;
 
 const STRATEGIES: [StrategyChoice; 6] = [
     StrategyChoice::Lib,

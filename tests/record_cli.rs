@@ -1,12 +1,11 @@
 //! `trisort record` through the real binary on real scenes: CarConcept's interior through the
 //! glass, kill-and-resume byte identity, determinism.
 
-mod support;
-
 use std::time::{Duration, Instant};
 
-use support::*;
 use trisort_format::{FileKind, Recording};
+
+use crate::support::*;
 
 fn read(path: &std::path::Path) -> Recording {
     trisort_format::read_file(FileKind::Recording, path).unwrap()

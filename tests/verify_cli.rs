@@ -3,10 +3,9 @@
 //! the off-pattern measure with `--max-error`, and the mutation check (a file whose order was
 //! corrupted on purpose fails with exit code 3).
 
-mod support;
-
-use support::*;
 use trisort_format::{Baked, FileKind, Recording};
+
+use crate::support::*;
 
 const SCENE: &str = "demo:10000";
 
@@ -14,22 +13,10 @@ const SCENE: &str = "demo:10000";
 /// (recording beside it), or `None` to skip the test where there is no GPU.
 fn baked_car() -> Option<tempfile::TempDir> {
     let dir = gpu_tempdir()?;
-    run(
-        dir.path(),
-        &[
-            "bake",
-            SCENE,
-            "--path",
-            "orbit:frames=2,degrees=40",
-            "--size",
-            "64x64",
-            "--samples",
-            "4",
-            "-o",
-            "car.baked",
-        ],
-        true,
+    let bake = format!(
+        "bake {SCENE} --path orbit:frames=2,degrees=40 --size 64x64 --samples 4 -o car.baked"
     );
+    run(dir.path(), &args(&bake), true);
     Some(dir)
 }
 
@@ -38,22 +25,11 @@ fn verify_reports_contract_keys_and_writes_difference_images() {
     let Some(dir) = baked_car() else {
         return;
     };
-    let v = run_json(
-        dir.path(),
-        &[
-            "verify",
-            "car.baked",
-            "--recording",
-            "car.baked.rec",
-            "--scene",
-            SCENE,
-            "--diff-dir",
-            "diff",
-            "--diff-all",
-            "--frames",
-            "1..2",
-        ],
+    let verify = format!(
+        "verify car.baked --recording car.baked.rec --scene {SCENE} \
+         --diff-dir diff --diff-all --frames 1..2"
     );
+    let v = run_json(dir.path(), &args(&verify));
     assert_eq!(v["ok"], true, "{v}");
     assert_eq!(v["at_recorded_pattern"], true);
     let frames = v["frames"].as_array().unwrap();
@@ -172,21 +148,8 @@ fn corrupted_order_fails_verification() {
     baked.copies.swap(pa, pb);
     trisort_format::write_file_atomic(FileKind::Baked, &path, &baked).unwrap();
 
-    let out = run(
-        dir.path(),
-        &[
-            "verify",
-            "car.baked",
-            "--scene",
-            SCENE,
-            "--frames",
-            "0..1",
-            "--diff-dir",
-            "diff",
-            "--json",
-        ],
-        false,
-    );
+    let verify = format!("verify car.baked --scene {SCENE} --frames 0..1 --diff-dir diff --json");
+    let out = run(dir.path(), &args(&verify), false);
     assert_eq!(out.status.code(), Some(3));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["ok"], false);

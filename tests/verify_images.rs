@@ -16,6 +16,21 @@ use trisort_testkit::gpu;
 
 // ---- scenes built here: camera at the origin looking down −Z ----
 
+/// Linear base colours shared by the scenes below.
+const RED: [f32; 3] = [0.9, 0.1, 0.1];
+const GREEN: [f32; 3] = [0.1, 0.9, 0.1];
+const BLUE: [f32; 3] = [0.1, 0.1, 0.9];
+
+/// A scene of [`quad`]s: flat colours as (linear rgb, alpha) ([`material`]), then each quad as
+/// `[x0, x1, y0, y1, z0, z1]` with the index of its material; quad k gets triangles 2k, 2k + 1.
+fn quads(materials: &[([f32; 3], f32)], quads: &[([f32; 6], u32)]) -> Geometry {
+    let mut g = scene(materials.iter().map(|&(rgb, a)| material(rgb, a)).collect());
+    for &([x0, x1, y0, y1, z0, z1], m) in quads {
+        quad(&mut g, x0, x1, y0, y1, z0, z1, m);
+    }
+    g
+}
+
 // ---- bake and verify through the libraries ----
 
 fn bake(
@@ -95,19 +110,23 @@ fn verify_all_modes(
 #[test]
 fn stacked_transparent_quads_verify_in_every_mode() {
     let Some(gpu) = gpu() else { return };
-    let mut g = scene(vec![
-        material([0.9, 0.1, 0.1], 0.5),
-        material([0.1, 0.9, 0.1], 0.6),
-        material([0.1, 0.1, 0.9], 0.4),
-        material([0.9, 0.9, 0.2], 0.7),
-        material([0.8, 0.8, 0.8], 1.0),
-    ]);
     // Ids chosen so that id order is not depth order: the back quad first.
-    quad(&mut g, -1.0, 1.0, -1.0, 1.0, -6.0, -6.0, 4);
-    quad(&mut g, -0.6, 0.3, -0.5, 0.6, -2.0, -2.0, 0);
-    quad(&mut g, -0.3, 0.7, -0.7, 0.3, -4.0, -4.0, 1);
-    quad(&mut g, -0.8, 0.1, -0.2, 0.8, -3.0, -3.0, 2);
-    quad(&mut g, -0.1, 0.9, -0.9, 0.1, -5.0, -5.0, 3);
+    let g = quads(
+        &[
+            (RED, 0.5),
+            (GREEN, 0.6),
+            (BLUE, 0.4),
+            ([0.9, 0.9, 0.2], 0.7),
+            ([0.8; 3], 1.0),
+        ],
+        &[
+            ([-1.0, 1.0, -1.0, 1.0, -6.0, -6.0], 4),
+            ([-0.6, 0.3, -0.5, 0.6, -2.0, -2.0], 0),
+            ([-0.3, 0.7, -0.7, 0.3, -4.0, -4.0], 1),
+            ([-0.8, 0.1, -0.2, 0.8, -3.0, -3.0], 2),
+            ([-0.1, 0.9, -0.9, 0.1, -5.0, -5.0], 3),
+        ],
+    );
     let frames = [frame_at(DVec3::ZERO), frame_at(DVec3::new(0.3, 0.1, 0.0))];
     let (_, baked) = bake(&gpu, &g, &frames, settings(64, 4));
     let reports = verify_all_modes(&gpu, "stacked quads", &baked, &g);
@@ -139,16 +158,16 @@ fn reference_config(mode: Mode) -> trisort_reference::ReferenceConfig {
 #[test]
 fn depth_reference_equals_the_plain_z_buffer_on_opaque_scenes() {
     let Some(gpu) = gpu() else { return };
-    let mut g = scene(vec![
-        material([0.9, 0.1, 0.1], 1.0),
-        material([0.1, 0.9, 0.1], 1.0),
-        material([0.1, 0.1, 0.9], 1.0),
-    ]);
     // Far ones first in id order, a coplanar pair (tie), and a tilted quad through another.
-    quad(&mut g, -1.0, 1.0, -1.0, 1.0, -6.0, -6.0, 0);
-    quad(&mut g, -0.6, 0.5, -0.5, 0.6, -3.0, -3.0, 1);
-    quad(&mut g, -0.2, 0.8, -0.7, 0.3, -3.0, -3.0, 2);
-    quad(&mut g, -0.9, 0.9, -0.4, 0.4, -2.0, -4.5, 0);
+    let g = quads(
+        &[(RED, 1.0), (GREEN, 1.0), (BLUE, 1.0)],
+        &[
+            ([-1.0, 1.0, -1.0, 1.0, -6.0, -6.0], 0),
+            ([-0.6, 0.5, -0.5, 0.6, -3.0, -3.0], 1),
+            ([-0.2, 0.8, -0.7, 0.3, -3.0, -3.0], 2),
+            ([-0.9, 0.9, -0.4, 0.4, -2.0, -4.5], 0),
+        ],
+    );
     let frames = [frame_at(DVec3::ZERO), frame_at(DVec3::new(0.2, -0.1, 0.3))];
     let s = settings(64, 4);
     let zbuffer = trisort_reference::exact::whole_scene_baked(&g, &frames, s);
@@ -170,15 +189,19 @@ fn depth_reference_equals_the_plain_z_buffer_on_opaque_scenes() {
 #[test]
 fn coplanar_quads_verify_in_every_mode() {
     let Some(gpu) = gpu() else { return };
-    let mut g = scene(vec![
-        material([0.9, 0.2, 0.1], 0.5),
-        material([0.1, 0.3, 0.9], 0.5),
-        material([0.2, 0.9, 0.2], 1.0),
-    ]);
     // Two overlapping quads in one plane (ties broken by id), a third behind.
-    quad(&mut g, -0.7, 0.4, -0.6, 0.5, -2.0, -2.0, 0);
-    quad(&mut g, -0.3, 0.8, -0.4, 0.7, -2.0, -2.0, 1);
-    quad(&mut g, -1.0, 1.0, -1.0, 1.0, -4.0, -4.0, 2);
+    let g = quads(
+        &[
+            ([0.9, 0.2, 0.1], 0.5),
+            ([0.1, 0.3, 0.9], 0.5),
+            ([0.2, 0.9, 0.2], 1.0),
+        ],
+        &[
+            ([-0.7, 0.4, -0.6, 0.5, -2.0, -2.0], 0),
+            ([-0.3, 0.8, -0.4, 0.7, -2.0, -2.0], 1),
+            ([-1.0, 1.0, -1.0, 1.0, -4.0, -4.0], 2),
+        ],
+    );
     let frames = [frame_at(DVec3::ZERO), frame_at(DVec3::new(-0.2, 0.1, 0.5))];
     let (rec, baked) = bake(&gpu, &g, &frames, settings(64, 4));
     assert!(
@@ -191,13 +214,14 @@ fn coplanar_quads_verify_in_every_mode() {
 #[test]
 fn interpenetrating_pair_differs_only_on_unordered_pixels() {
     let Some(gpu) = gpu() else { return };
-    let mut g = scene(vec![
-        material([0.9, 0.1, 0.1], 0.5),
-        material([0.1, 0.2, 0.9], 0.5),
-    ]);
     // A flat quad and a tilted one passing through it: each is in front on one side.
-    quad(&mut g, -0.8, 0.8, -0.8, 0.8, -3.0, -3.0, 0);
-    quad(&mut g, -0.8, 0.8, -0.6, 0.6, -2.0, -4.0, 1);
+    let g = quads(
+        &[(RED, 0.5), ([0.1, 0.2, 0.9], 0.5)],
+        &[
+            ([-0.8, 0.8, -0.8, 0.8, -3.0, -3.0], 0),
+            ([-0.8, 0.8, -0.6, 0.6, -2.0, -4.0], 1),
+        ],
+    );
     let frames = [frame_at(DVec3::ZERO)];
     let (_, baked) = bake(&gpu, &g, &frames, settings(64, 4));
     assert!(
@@ -315,26 +339,15 @@ fn default_pipeline_is_exact_only_when_id_order_is_back_to_front() {
         let r = reference.render(0, None).expect("reference frame");
         trisort_reference::compare(&d, &r.rgba8, 64, 64, &[])
     };
-    let materials = || {
-        vec![
-            material([0.9, 0.1, 0.1], 0.5),
-            material([0.1, 0.2, 0.9], 0.5),
-            material([0.7, 0.7, 0.7], 1.0),
-        ]
-    };
+    let materials = [(RED, 0.5), ([0.1, 0.2, 0.9], 0.5), ([0.7; 3], 1.0)];
+    let wall = ([-1.0, 1.0, -1.0, 1.0, -6.0, -6.0], 2);
+    let far = ([-0.6, 0.4, -0.6, 0.4, -4.0, -4.0], 1);
+    let near = ([-0.4, 0.6, -0.4, 0.6, -2.0, -2.0], 0);
     // Ids back to front: opaque wall, then the far transparent quad, then the near one.
-    let mut sorted = scene(materials());
-    quad(&mut sorted, -1.0, 1.0, -1.0, 1.0, -6.0, -6.0, 2);
-    quad(&mut sorted, -0.6, 0.4, -0.6, 0.4, -4.0, -4.0, 1);
-    quad(&mut sorted, -0.4, 0.6, -0.4, 0.6, -2.0, -2.0, 0);
-    let c = render(&sorted);
+    let c = render(&quads(&materials, &[wall, far, near]));
     assert_eq!(c.pixels_differing, 0, "{c:?}");
     // The same quads with the transparent ones in front-to-back id order.
-    let mut unsorted = scene(materials());
-    quad(&mut unsorted, -1.0, 1.0, -1.0, 1.0, -6.0, -6.0, 2);
-    quad(&mut unsorted, -0.4, 0.6, -0.4, 0.6, -2.0, -2.0, 0);
-    quad(&mut unsorted, -0.6, 0.4, -0.6, 0.4, -4.0, -4.0, 1);
-    let c = render(&unsorted);
+    let c = render(&quads(&materials, &[wall, near, far]));
     // The overlap of the two transparent quads (about 8 × 10 pixels) is wrong.
     assert!(c.pixels_differing >= 60 && c.max_channel_diff > 10, "{c:?}");
     assert!(c.psnr < 45.0 && c.flip_mean > 0.0, "{c:?}");

@@ -3,14 +3,12 @@
 //! until `--window-frames` frames were presented; where `xwd` is installed too
 //! (`apt-get install x11-apps`), screenshots of the window equal the PNG of the same frame.
 
-mod support;
-
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
-use support::*;
+use crate::support::*;
 
 /// `xvfb-run` on a display number of its own (`-a` could pick the number of a server that an
 /// earlier `xvfb-run` killed without waiting for it), with `-noreset`: by default the X server

@@ -1,8 +1,6 @@
 //! Harness for tests that run the real `trisort` binary: a temp directory per test and, on
 //! failure, the command, its directory and its stderr.
 
-#![allow(dead_code)]
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -37,6 +35,36 @@ pub fn run(dir: &Path, args: &[&str], expect_success: bool) -> Output {
         );
     }
     out
+}
+
+/// The arguments of a command line written as one string, split at whitespace:
+/// `args("play car.baked --frames 0..1")`. For literal arguments; pass paths, which may hold
+/// spaces, as arguments of their own.
+pub fn args(line: &str) -> Vec<&str> {
+    line.split_whitespace().collect()
+}
+
+/// The arguments of `trisort bake SCENE --path PATH --size SIZE --samples SAMPLES -o OUT`, in
+/// that order; add options after them.
+pub fn bake_args<'a>(
+    scene: &'a str,
+    path: &'a str,
+    size: &'a str,
+    samples: &'a str,
+    out: &'a str,
+) -> Vec<&'a str> {
+    vec![
+        "bake",
+        scene,
+        "--path",
+        path,
+        "--size",
+        size,
+        "--samples",
+        samples,
+        "-o",
+        out,
+    ]
 }
 
 /// Runs with `--json` appended and parses stdout.

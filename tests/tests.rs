@@ -1,0 +1,19 @@
+//! trisort's integration tests: one test binary (as in ripgrep's `tests/tests.rs`), one module
+//! per subject, all sharing the [`support`] harness. Most run the real `trisort` binary on real
+//! scenes; `verify_images` drives the libraries directly. Run one subject with
+//! `cargo test --test tests -- <module>::`.
+
+mod support;
+
+mod bad_input;
+mod bake_play_cli;
+mod bench_cli;
+mod cli_basics;
+mod extremes;
+mod extremes_no_lost_work;
+mod long_paths;
+mod merge_car;
+mod record_cli;
+mod verify_cli;
+mod verify_images;
+mod window_cli;
