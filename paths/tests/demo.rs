@@ -1,13 +1,12 @@
 //! The demo car's default path: an orbit while the driver door opens outward and closes.
 
-mod common;
-
-use common::{eye_forward, node, scene_with_boxes};
 use glam::{DMat4, DVec3, Vec3};
 use trisort_format::world_transforms;
 use trisort_paths::{demo_default, Timeline};
 use trisort_scene::demo_car::{demo_car, DOOR_NODE};
 use trisort_scene::Scene;
+
+use crate::common::{eye_forward, node, scene_with_boxes};
 
 /// World-space centroid of the vertices of `node` at a frame.
 fn centroid(scene: &Scene, t: &Timeline, f: usize, node: u32) -> DVec3 {
@@ -91,7 +90,7 @@ fn hand_built_doors_on_either_side_open_outward() {
 
 #[test]
 fn without_a_door_just_an_orbit() {
-    let scene = common::box_scene();
+    let scene = crate::common::box_scene();
     let t = demo_default(&scene);
     assert_eq!(t.frames.len(), 48);
     assert!(t.frames.iter().all(|s| s.poses.is_empty()));

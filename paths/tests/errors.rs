@@ -1,10 +1,9 @@
 //! Every bad input gets its error, located, and nothing panics.
 
-mod common;
-
-use common::{box_scene, load_toml, problem};
 use trisort_paths::{load, PathError, PathOptions, Problem};
 use trisort_scene::Scene;
+
+use crate::common::{box_scene, load_toml, problem};
 
 /// A valid camera section to append keys after.
 const GOOD_KEY: &str = "[[camera.key]]\nframe = 0\neye = [0, 1, 8]\ntarget = [0, 0.5, 0]\n";
@@ -241,8 +240,8 @@ fn eye_at_target() {
     );
     assert_eq!((p, line), (Problem::EyeAtTarget { frame: 5 }, None));
     // A dolly through the centre of a cube around the origin.
-    let cube = common::scene_with_boxes(
-        vec![common::node("Cube", None, glam::DMat4::IDENTITY)],
+    let cube = crate::common::scene_with_boxes(
+        vec![crate::common::node("Cube", None, glam::DMat4::IDENTITY)],
         &[(0, glam::DVec3::splat(-1.0), glam::DVec3::splat(1.0))],
     );
     let spec = "dolly:from=0;0;5,to=0;0;-5,frames=3";

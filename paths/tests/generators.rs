@@ -1,11 +1,10 @@
 //! `orbit:` and `dolly:` around a hand-built scene.
 
-mod common;
-
-use common::{eye_forward, node, scene_with_boxes};
 use glam::{DMat4, DVec3};
 use trisort_paths::{load, PathOptions, Timeline};
 use trisort_scene::Scene;
+
+use crate::common::{eye_forward, node, scene_with_boxes};
 
 /// A 4 × 2 × 6 box centred at (10, 1, −3): radius √14.
 fn offset_box() -> Scene {

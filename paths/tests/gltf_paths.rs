@@ -1,12 +1,11 @@
 //! The `gltf` path on hand-built scenes: channel composition with the rest pose, the three
 //! interpolation modes, animated cameras, the fallbacks without animation or camera, errors.
 
-mod common;
-
-use common::{box_scene, eye_forward, problem};
 use glam::{DMat4, DQuat, DVec3};
 use trisort_paths::{load, PathOptions, Problem, Timeline};
 use trisort_scene::{Animation, Channel, Interpolation, Property, Scene, SceneCamera};
+
+use crate::common::{box_scene, eye_forward, problem};
 
 fn quat_values(qs: &[DQuat]) -> Vec<f32> {
     qs.iter()
@@ -126,7 +125,7 @@ fn animated_camera_node_views_through_its_world_transform() {
     // Camera on node 3, a child of the Lid; the Lid is translated by an animation and the
     // camera node carries a scale that must not reach the view.
     let mut scene = box_scene();
-    scene.geometry.nodes.push(common::node(
+    scene.geometry.nodes.push(crate::common::node(
         "Cam",
         Some(1),
         DMat4::from_scale_rotation_translation(

@@ -2,16 +2,15 @@
 //! tour over CarConcept. Each test skips (printing why) when its scene is missing, unless
 //! `TRISORT_REQUIRE_SCENES=1`.
 
-mod common;
-
 use std::path::Path;
 
-use common::eye_forward;
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use trisort_format::world_transforms;
 use trisort_paths::{load, PathOptions, Timeline};
 use trisort_scene::Scene;
 use trisort_testkit::scene_path;
+
+use crate::common::eye_forward;
 
 fn import(rel: &str) -> Option<Scene> {
     let path = scene_path(rel)?;

@@ -1,11 +1,10 @@
 //! TOML keyframe paths that load: key values, interpolation modes, pivots, frame counts,
 //! clip planes.
 
-mod common;
-
-use common::{box_scene, eye_forward, load_toml};
 use glam::{DMat4, DVec3};
 use trisort_paths::Timeline;
+
+use crate::common::{box_scene, eye_forward, load_toml};
 
 fn path(mode: &str) -> String {
     format!(

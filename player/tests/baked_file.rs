@@ -1,13 +1,12 @@
 //! The baked file as the player reads it (no GPU): byte-exact round trip, clear errors for
 //! truncated, corrupted, junk and inconsistent files, and the playback warnings.
 
-mod support;
-
 use std::path::Path;
 
-use support::*;
 use trisort_format::{container, Baked, FileKind, FormatError};
 use trisort_player::{open_baked, playback_warnings, Mode, PlayerConfig, PlayerError};
+
+use crate::support::*;
 
 #[test]
 fn a_baked_file_round_trips_byte_for_byte() {

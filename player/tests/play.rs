@@ -2,15 +2,14 @@
 //! `TRISORT_REQUIRE_GPU=1`): the calls a frame issues, the images of each mode, both index
 //! widths, both draw paths, and a pipeline-statistics cross-check.
 
-mod support;
-
-use support::*;
-use trisort_format::DrawIndexedIndirectArgs;
+use trisort_format::{Baked, DrawIndexedIndirectArgs};
 use trisort_gpu::Gpu;
 use trisort_player::{
     Call, CallLog, DrawPath, HeadlessConfig, HeadlessRenderer, Mode, Player, PlayerConfig,
     PlayerError, BACKGROUND,
 };
+
+use crate::support::*;
 
 fn gpu() -> Option<Gpu> {
     std::env::set_var(
@@ -28,6 +27,11 @@ fn config(mode: Mode, draw_path: DrawPath) -> PlayerConfig {
         depth_format: (mode == Mode::Depth).then_some(wgpu::TextureFormat::Depth32Float),
         ..PlayerConfig::recorded(&baked, wgpu::TextureFormat::Rgba8Unorm)
     }
+}
+
+/// A player of `baked` in `mode` along `draw_path` ([`config`]).
+fn player(gpu: &Gpu, baked: &Baked, mode: Mode, draw_path: DrawPath) -> Player {
+    Player::new(&gpu.device, &gpu.queue, baked, config(mode, draw_path)).unwrap()
 }
 
 fn headless(mode: Mode, samples: u32) -> HeadlessConfig {
@@ -71,13 +75,7 @@ fn each_frame_is_exactly_one_multi_draw_over_its_window() {
     let Some(gpu) = gpu() else { return };
     let baked = quads();
     for mode in Mode::ALL {
-        let player = Player::new(
-            &gpu.device,
-            &gpu.queue,
-            &baked,
-            config(mode, DrawPath::MultiDrawIndirect),
-        )
-        .unwrap();
+        let player = player(&gpu, &baked, mode, DrawPath::MultiDrawIndirect);
         for frame in 0..3u32 {
             let mut log = CallLog::default();
             player.draw(&mut log, frame).unwrap();
@@ -133,20 +131,8 @@ fn fallback_draws_the_same_ranges_one_by_one_and_the_same_image() {
     let Some(gpu) = gpu() else { return };
     let baked = quads();
     for mode in Mode::ALL {
-        let multi = Player::new(
-            &gpu.device,
-            &gpu.queue,
-            &baked,
-            config(mode, DrawPath::MultiDrawIndirect),
-        )
-        .unwrap();
-        let direct = Player::new(
-            &gpu.device,
-            &gpu.queue,
-            &baked,
-            config(mode, DrawPath::Direct),
-        )
-        .unwrap();
+        let multi = player(&gpu, &baked, mode, DrawPath::MultiDrawIndirect);
+        let direct = player(&gpu, &baked, mode, DrawPath::Direct);
         for frame in 0..3u32 {
             let mut m = CallLog::default();
             multi.draw(&mut m, frame).unwrap();
@@ -321,13 +307,7 @@ fn u16_and_u32_indices_give_the_same_frames() {
 fn warnings_at_another_size_sample_count_or_device() {
     let Some(gpu) = gpu() else { return };
     let baked = quads();
-    let exact = Player::new(
-        &gpu.device,
-        &gpu.queue,
-        &baked,
-        config(Mode::Blend, DrawPath::MultiDrawIndirect),
-    )
-    .unwrap();
+    let exact = player(&gpu, &baked, Mode::Blend, DrawPath::MultiDrawIndirect);
     assert!(exact.warnings().is_empty(), "{:?}", exact.warnings());
     let resized = PlayerConfig {
         size: (64, 32),
@@ -440,13 +420,7 @@ fn pipeline_statistics_count_exactly_the_windows_triangles() {
     }
     let baked = quads();
     let device = &gpu.device;
-    let player = Player::new(
-        device,
-        &gpu.queue,
-        &baked,
-        config(Mode::Blend, DrawPath::MultiDrawIndirect),
-    )
-    .unwrap();
+    let player = player(&gpu, &baked, Mode::Blend, DrawPath::MultiDrawIndirect);
     let target = device.create_texture(&wgpu::TextureDescriptor {
         label: None,
         size: wgpu::Extent3d {

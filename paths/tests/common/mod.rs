@@ -1,5 +1,4 @@
 //! Hand-built scenes and helpers shared by the integration tests.
-#![allow(dead_code)]
 
 use std::io::Write;
 

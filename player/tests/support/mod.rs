@@ -1,6 +1,5 @@
 //! Baked files built by hand for the player's tests: a few quads at different depths and
 //! colours, three frames with different windows.
-#![allow(dead_code)]
 
 use glam::{DMat4, DVec3};
 use trisort_format::{

@@ -1,0 +1,5 @@
+//! The recorder's integration tests, one binary: known answers on scenes built here
+//! (`known_answers`) and a 5-million-triangle scene (`scale`).
+
+mod known_answers;
+mod scale;
