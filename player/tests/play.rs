@@ -197,24 +197,26 @@ fn blend_composites_back_to_front() {
     for samples in [1, 4] {
         let r = HeadlessRenderer::new(&gpu, &baked, &headless(Mode::Blend, samples)).unwrap();
         let f0 = r.render(0).unwrap().rgba8;
-        assert_close(
-            pixel(&f0, 16, 16),
-            srgb8(over(red, over(green, bg))),
+        assert_pixel(
+            &f0,
+            (16, 16),
+            over(red, over(green, bg)),
             1,
             "red over green",
         );
-        assert_close(pixel(&f0, 6, 25), srgb8(over(red, bg)), 1, "red alone");
-        assert_close(pixel(&f0, 25, 6), srgb8(over(green, bg)), 1, "green alone");
-        assert_close(pixel(&f0, 30, 30), srgb8(bg), 0, "background");
+        assert_pixel(&f0, (6, 25), over(red, bg), 1, "red alone");
+        assert_pixel(&f0, (25, 6), over(green, bg), 1, "green alone");
+        assert_pixel(&f0, (30, 30), bg, 0, "background");
         let f1 = r.render(1).unwrap().rgba8;
         let b = over(blue, bg);
-        assert_close(
-            pixel(&f1, 16, 16),
-            srgb8(over(red, over(green, b))),
+        assert_pixel(
+            &f1,
+            (16, 16),
+            over(red, over(green, b)),
             1,
             "red over green over blue",
         );
-        assert_close(pixel(&f1, 30, 30), srgb8(b), 1, "blue");
+        assert_pixel(&f1, (30, 30), b, 1, "blue");
         // Frame 2 draws the same quads as frame 0 from other ranges.
         assert_eq!(r.render(2).unwrap().rgba8, f0, "{samples}x");
         // Played the wrong way round (green over red) the overlap differs: the test can fail.
@@ -236,21 +238,11 @@ fn depth_mode_keeps_the_front_quad() {
         let r = HeadlessRenderer::new(&gpu, &baked, &headless(Mode::Depth, samples)).unwrap();
         let f0 = r.render(0).unwrap().rgba8;
         // Front to back with depth writes: red is drawn first and hides green where they overlap.
-        assert_close(
-            pixel(&f0, 16, 16),
-            srgb8(over(red, bg)),
-            1,
-            "front quad only",
-        );
-        assert_close(pixel(&f0, 25, 6), srgb8(over(green, bg)), 1, "green alone");
+        assert_pixel(&f0, (16, 16), over(red, bg), 1, "front quad only");
+        assert_pixel(&f0, (25, 6), over(green, bg), 1, "green alone");
         let f1 = r.render(1).unwrap().rgba8;
-        assert_close(
-            pixel(&f1, 16, 16),
-            srgb8(over(red, bg)),
-            1,
-            "front quad hides the rest",
-        );
-        assert_close(pixel(&f1, 30, 30), srgb8(over(blue, bg)), 1, "blue");
+        assert_pixel(&f1, (16, 16), over(red, bg), 1, "front quad hides the rest");
+        assert_pixel(&f1, (30, 30), over(blue, bg), 1, "blue");
     }
 }
 

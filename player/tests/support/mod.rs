@@ -184,6 +184,12 @@ pub fn assert_close(got: [u8; 3], want: [u8; 3], tol: u8, what: &str) {
     assert!(d <= tol, "{what}: got {got:?}, expected {want:?} (±{tol})");
 }
 
+/// Asserts that the pixel at `xy` of an RGBA8 image `SIZE` wide is the linear colour `want`
+/// in 8-bit sRGB ([`srgb8`]), within `tol` per channel.
+pub fn assert_pixel(rgba8: &[u8], (x, y): (u32, u32), want: [f64; 3], tol: u8, what: &str) {
+    assert_close(pixel(rgba8, x, y), srgb8(want), tol, what);
+}
+
 /// A quad in the plane z whose front face looks away from the camera (clockwise as seen from
 /// +Z, normal −Z), uv running 0 → 1 from x0 to x1.
 fn back_quad(g: &mut Geometry, x0: f32, y0: f32, x1: f32, y1: f32, z: f32, material: u32) {
