@@ -3,8 +3,11 @@
 
 use std::ops::Range;
 use std::path::Path;
+use std::sync::OnceLock;
 
 use anyhow::{bail, Context, Result};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use trisort_format::{Choice, Choosable, OptionValue, ParseOptionError, RecordSettings};
 use trisort_scene::Scene;
 
 /// Loads a scene: a `.glb`/`.gltf` file, or `demo` / `demo:TRIANGLES` for the built-in car.
@@ -60,6 +63,44 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("size {s}: each side must be 1..=16384"));
     }
     Ok((w, h))
+}
+
+/// The default recording size as `--size` spells it (`512x512`: [`RecordSettings::DEFAULT_SIZE`]),
+/// for clap's `default_value`.
+pub fn default_size() -> &'static str {
+    static SIZE: OnceLock<String> = OnceLock::new();
+    SIZE.get_or_init(|| {
+        let (w, h) = RecordSettings::DEFAULT_SIZE;
+        format!("{w}x{h}")
+    })
+}
+
+/// The clap value parser of a typed option (`--bridge`, `--seeding`): its names are the
+/// possible values, each with its help line, and the value is the type's own parse of the
+/// name. A name outside the list is a usage error (exit status 2).
+pub fn option_parser<T>() -> impl TypedValueParser<Value = T>
+where
+    T: OptionValue + std::str::FromStr<Err = ParseOptionError>,
+{
+    let values = T::ALL
+        .iter()
+        .map(|v| PossibleValue::new(v.name()).help(v.help()));
+    PossibleValuesParser::new(values).map(|name| parse_listed::<T>(&name))
+}
+
+/// The clap value parser of an option that may be `auto` (`--strategy`, `--layout`): every
+/// value, then `auto`, as for [`option_parser`].
+pub fn choice_parser<T: Choosable>() -> impl TypedValueParser<Value = Choice<T>> {
+    let values = Choice::<T>::all()
+        .into_iter()
+        .map(|c| PossibleValue::new(c.name()).help(c.help()));
+    PossibleValuesParser::new(values).map(|name| parse_listed::<Choice<T>>(&name))
+}
+
+/// Parses a name clap has already checked against the type's own list.
+fn parse_listed<T: std::str::FromStr<Err = ParseOptionError>>(name: &str) -> T {
+    name.parse()
+        .unwrap_or_else(|e| unreachable!("clap accepted an unlisted name: {e}"))
 }
 
 /// Parses a half-open frame range `a..b` (also `a..` and `..b`, and a single frame `a`).

@@ -16,10 +16,10 @@ use std::time::Instant;
 use serde::Serialize;
 use serde_json::json;
 use trisort_format::{Phase, RecordSettings, Recording};
+use trisort_gpu::Gpu;
 use trisort_merger::synth::{split_frames, turntable, Turntable};
 use trisort_merger::MergeOptions;
 use trisort_recorder::{record, RecordJob};
-use trisort_gpu::Gpu;
 
 use crate::plot::{write_svg, Chart, Series, Style};
 use crate::BenchError;
@@ -104,12 +104,7 @@ impl ScalingConfig {
     }
 
     fn settings(&self) -> RecordSettings {
-        RecordSettings {
-            width: self.size.0,
-            height: self.size.1,
-            samples: self.samples,
-            ..RecordSettings::default()
-        }
+        RecordSettings::new(self.size, self.samples)
     }
 }
 
@@ -479,7 +474,11 @@ fn run_real(
         ));
         Ok::<_, BenchError>(row)
     };
-    let mut rows = vec![measure(axis, &MergeOptions::default(), window)?];
+    let whole = MergeOptions {
+        segment: None,
+        ..MergeOptions::default()
+    };
+    let mut rows = vec![measure(axis, &whole, window)?];
     if let Some(segment) = segment {
         let opts = MergeOptions {
             segment: Some(segment),

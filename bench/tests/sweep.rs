@@ -93,7 +93,7 @@ fn tiny_sweep_writes_consistent_outputs() {
     };
     assert!(value("record-size", "1x").is_default);
     assert!(value("record-size", "0.5x (32x32)").record_seconds > 0.0);
-    assert!(value("segment", "none").is_default);
+    assert!(value("segment", "64").is_default);
     assert!(value("bridge", "visible").is_default);
     // `visible` draws exactly each frame's V_f, for more copies.
     assert_eq!(value("bridge", "visible").drawn_not_visible_mean, 0.0);

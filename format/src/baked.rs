@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::camera::FrameState;
 use crate::geometry::Geometry;
+use crate::options::{Bridge, Layout, Seeding, Strategy};
 use crate::recording::{DeviceInfo, Edge, RecordSettings};
 use crate::Hash;
 
@@ -37,18 +38,18 @@ pub struct FrameWindow {
 /// How a file was merged.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MergeInfo {
-    /// Strategy name (lib, lbi, ilb, ibl, bli, bil).
-    pub strategy: String,
-    /// Layout name (paper, compact).
-    pub layout: String,
-    /// Bridge policy (hidden, ignored).
-    pub bridge: String,
+    /// The strategy used (never `auto`: the one `auto` kept).
+    pub strategy: Strategy,
+    /// The layout used.
+    pub layout: Layout,
+    /// The bridge policy (what rule 2 allows; the validator checks against it).
+    pub bridge: Bridge,
     /// Whether only tie edges were kept (plays only with the depth test).
     pub depth_only: bool,
     /// Segment length in frames, if the path was cut into segments.
     pub segment: Option<u32>,
-    /// Seeding used to build the matrix (interval, paper).
-    pub seeding: String,
+    /// Seeding used to build the matrix.
+    pub seeding: Seeding,
     /// The non-empty cells of the upper-triangular matrix (of every segment), in index-buffer
     /// order: what `trisort inspect --matrix` draws (the paper's Figure 14).
     pub cells: Vec<MatrixCell>,

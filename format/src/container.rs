@@ -21,8 +21,12 @@ use std::path::{Path, PathBuf};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
-/// Current version of the container and of the types inside it.
-pub const FORMAT_VERSION: u32 = 1;
+/// Current version of the container and of the types inside it. Files of another version are
+/// refused ([`FormatError::Version`]), never guessed at.
+///
+/// History: 1, the first; 2, [`crate::MergeInfo`] stores its options as enums
+/// ([`crate::options`]) instead of strings.
+pub const FORMAT_VERSION: u32 = 2;
 
 /// Decompressed payloads larger than this are refused (16 GiB).
 pub const MAX_PAYLOAD: u64 = 16 << 30;
@@ -84,7 +88,8 @@ pub enum FormatError {
     },
     /// The file is of another version.
     #[error(
-        "{path}: format version {found} is not supported (this trisort reads version {supported})"
+        "{path}: format version {found} is not supported (this trisort reads version \
+         {supported}); record or merge it again with this trisort"
     )]
     Version {
         /// The file.
@@ -323,6 +328,27 @@ mod tests {
         let err = decode::<Vec<(u32, String)>>(FileKind::Baked, &bytes, Path::new("h.baked"))
             .unwrap_err();
         assert!(err.to_string().contains("h.baked"), "{err}");
+    }
+
+    #[test]
+    fn a_file_of_the_previous_version_is_refused_with_what_to_do() {
+        let mut bytes = encode(FileKind::Baked, &sample());
+        bytes[8..12].copy_from_slice(&(FORMAT_VERSION - 1).to_le_bytes());
+        let err = decode::<Vec<(u32, String)>>(FileKind::Baked, &bytes, Path::new("old.baked"))
+            .unwrap_err();
+        assert!(matches!(
+            err,
+            FormatError::Version {
+                found: 1,
+                supported: 2,
+                ..
+            }
+        ));
+        assert_eq!(
+            err.to_string(),
+            "old.baked: format version 1 is not supported (this trisort reads version 2); \
+             record or merge it again with this trisort"
+        );
     }
 
     #[test]

@@ -2,67 +2,55 @@
 //! strategy × layout separately, optionally validates, and prints the figures and times.
 //!
 //! `cargo run --release -p trisort-merger --example merge_file -- REC... [--strategy S|all]
-//! [--layout paper|compact|all] [--bridge hidden|ignored] [--seeding interval|paper]
-//! [--segment N] [--auto] [--verify]`
+//! [--layout paper|compact|all] [--bridge hidden|ignored|visible] [--seeding interval|paper]
+//! [--segment N (0: one matrix)] [--auto] [--verify]`
 //!
-//! `--auto` also runs the library's own `auto` (every combination at once, as the CLI does).
+//! Options not given take the merge's defaults ([`MergeOptions::default`]). `--auto` also
+//! runs the library's own `auto` (every combination at once, as the CLI does).
 
 use std::path::PathBuf;
+use std::str::FromStr;
 use std::time::Instant;
 
 use trisort_format::{FileKind, Recording};
-use trisort_merger::{
-    merge, Bridge, LayoutChoice, MergeOptions, Seeding, Strategy, StrategyChoice,
-};
+use trisort_merger::{merge, Choice, Layout, MergeOptions, Strategy};
 
-fn strategy_choice(s: Strategy) -> StrategyChoice {
-    match s {
-        Strategy::Lib => StrategyChoice::Lib,
-        Strategy::Lbi => StrategyChoice::Lbi,
-        Strategy::Ilb => StrategyChoice::Ilb,
-        Strategy::Ibl => StrategyChoice::Ibl,
-        Strategy::Bli => StrategyChoice::Bli,
-        Strategy::Bil => StrategyChoice::Bil,
+/// `all` (every value) or one value's name; exits with the parse error otherwise.
+fn one_or_all<T: Copy + FromStr<Err = trisort_format::ParseOptionError>>(
+    v: &str,
+    all: &[T],
+) -> Vec<T> {
+    if v == "all" {
+        return all.to_vec();
     }
+    vec![parse(v)]
+}
+
+fn parse<T: FromStr<Err = trisort_format::ParseOptionError>>(v: &str) -> T {
+    v.parse().unwrap_or_else(|e| {
+        eprintln!("merge_file: {e}");
+        std::process::exit(2)
+    })
 }
 
 fn main() {
     let mut files = Vec::new();
     let mut strategies: Vec<Strategy> = Strategy::ALL.to_vec();
-    let mut layouts = vec![LayoutChoice::Paper, LayoutChoice::Compact];
+    let mut layouts: Vec<Layout> = Layout::ALL.to_vec();
     let mut base = MergeOptions::default();
     let (mut auto, mut verify) = (false, false);
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = || args.next().expect("option needs a value");
         match a.as_str() {
-            "--strategy" => {
-                let v = value();
-                if v != "all" {
-                    strategies = vec![Strategy::from_name(&v).expect("strategy name")];
-                }
+            "--strategy" => strategies = one_or_all(&value(), &Strategy::ALL),
+            "--layout" => layouts = one_or_all(&value(), &Layout::ALL),
+            "--bridge" => base.bridge = parse(&value()),
+            "--seeding" => base.seeding = parse(&value()),
+            "--segment" => {
+                let n: u32 = value().parse().expect("segment");
+                base.segment = (n > 0).then_some(n);
             }
-            "--layout" => {
-                layouts = match value().as_str() {
-                    "paper" => vec![LayoutChoice::Paper],
-                    "compact" => vec![LayoutChoice::Compact],
-                    _ => vec![LayoutChoice::Paper, LayoutChoice::Compact],
-                }
-            }
-            "--bridge" => {
-                base.bridge = match value().as_str() {
-                    "ignored" => Bridge::Ignored,
-                    "visible" => Bridge::Visible,
-                    _ => Bridge::Hidden,
-                }
-            }
-            "--seeding" => {
-                base.seeding = match value().as_str() {
-                    "paper" => Seeding::Paper,
-                    _ => Seeding::Interval,
-                }
-            }
-            "--segment" => base.segment = Some(value().parse().expect("segment")),
             "--auto" => auto = true,
             "--verify" => verify = true,
             _ => files.push(PathBuf::from(a)),
@@ -83,16 +71,16 @@ fn main() {
     for &s in &strategies {
         for &l in &layouts {
             runs.push(MergeOptions {
-                strategy: strategy_choice(s),
-                layout: l,
+                strategy: Choice::Only(s),
+                layout: Choice::Only(l),
                 ..base
             });
         }
     }
     if auto {
         runs.push(MergeOptions {
-            strategy: StrategyChoice::Auto,
-            layout: LayoutChoice::Auto,
+            strategy: Choice::Auto,
+            layout: Choice::Auto,
             ..base
         });
     }
@@ -125,7 +113,7 @@ fn main() {
             s.unordered_samples,
             secs,
             valid,
-            if opts.strategy == StrategyChoice::Auto {
+            if opts.strategy == Choice::Auto {
                 " (auto)"
             } else {
                 ""

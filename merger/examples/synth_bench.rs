@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use trisort_merger::synth::{turntable, Turntable};
-use trisort_merger::{merge, Bridge, LayoutChoice, MergeOptions, Seeding, StrategyChoice};
+use trisort_merger::{merge, Bridge, Choice, Layout, MergeOptions, Seeding, Strategy};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -22,7 +22,11 @@ fn main() {
         ..Turntable::default()
     };
     let segment = args.get(3).and_then(|s| s.parse().ok());
-    let only = args.get(4).cloned().unwrap_or_default();
+    // One strategy (by name), or every one (`all` or nothing).
+    let only: Option<Strategy> = args
+        .get(4)
+        .filter(|s| !s.is_empty() && *s != "all")
+        .map(|s| s.parse().unwrap_or_else(|e| panic!("{e}")));
     let fast = std::env::var("SYNTH_BENCH_FAST").is_ok();
     let t0 = Instant::now();
     let rec = turntable(&p);
@@ -33,18 +37,9 @@ fn main() {
         t0.elapsed().as_secs_f64()
     );
     println!("seeding  bridge  strategy layout  | index/|G| draws mean  max | drawn-not-vis unordered | seconds | cell edges -> reduced");
-    let all = [
-        (StrategyChoice::Lib, "lib"),
-        (StrategyChoice::Lbi, "lbi"),
-        (StrategyChoice::Ilb, "ilb"),
-        (StrategyChoice::Ibl, "ibl"),
-        (StrategyChoice::Bli, "bli"),
-        (StrategyChoice::Bil, "bil"),
-    ];
-    let strategies: Vec<StrategyChoice> = all
-        .iter()
-        .filter(|(_, n)| only.is_empty() || only == "all" || only == *n)
-        .map(|(s, _)| *s)
+    let strategies: Vec<Strategy> = Strategy::ALL
+        .into_iter()
+        .filter(|&s| only.is_none_or(|o| o == s))
         .collect();
     let seedings: &[Seeding] = if fast {
         &[Seeding::Interval]
@@ -59,10 +54,10 @@ fn main() {
     for &seeding in seedings {
         for &bridge in bridges {
             for &strategy in &strategies {
-                for layout in [LayoutChoice::Paper, LayoutChoice::Compact] {
+                for layout in Layout::ALL {
                     let opts = MergeOptions {
-                        strategy,
-                        layout,
+                        strategy: Choice::Only(strategy),
+                        layout: Choice::Only(layout),
                         bridge,
                         seeding,
                         segment,
@@ -74,8 +69,8 @@ fn main() {
                     let s = &b.stats;
                     println!(
                         "{:8} {:7} {:8} {:7} | {:9.3} {:10.1} {:4} | {:13.1} {:9} | {:.3} | {} -> {}",
-                        seeding.name(),
-                        bridge.name(),
+                        seeding,
+                        bridge,
                         b.merge.strategy,
                         b.merge.layout,
                         s.index_triangles as f64 / s.unique_visible as f64,

@@ -44,6 +44,7 @@ use rayon::prelude::*;
 use trisort_format::{Baked, MatrixCell, Recording};
 
 pub use strategy::{Layout, Strategy};
+pub use trisort_format::{Bridge, Choice, Seeding};
 
 /// The order in which `auto` runs the combinations: those that needed the fewest copies on
 /// the synthetic turntable and the demo car first (ILB and IBL), so that the bound they set
@@ -72,134 +73,47 @@ const LEADERS: usize = 2;
 /// synthetic turntables, so the bound discards only combinations that end up worse.
 const PRUNE_FACTOR: (u64, u64) = (3, 2);
 
-/// Which strategy to use (paper §5.1), or `Auto` to try all six.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum StrategyChoice {
-    /// L, I, B.
-    Lib,
-    /// L, B, I.
-    Lbi,
-    /// I, L, B.
-    Ilb,
-    /// I, B, L.
-    Ibl,
-    /// B, L, I.
-    Bli,
-    /// B, I, L.
-    Bil,
-    /// Every strategy; the best by [`merge`]'s objective.
-    #[default]
-    Auto,
-}
-
-impl StrategyChoice {
-    /// The strategies this choice tries.
-    pub fn strategies(self) -> Vec<Strategy> {
-        match self {
-            StrategyChoice::Lib => vec![Strategy::Lib],
-            StrategyChoice::Lbi => vec![Strategy::Lbi],
-            StrategyChoice::Ilb => vec![Strategy::Ilb],
-            StrategyChoice::Ibl => vec![Strategy::Ibl],
-            StrategyChoice::Bli => vec![Strategy::Bli],
-            StrategyChoice::Bil => vec![Strategy::Bil],
-            StrategyChoice::Auto => Strategy::ALL.to_vec(),
-        }
-    }
-}
-
-/// Which layout to use, or `Auto` to try both.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LayoutChoice {
-    /// The paper's (rows for LIB/BIL, diagonals otherwise).
-    Paper,
-    /// The compact one (≤ max(f+1, F−f) ranges per window).
-    Compact,
-    /// Both; the best by [`merge`]'s objective.
-    #[default]
-    Auto,
-}
-
-impl LayoutChoice {
-    /// The layouts this choice tries.
-    pub fn layouts(self) -> Vec<Layout> {
-        match self {
-            LayoutChoice::Paper => vec![Layout::Paper],
-            LayoutChoice::Compact => vec![Layout::Compact],
-            LayoutChoice::Auto => Layout::ALL.to_vec(),
-        }
-    }
-}
-
-/// Where a copy may span frames in which its triangle is not visible (DESIGN rule 2).
-///
-/// A copy always starts and ends at frames where its triangle is visible; this decides what
-/// the frames between may be.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Bridge {
-    /// Any frame where the triangle is not visible: covered but hidden (t ∈ C_f \ V_f, costs
-    /// fill, and the copy is then ordered there like any drawn triangle), or with no fragment
-    /// at all (t ∉ C_f, the ignore list: drawing it changes nothing).
-    Hidden,
-    /// Only frames where the triangle has no fragment (t ∉ C_f): drawing it changes nothing
-    /// and costs no fill.
-    Ignored,
-    /// None: a copy spans only frames where its triangle is visible, so every frame draws
-    /// exactly its V_f (no drawn-not-visible triangle, the `source` lower bound in triangles)
-    /// at the price of more copies. The default since issue 7's benchmarks: on the demo car
-    /// merged / source frame time fell from 1.31 to 1.06 for 26 % more copies (BENCHMARKS.md).
-    #[default]
-    Visible,
-}
-
-impl Bridge {
-    /// Lower-case name (`hidden`, `ignored`), as stored in [`trisort_format::MergeInfo`].
-    pub fn name(self) -> &'static str {
-        match self {
-            Bridge::Hidden => "hidden",
-            Bridge::Ignored => "ignored",
-            Bridge::Visible => "visible",
-        }
-    }
-}
-
-/// How the matrix is seeded before interval splitting makes it valid.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Seeding {
-    /// One copy per maximal bridgeable run of a triangle's visible frames (the specification).
-    #[default]
-    Interval,
-    /// The paper's diagonal-by-diagonal merge of adjacent cells (§3.2, Figures 4 and 12),
-    /// with copies trimmed so rule 1 holds; interval splitting then repairs what it misses.
-    Paper,
-}
-
-impl Seeding {
-    /// Lower-case name (`interval`, `paper`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Seeding::Interval => "interval",
-            Seeding::Paper => "paper",
-        }
-    }
-}
-
-/// Merge options (the flags of `trisort merge`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// Merge options (the flags of `trisort merge`). [`MergeOptions::default`] is the one
+/// definition of the merge's defaults: the CLI's flags, `demo`, `bench` and the sweep take
+/// theirs from it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MergeOptions {
-    /// Strategy (default `Auto`).
-    pub strategy: StrategyChoice,
-    /// Layout (default `Auto`).
-    pub layout: LayoutChoice,
-    /// Bridge policy (default `Visible`).
+    /// Strategy (default `auto`).
+    pub strategy: Choice<Strategy>,
+    /// Layout (default `auto`).
+    pub layout: Choice<Layout>,
+    /// Bridge policy (default [`Bridge::Visible`]).
     pub bridge: Bridge,
     /// Keep only tie edges ([`trisort_format::FrameRecord::ties`]); the bake then plays only
     /// with the depth test.
     pub depth_only: bool,
     /// Cut the path into segments of this many frames, each with its own matrix, so draws per
-    /// frame stay bounded on long paths.
+    /// frame stay bounded on long paths (default [`MergeOptions::DEFAULT_SEGMENT`]; `None`:
+    /// one matrix for the whole path).
     pub segment: Option<u32>,
-    /// Seeding (default `Interval`).
+    /// Seeding (default [`Seeding::Interval`]).
     pub seeding: Seeding,
+}
+
+impl MergeOptions {
+    /// The default segment length: it bounds draws per frame by 64 and changes nothing on
+    /// paths of up to 64 frames (BENCHMARKS.md § Sweep).
+    pub const DEFAULT_SEGMENT: u32 = 64;
+}
+
+impl Default for MergeOptions {
+    /// `auto` strategy and layout, bridge `visible`, no depth-only, segments of
+    /// [`MergeOptions::DEFAULT_SEGMENT`] frames, interval seeding.
+    fn default() -> MergeOptions {
+        MergeOptions {
+            strategy: Choice::Auto,
+            layout: Choice::Auto,
+            bridge: Bridge::default(),
+            depth_only: false,
+            segment: Some(MergeOptions::DEFAULT_SEGMENT),
+            seeding: Seeding::default(),
+        }
+    }
 }
 
 /// Why recordings could not be merged. Variants name the recording (its index in the slice
@@ -336,9 +250,9 @@ pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, Mer
         .collect();
     let combos: Vec<(Strategy, Layout)> = opts
         .strategy
-        .strategies()
+        .candidates()
         .into_iter()
-        .flat_map(|s| opts.layout.layouts().into_iter().map(move |l| (s, l)))
+        .flat_map(|s| opts.layout.candidates().into_iter().map(move |l| (s, l)))
         .collect();
     let triangles = &first.geometry.triangles;
     // Combinations run in `PRIORITY` order (the ones that usually win first). The first

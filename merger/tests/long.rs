@@ -2,13 +2,13 @@
 //! still validates.
 
 use trisort_merger::synth::{turntable, Turntable};
-use trisort_merger::{merge, LayoutChoice, MergeOptions, StrategyChoice};
+use trisort_merger::{merge, Choice, Layout, MergeOptions, Strategy};
 use trisort_verify::check_graph;
 
 fn ibl_compact(segment: Option<u32>) -> MergeOptions {
     MergeOptions {
-        strategy: StrategyChoice::Ibl,
-        layout: LayoutChoice::Compact,
+        strategy: Choice::Only(Strategy::Ibl),
+        layout: Choice::Only(Layout::Compact),
         segment,
         ..MergeOptions::default()
     }

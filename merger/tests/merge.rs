@@ -2,30 +2,16 @@
 //! determinism and long synthetic paths.
 
 use proptest::prelude::*;
+use proptest::strategy::Strategy as _;
 use trisort_format::{Baked, Recording};
 use trisort_merger::synth::{recording_from_frames, split_frames, turntable, FrameSpec, Turntable};
-use trisort_merger::{merge, Bridge, LayoutChoice, MergeOptions, Seeding, StrategyChoice};
+use trisort_merger::{merge, Bridge, Choice, Layout, MergeOptions, Seeding, Strategy};
 use trisort_verify::check_graph;
 
-const STRATEGIES: [StrategyChoice; 6] = [
-    StrategyChoice::Lib,
-    StrategyChoice::Lbi,
-    StrategyChoice::Ilb,
-    StrategyChoice::Ibl,
-    StrategyChoice::Bli,
-    StrategyChoice::Bil,
-];
-const LAYOUTS: [LayoutChoice; 2] = [LayoutChoice::Paper, LayoutChoice::Compact];
-
-fn opts(
-    strategy: StrategyChoice,
-    layout: LayoutChoice,
-    bridge: Bridge,
-    seeding: Seeding,
-) -> MergeOptions {
+fn opts(strategy: Strategy, layout: Layout, bridge: Bridge, seeding: Seeding) -> MergeOptions {
     MergeOptions {
-        strategy,
-        layout,
+        strategy: Choice::Only(strategy),
+        layout: Choice::Only(layout),
         bridge,
         seeding,
         ..MergeOptions::default()
@@ -55,8 +41,8 @@ fn assert_valid(recs: &[Recording], baked: &Baked, what: &str) {
 
 /// Every strategy × layout × bridge × seeding passes the validator.
 fn assert_all_valid(recs: &[Recording], what: &str) {
-    for s in STRATEGIES {
-        for l in LAYOUTS {
+    for s in Strategy::ALL {
+        for l in Layout::ALL {
             for b in [Bridge::Hidden, Bridge::Ignored, Bridge::Visible] {
                 for seeding in [Seeding::Interval, Seeding::Paper] {
                     let baked = merge(recs, &opts(s, l, b, seeding)).expect("merge");
@@ -73,7 +59,7 @@ fn assert_all_valid(recs: &[Recording], what: &str) {
 
 /// Random per-frame graphs over a few triangles: random visibility, hidden and never-covered
 /// triangles, edges among covered triangles (chains through hidden ones), intra-frame cycles.
-fn random_frames() -> impl Strategy<Value = Vec<FrameSpec>> {
+fn random_frames() -> impl proptest::strategy::Strategy<Value = Vec<FrameSpec>> {
     let frame = (
         proptest::collection::vec(0u8..4, 8),
         proptest::collection::vec((0u32..8, 0u32..8, 1u32..9, any::<bool>()), 0..14),
@@ -144,8 +130,8 @@ fn camera_turning_180_degrees_forces_splits() {
         })
         .collect();
     let rec = recording_from_frames(n, &frames);
-    for s in STRATEGIES {
-        for l in LAYOUTS {
+    for s in Strategy::ALL {
+        for l in Layout::ALL {
             for seeding in [Seeding::Interval, Seeding::Paper] {
                 let baked = merge(
                     std::slice::from_ref(&rec),
@@ -238,8 +224,8 @@ fn order_through_an_undrawn_triangle() {
         },
     ];
     let rec = recording_from_frames(3, &frames);
-    for s in STRATEGIES {
-        for l in LAYOUTS {
+    for s in Strategy::ALL {
+        for l in Layout::ALL {
             let baked = merge(
                 std::slice::from_ref(&rec),
                 &opts(s, l, Bridge::Ignored, Seeding::Interval),

@@ -99,33 +99,7 @@ fn check_job(job: &RecordJob) -> Result<Range<u32>, RecordError> {
             range.start, range.end
         )));
     }
-    if s.width == 0 || s.height == 0 || s.width > 16384 || s.height > 16384 {
-        return Err(RecordError::Invalid(format!(
-            "size {}x{} is out of range (1..16384)",
-            s.width, s.height
-        )));
-    }
-    if s.samples != 1 && s.samples != 4 {
-        return Err(RecordError::Invalid(format!(
-            "{} samples: only 1 and 4 are supported",
-            s.samples
-        )));
-    }
-    if !(s.saturation > 0.0 && s.saturation <= 1.0) {
-        return Err(RecordError::Invalid(format!(
-            "saturation {} must be in (0, 1]",
-            s.saturation
-        )));
-    }
-    if !(0.0..=1.0).contains(&s.glass_opacity) {
-        return Err(RecordError::Invalid(format!(
-            "glass opacity {} must be in [0, 1]",
-            s.glass_opacity
-        )));
-    }
-    if s.max_layers == 0 {
-        return Err(RecordError::Invalid("max layers must be at least 1".into()));
-    }
+    s.validate().map_err(|e| RecordError::Invalid(e.to_string()))?;
     Ok(range)
 }
 

@@ -12,14 +12,18 @@ use serde_json::json;
 use trisort_bench::methods::{source_baked, BenchView};
 use trisort_bench::plot::{write_svg, Chart, Series, Style};
 use trisort_bench::table::{run_group, GroupInput, GroupReport, MethodKind};
-use trisort_format::{Baked, FileKind, Recording};
-use trisort_player::Mode;
+use trisort_format::{Baked, Bridge, FileKind, RecordSettings, Recording};
 use trisort_gpu::Gpu;
+use trisort_merger::MergeOptions;
+use trisort_player::Mode;
 
 use crate::cmd::bake::{bake, recording_path};
-use crate::cmd::merge::{BridgeArg, MergeOpts};
+use crate::cmd::merge::MergeOpts;
 use crate::cmd::RecordOpts;
-use crate::common::{load_path, load_scene, parse_range, parse_size, print_json, FrameRange};
+use crate::common::{
+    default_size, load_path, load_scene, option_parser, parse_range, parse_size, print_json,
+    FrameRange,
+};
 
 /// Arguments of `bench`.
 #[derive(Args, Debug)]
@@ -30,7 +34,7 @@ pub struct BenchArgs {
     #[arg(long)]
     path: String,
     /// Recording and playback size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    #[arg(long, default_value = default_size(), value_parser = parse_size)]
     size: (u32, u32),
     /// MSAA sample counts, comma-separated; each is baked (recorded) at its own count, so every
     /// method plays at its recorded pattern. The first is the headline (`methods` in --json).
@@ -52,12 +56,13 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 5)]
     repeats: u32,
     /// Opacity at which transmissive glass is recorded and played.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = RecordSettings::DEFAULT_GLASS_OPACITY)]
     glass_opacity: f32,
     /// Bridge policy of the bakes (see `trisort merge --bridge`): `visible` draws exactly each
     /// frame's visible set; `hidden` shares more copies and draws more triangles.
-    #[arg(long, value_enum, default_value = "visible")]
-    bridge: BridgeArg,
+    #[arg(long, value_parser = option_parser::<Bridge>(),
+          default_value_t = MergeOptions::default().bridge)]
+    bridge: Bridge,
     /// Sampling rate for `--path gltf` and generated paths (a TOML file sets its own).
     #[arg(long, default_value_t = 30.0)]
     fps: f64,
@@ -135,52 +140,38 @@ fn bake_for(
         bridge: a.bridge,
         ..MergeOpts::defaults()
     };
-    let bridge = merge.options().bridge.name();
-    let suffix = if bridge == MergeOpts::defaults().options().bridge.name() {
+    let suffix = if a.bridge == MergeOptions::default().bridge {
         String::new()
     } else {
-        format!("-{bridge}")
+        format!("-{}", a.bridge)
     };
     let path = a.out.join(format!(
         "bake-{}x{}-{}x{suffix}.baked",
         a.size.0, a.size.1, samples
     ));
     let rec_path = recording_path(&path);
-    let record = RecordOpts {
-        size: a.size,
-        samples,
-        saturation: 0.998,
+    let settings = RecordSettings {
         glass_opacity: a.glass_opacity,
-        max_layers: 256,
-        frames: None,
-        fps: a.fps,
+        ..RecordSettings::new(a.size, samples)
     };
+    let record = RecordOpts::new(settings, a.fps);
     if path.exists() && rec_path.exists() {
-        let baked: Baked = trisort_format::read_file(FileKind::Baked, &path)?;
-        let recording: Recording = trisort_format::read_file(FileKind::Recording, &rec_path)?;
-        if baked.scene_hash == scene.hash()
-            && baked.path_hash == timeline.hash()
-            && baked.settings == record.settings()
-            && baked.merge.bridge == bridge
-            && baked.merge.segment == merge.options().segment
-            && recording.content_hash() == *baked.recording_hashes.first().unwrap_or(&[0; 32])
-        {
-            say(&format!("reusing {}", path.display()));
-            let bytes = std::fs::metadata(&path)?.len();
-            return Ok(BakeRun {
-                samples,
-                source: source_baked(&baked, &recording)?,
-                baked,
-                record_seconds: None,
-                merge_seconds: None,
-                bytes,
-                path,
-            });
+        match reusable(&path, &rec_path, scene, timeline, &settings, &merge) {
+            Ok((baked, recording)) => {
+                say(&format!("reusing {}", path.display()));
+                let bytes = std::fs::metadata(&path)?.len();
+                return Ok(BakeRun {
+                    samples,
+                    source: source_baked(&baked, &recording)?,
+                    baked,
+                    record_seconds: None,
+                    merge_seconds: None,
+                    bytes,
+                    path,
+                });
+            }
+            Err(why) => say(&format!("{}: {why}; baking again", path.display())),
         }
-        say(&format!(
-            "{} was made from other inputs; baking again",
-            path.display()
-        ));
     }
     say(&format!(
         "baking {} frames at {}x{} {}x",
@@ -207,6 +198,33 @@ fn bake_for(
         bytes,
         path,
     })
+}
+
+/// The bake at `path` and its recording at `rec_path` when they were made from `scene`,
+/// `timeline`, `settings` and `merge`'s bridge and segments; otherwise why not (another
+/// trisort's file version, other inputs).
+fn reusable(
+    path: &Path,
+    rec_path: &Path,
+    scene: &trisort_scene::Scene,
+    timeline: &trisort_paths::Timeline,
+    settings: &RecordSettings,
+    merge: &MergeOpts,
+) -> Result<(Baked, Recording)> {
+    let baked: Baked = trisort_format::read_file(FileKind::Baked, path)?;
+    let recording: Recording = trisort_format::read_file(FileKind::Recording, rec_path)?;
+    let options = merge.options();
+    if baked.scene_hash == scene.hash()
+        && baked.path_hash == timeline.hash()
+        && baked.settings == *settings
+        && baked.merge.bridge == options.bridge
+        && baked.merge.segment == options.segment
+        && recording.content_hash() == *baked.recording_hashes.first().unwrap_or(&[0; 32])
+    {
+        Ok((baked, recording))
+    } else {
+        bail!("made from other inputs")
+    }
 }
 
 pub fn run(a: BenchArgs) -> Result<ExitCode> {

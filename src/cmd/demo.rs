@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::Args;
+use trisort_format::RecordSettings;
 use trisort_player::headless::HeadlessConfig;
 
 use crate::cmd::bake::bake;
@@ -30,7 +31,7 @@ pub struct DemoArgs {
     #[arg(long, default_value = "256x256", value_parser = parse_size)]
     size: (u32, u32),
     /// MSAA samples.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = RecordSettings::DEFAULT_SAMPLES)]
     samples: u32,
 }
 
@@ -53,15 +54,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         scene.geometry.materials.len(),
         path.frames.len()
     );
-    let record = RecordOpts {
-        size: a.size,
-        samples: a.samples,
-        saturation: 0.998,
-        glass_opacity: 0.0,
-        max_layers: 256,
-        frames: None,
-        fps: path.fps,
-    };
+    let record = RecordOpts::new(RecordSettings::new(a.size, a.samples), path.fps);
     let merge = MergeOpts::defaults();
     let gpu = crate::common::open_gpu()?;
     println!("device: {}", gpu.describe());

@@ -4,134 +4,66 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use serde_json::json;
-use trisort_format::{Baked, FileKind, Recording};
-use trisort_merger::{Bridge, LayoutChoice, MergeOptions, Seeding, StrategyChoice};
+use trisort_format::{Baked, Bridge, Choice, FileKind, Layout, Recording, Seeding, Strategy};
+use trisort_merger::MergeOptions;
 
-use crate::common::print_json;
+use crate::common::{choice_parser, option_parser, print_json};
 
-/// Strategy names of the CLI.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum StrategyArg {
-    /// Left, intersection, bottom.
-    Lib,
-    /// Left, bottom, intersection.
-    Lbi,
-    /// Intersection, left, bottom.
-    Ilb,
-    /// Intersection, bottom, left.
-    Ibl,
-    /// Bottom, left, intersection.
-    Bli,
-    /// Bottom, intersection, left.
-    Bil,
-    /// Try all, keep the best (index triangles, then worst-frame draws).
-    Auto,
-}
-
-/// Layout names of the CLI.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum LayoutArg {
-    /// The paper's layout (rows for LIB/BIL, diagonals otherwise).
-    Paper,
-    /// The compact layout (at most max(f+1, F−f) ranges per frame).
-    Compact,
-    /// Try both.
-    Auto,
-}
-
-/// Bridge policy names of the CLI.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum BridgeArg {
-    /// Copies may span frames where the triangle is covered but hidden (or has no fragment).
-    Hidden,
-    /// Copies may span only frames where the triangle has no fragment.
-    Ignored,
-    /// Copies span only frames where the triangle is visible: every frame draws exactly its
-    /// visible set (fewest triangles per frame), at the price of more copies.
-    Visible,
-}
-
-/// Seeding names of the CLI.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum SeedingArg {
-    /// Interval splitting (the specification).
-    Interval,
-    /// The paper's diagonal-by-diagonal merge.
-    Paper,
-}
-
-/// Merge options shared by `merge`, `bake` and `demo`.
+/// Merge options shared by `merge`, `bake` and `demo`; every default is
+/// [`MergeOptions::default`]'s.
 #[derive(Args, Debug, Clone)]
 pub struct MergeOpts {
     /// Merge strategy.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub strategy: StrategyArg,
+    #[arg(long, value_parser = choice_parser::<Strategy>(),
+          default_value_t = MergeOptions::default().strategy)]
+    pub strategy: Choice<Strategy>,
     /// Matrix layout.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub layout: LayoutArg,
+    #[arg(long, value_parser = choice_parser::<Layout>(),
+          default_value_t = MergeOptions::default().layout)]
+    pub layout: Choice<Layout>,
     /// What a copy may span besides frames where its triangle is visible.
-    #[arg(long, value_enum, default_value = "visible")]
-    pub bridge: BridgeArg,
+    #[arg(long, value_parser = option_parser::<Bridge>(),
+          default_value_t = MergeOptions::default().bridge)]
+    pub bridge: Bridge,
     /// Keep only equal-depth (tie) edges: plays only with the depth test.
     #[arg(long)]
     pub depth_only: bool,
     /// Cut the path into segments of N frames with their own matrices, so no frame needs more
     /// than N draws whatever the path's length (0: one matrix for the whole path). The
     /// default, 64, changes nothing on paths of up to 64 frames (BENCHMARKS.md § Sweep).
-    #[arg(long, default_value_t = DEFAULT_SEGMENT)]
+    #[arg(long, default_value_t = MergeOptions::DEFAULT_SEGMENT)]
     pub segment: u32,
     /// How the matrix is seeded.
-    #[arg(long, value_enum, default_value = "interval")]
-    pub seeding: SeedingArg,
+    #[arg(long, value_parser = option_parser::<Seeding>(),
+          default_value_t = MergeOptions::default().seeding)]
+    pub seeding: Seeding,
 }
 
-/// The default segment length: the bound on draws per frame.
-pub const DEFAULT_SEGMENT: u32 = 64;
-
 impl MergeOpts {
-    /// The command line's defaults (auto strategy and layout, bridge visible, interval seeding,
-    /// segments of 64 frames).
+    /// The command line's defaults: [`MergeOptions::default`].
     pub fn defaults() -> MergeOpts {
+        let o = MergeOptions::default();
         MergeOpts {
-            strategy: StrategyArg::Auto,
-            layout: LayoutArg::Auto,
-            bridge: BridgeArg::Visible,
-            depth_only: false,
-            segment: DEFAULT_SEGMENT,
-            seeding: SeedingArg::Interval,
+            strategy: o.strategy,
+            layout: o.layout,
+            bridge: o.bridge,
+            depth_only: o.depth_only,
+            segment: o.segment.unwrap_or(0),
+            seeding: o.seeding,
         }
     }
 
-    /// The merger's options.
+    /// The merger's options (`--segment 0`: no segments).
     pub fn options(&self) -> MergeOptions {
         MergeOptions {
-            strategy: match self.strategy {
-                StrategyArg::Lib => StrategyChoice::Lib,
-                StrategyArg::Lbi => StrategyChoice::Lbi,
-                StrategyArg::Ilb => StrategyChoice::Ilb,
-                StrategyArg::Ibl => StrategyChoice::Ibl,
-                StrategyArg::Bli => StrategyChoice::Bli,
-                StrategyArg::Bil => StrategyChoice::Bil,
-                StrategyArg::Auto => StrategyChoice::Auto,
-            },
-            layout: match self.layout {
-                LayoutArg::Paper => LayoutChoice::Paper,
-                LayoutArg::Compact => LayoutChoice::Compact,
-                LayoutArg::Auto => LayoutChoice::Auto,
-            },
-            bridge: match self.bridge {
-                BridgeArg::Hidden => Bridge::Hidden,
-                BridgeArg::Ignored => Bridge::Ignored,
-                BridgeArg::Visible => Bridge::Visible,
-            },
+            strategy: self.strategy,
+            layout: self.layout,
+            bridge: self.bridge,
             depth_only: self.depth_only,
             segment: (self.segment > 0).then_some(self.segment),
-            seeding: match self.seeding {
-                SeedingArg::Interval => Seeding::Interval,
-                SeedingArg::Paper => Seeding::Paper,
-            },
+            seeding: self.seeding,
         }
     }
 }

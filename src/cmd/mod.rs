@@ -15,7 +15,9 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 
-use crate::common::{parse_range, parse_size, FrameRange};
+use trisort_format::RecordSettings;
+
+use crate::common::{default_size, parse_range, parse_size, FrameRange};
 
 /// trisort: bake fixed camera paths into one depth-sorted index buffer with a sliding window
 /// per frame, and play, verify and measure the result.
@@ -50,19 +52,19 @@ enum Command {
 #[derive(Args, Debug, Clone)]
 pub struct RecordOpts {
     /// Recording size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "512x512", value_parser = parse_size)]
+    #[arg(long, default_value = default_size(), value_parser = parse_size)]
     pub size: (u32, u32),
     /// MSAA samples (1 or 4).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = RecordSettings::DEFAULT_SAMPLES)]
     pub samples: u32,
     /// Accumulated opacity at which a sample counts as saturated.
-    #[arg(long, default_value_t = 0.998)]
+    #[arg(long, default_value_t = RecordSettings::DEFAULT_SATURATION)]
     pub saturation: f32,
     /// Opacity at which transmissive glass is recorded.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = RecordSettings::DEFAULT_GLASS_OPACITY)]
     pub glass_opacity: f32,
     /// Safety bound on peel layers per frame (a frame hitting it is marked truncated).
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = RecordSettings::DEFAULT_MAX_LAYERS)]
     pub max_layers: u32,
     /// Frames to record, half-open `a..b` (default: all).
     #[arg(long, value_parser = parse_range)]
@@ -73,9 +75,22 @@ pub struct RecordOpts {
 }
 
 impl RecordOpts {
+    /// Options recording the whole path with `settings`, sampling generated paths at `fps`.
+    pub fn new(settings: RecordSettings, fps: f64) -> RecordOpts {
+        RecordOpts {
+            size: (settings.width, settings.height),
+            samples: settings.samples,
+            saturation: settings.saturation,
+            glass_opacity: settings.glass_opacity,
+            max_layers: settings.max_layers,
+            frames: None,
+            fps,
+        }
+    }
+
     /// The settings stored in the recording.
-    pub fn settings(&self) -> trisort_format::RecordSettings {
-        trisort_format::RecordSettings {
+    pub fn settings(&self) -> RecordSettings {
+        RecordSettings {
             width: self.size.0,
             height: self.size.1,
             samples: self.samples,

@@ -8,9 +8,9 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use serde_json::json;
 use trisort_format::{FileKind, Phase, Recording};
+use trisort_gpu::Gpu;
 use trisort_recorder::partial::{partial_path, PartialDir};
 use trisort_recorder::{record, RecordJob};
-use trisort_gpu::Gpu;
 
 use crate::cmd::RecordOpts;
 use crate::common::{load_path, load_scene, print_json, progress_bar};

@@ -21,7 +21,7 @@
 #![deny(missing_docs)]
 
 use serde::Serialize;
-use trisort_format::{Baked, Edge, FrameRecord, Phase, Recording};
+use trisort_format::{Baked, Bridge, Edge, FrameRecord, Phase, Recording};
 
 /// One frame's findings.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
@@ -96,14 +96,10 @@ pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
     let ids = &baked.scene_ids;
     let n = ids.len();
     // (hidden frames allowed, frames without a fragment allowed)
-    let (hidden_ok, uncovered_ok) = match baked.merge.bridge.as_str() {
-        "hidden" => (true, true),
-        "ignored" => (false, true),
-        "visible" => (false, false),
-        other => {
-            report.problem(format!("unknown bridge policy {other:?}"));
-            (false, false)
-        }
+    let (hidden_ok, uncovered_ok) = match baked.merge.bridge {
+        Bridge::Hidden => (true, true),
+        Bridge::Ignored => (false, true),
+        Bridge::Visible => (false, false),
     };
     let ncopies = baked.copies.len();
     // Per copy: first frame, last frame, number of frames, drawn where visible.

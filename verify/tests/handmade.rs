@@ -1,8 +1,8 @@
 //! The validator on files written by hand (no merger involved).
 
 use trisort_format::{
-    Baked, Camera, DrawIndexedIndirectArgs, Edge, FrameRecord, FrameState, FrameWindow, Geometry,
-    Material, MergeInfo, MergeStats, Node, Phase, RecordSettings, Recording, Vertex,
+    Baked, Bridge, Camera, DrawIndexedIndirectArgs, Edge, FrameRecord, FrameState, FrameWindow,
+    Geometry, Material, MergeInfo, MergeStats, Node, Phase, RecordSettings, Recording, Vertex,
 };
 use trisort_verify::check_graph;
 
@@ -107,7 +107,7 @@ fn draw(first_copy: u32, count: u32) -> DrawIndexedIndirectArgs {
 /// frame 1 draws `f1` (as (first copy, count) ranges).
 fn baked(
     rec: &Recording,
-    bridge: &str,
+    bridge: Bridge,
     copies: Vec<u32>,
     f0: &[(u32, u32)],
     f1: &[(u32, u32)],
@@ -129,7 +129,7 @@ fn baked(
         settings: rec.settings,
         device: rec.device.clone(),
         merge: MergeInfo {
-            bridge: bridge.into(),
+            bridge,
             ..MergeInfo::default()
         },
         stats: MergeStats::default(),
@@ -148,14 +148,26 @@ fn order_through_an_undrawn_triangle() {
     let rec = recording();
     let recs = std::slice::from_ref(&rec);
     // Buffer [A, H, B]: frame 0 draws A and B (skipping H) as two ranges, frame 1 all.
-    let good = baked(&rec, "ignored", vec![0, 1, 2], &[(0, 1), (2, 1)], &[(0, 3)]);
+    let good = baked(
+        &rec,
+        Bridge::Ignored,
+        vec![0, 1, 2],
+        &[(0, 1), (2, 1)],
+        &[(0, 3)],
+    );
     let r = check_graph(recs, &good);
     assert!(r.ok, "{:?}", r.problems);
     assert_eq!(r.frames[0].drawn_not_visible, 0);
 
     // Buffer [B, A, H]: frame 0 draws B then A. B is reachable from A only through the
     // undrawn H, which still orders A first.
-    let bad = baked(&rec, "ignored", vec![2, 0, 1], &[(0, 2)], &[(1, 2), (0, 1)]);
+    let bad = baked(
+        &rec,
+        Bridge::Ignored,
+        vec![2, 0, 1],
+        &[(0, 2)],
+        &[(1, 2), (0, 1)],
+    );
     let r = check_graph(recs, &bad);
     assert!(!r.ok);
     assert_eq!(r.frames[0].graph_violations, 1, "{:?}", r.frames);
@@ -169,15 +181,15 @@ fn bridge_policy_and_copies() {
     let recs = std::slice::from_ref(&rec);
     // One copy of each drawn in both frames: H is drawn at frame 0 where it is covered but
     // hidden. Allowed by `hidden`, not by `ignored`.
-    let both = |bridge: &str| baked(&rec, bridge, vec![0, 1, 2], &[(0, 3)], &[(0, 3)]);
-    let r = check_graph(recs, &both("hidden"));
+    let both = |bridge: Bridge| baked(&rec, bridge, vec![0, 1, 2], &[(0, 3)], &[(0, 3)]);
+    let r = check_graph(recs, &both(Bridge::Hidden));
     assert!(r.ok, "{:?}", r.problems);
     assert_eq!(r.frames[0].drawn_not_visible, 1);
-    let r = check_graph(recs, &both("ignored"));
+    let r = check_graph(recs, &both(Bridge::Ignored));
     assert!(!r.ok);
     assert_eq!(r.frames[0].bridge_violations, 1);
     // `visible` allows no drawn-not-visible triangle at all.
-    let r = check_graph(recs, &both("visible"));
+    let r = check_graph(recs, &both(Bridge::Visible));
     assert!(!r.ok);
     assert_eq!(r.frames[0].bridge_violations, 1);
     assert_eq!(r.frames[1].bridge_violations, r.frames[1].drawn_not_visible);
@@ -185,7 +197,7 @@ fn bridge_policy_and_copies() {
     // A visible triangle drawn twice in one frame.
     let twice = baked(
         &rec,
-        "hidden",
+        Bridge::Hidden,
         vec![0, 1, 2, 2],
         &[(0, 1), (2, 2)],
         &[(0, 3)],
@@ -197,7 +209,7 @@ fn bridge_policy_and_copies() {
     // A copy drawn in no frame.
     let unused = baked(
         &rec,
-        "hidden",
+        Bridge::Hidden,
         vec![0, 1, 2, 1],
         &[(0, 1), (2, 1)],
         &[(0, 3)],
@@ -207,7 +219,7 @@ fn bridge_policy_and_copies() {
     assert_eq!(r.bad_copies, 1);
 
     // A malformed draw is reported, not a panic.
-    let mut broken = both("hidden");
+    let mut broken = both(Bridge::Hidden);
     broken.draws[0].index_count = 300;
     let r = check_graph(recs, &broken);
     assert!(!r.ok && r.problems[0].contains("structure"));
@@ -224,7 +236,13 @@ fn removed_edges_must_exist_and_add_up() {
     });
     rec.frames[1].edges.sort();
     let recs = std::slice::from_ref(&rec);
-    let mut b = baked(&rec, "ignored", vec![0, 1, 2], &[(0, 1), (2, 1)], &[(0, 3)]);
+    let mut b = baked(
+        &rec,
+        Bridge::Ignored,
+        vec![0, 1, 2],
+        &[(0, 1), (2, 1)],
+        &[(0, 3)],
+    );
     // Unbroken cycle: E_f minus nothing is cyclic.
     assert!(!check_graph(recs, &b).ok);
     // Removing B → A (G-local 2 → 0) with its weight, and reporting it, passes.
@@ -249,7 +267,7 @@ fn removed_edges_must_exist_and_add_up() {
 #[test]
 fn malformed_recording_is_reported() {
     let mut rec = recording();
-    let good = baked(&rec, "hidden", vec![0, 1, 2], &[(0, 3)], &[(0, 3)]);
+    let good = baked(&rec, Bridge::Hidden, vec![0, 1, 2], &[(0, 3)], &[(0, 3)]);
     rec.frames[0].visible = vec![B, A];
     let r = check_graph(std::slice::from_ref(&rec), &good);
     assert!(

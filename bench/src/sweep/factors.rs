@@ -4,7 +4,7 @@
 use std::str::FromStr;
 
 use trisort_format::RecordSettings;
-use trisort_merger::{Bridge, LayoutChoice, MergeOptions, StrategyChoice};
+use trisort_merger::{Bridge, Choice, Layout, MergeOptions, Strategy};
 
 use super::SweepConfig;
 use crate::BenchError;
@@ -128,31 +128,6 @@ pub(super) fn same_settings(a: &RecordSettings, b: &RecordSettings) -> bool {
     settings_key(a) == settings_key(b)
 }
 
-/// The default merge options of the CLI (`auto`, `auto`, `hidden`, no segments).
-pub(super) fn default_merge() -> MergeOptions {
-    MergeOptions::default()
-}
-
-fn strategy_name(s: StrategyChoice) -> &'static str {
-    match s {
-        StrategyChoice::Lib => "lib",
-        StrategyChoice::Lbi => "lbi",
-        StrategyChoice::Ilb => "ilb",
-        StrategyChoice::Ibl => "ibl",
-        StrategyChoice::Bli => "bli",
-        StrategyChoice::Bil => "bil",
-        StrategyChoice::Auto => "auto",
-    }
-}
-
-fn layout_name(l: LayoutChoice) -> &'static str {
-    match l {
-        LayoutChoice::Paper => "paper",
-        LayoutChoice::Compact => "compact",
-        LayoutChoice::Auto => "auto",
-    }
-}
-
 /// A float as the sweep names it (`0.998`, `1`, `0.3`).
 pub(super) fn number(v: f32) -> String {
     let s = format!("{v}");
@@ -173,7 +148,7 @@ fn with_default(mut values: Vec<f32>, default: f32) -> Vec<f32> {
 }
 
 pub(super) fn variants(config: &SweepConfig, base: RecordSettings) -> Vec<Variant> {
-    let merge = default_merge();
+    let merge = MergeOptions::default();
     let factors: Vec<Factor> = if config.factors.is_empty() {
         Factor::ALL.to_vec()
     } else {
@@ -215,7 +190,8 @@ pub(super) fn variants(config: &SweepConfig, base: RecordSettings) -> Vec<Varian
                 }
             }
             Factor::Saturation => {
-                for x in with_default(vec![0.99, 0.998, 1.0], base.saturation) {
+                let values = vec![0.99, RecordSettings::DEFAULT_SATURATION, 1.0];
+                for x in with_default(values, base.saturation) {
                     let s = RecordSettings {
                         saturation: x,
                         ..base
@@ -233,37 +209,28 @@ pub(super) fn variants(config: &SweepConfig, base: RecordSettings) -> Vec<Varian
                 }
             }
             Factor::Bridge => {
-                for b in [Bridge::Hidden, Bridge::Ignored, Bridge::Visible] {
+                for b in Bridge::ALL {
                     let m = MergeOptions { bridge: b, ..merge };
-                    out.push(v(b.name().to_string(), base, m));
+                    out.push(v(b.to_string(), base, m));
                 }
             }
             Factor::StrategyLayout => {
-                out.push(v("auto/auto".into(), base, merge));
-                for s in [
-                    StrategyChoice::Lib,
-                    StrategyChoice::Lbi,
-                    StrategyChoice::Ilb,
-                    StrategyChoice::Ibl,
-                    StrategyChoice::Bli,
-                    StrategyChoice::Bil,
-                ] {
-                    for l in [LayoutChoice::Paper, LayoutChoice::Compact] {
+                let auto = format!("{}/{}", merge.strategy, merge.layout);
+                out.push(v(auto, base, merge));
+                for s in Strategy::ALL {
+                    for l in Layout::ALL {
                         let m = MergeOptions {
-                            strategy: s,
-                            layout: l,
+                            strategy: Choice::Only(s),
+                            layout: Choice::Only(l),
                             ..merge
                         };
-                        out.push(v(
-                            format!("{}/{}", strategy_name(s), layout_name(l)),
-                            base,
-                            m,
-                        ));
+                        out.push(v(format!("{s}/{l}"), base, m));
                     }
                 }
             }
             Factor::Segment => {
-                for seg in [None, Some(64), Some(16), Some(4)] {
+                let default = Some(MergeOptions::DEFAULT_SEGMENT);
+                for seg in [None, default, Some(16), Some(4)] {
                     let m = MergeOptions {
                         segment: seg,
                         ..merge
@@ -280,7 +247,6 @@ pub(super) fn variants(config: &SweepConfig, base: RecordSettings) -> Vec<Varian
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sweep::MAX_LAYERS;
 
     #[test]
     fn factors_parse_and_name() {
@@ -300,14 +266,7 @@ mod tests {
     #[test]
     fn variants_cover_every_value_around_the_defaults() {
         let config = SweepConfig::new((256, 128), 4);
-        let base = RecordSettings {
-            width: 256,
-            height: 128,
-            samples: 4,
-            saturation: 0.998,
-            glass_opacity: 0.0,
-            max_layers: MAX_LAYERS,
-        };
+        let base = RecordSettings::new((256, 128), 4);
         let v = variants(&config, base);
         let count = |f: Factor| v.iter().filter(|x| x.factor == f).count();
         assert_eq!(count(Factor::RecordSize), 3);
@@ -322,7 +281,9 @@ mod tests {
             let defaults = v
                 .iter()
                 .filter(|x| {
-                    x.factor == f && same_settings(&x.settings, &base) && x.merge == default_merge()
+                    x.factor == f
+                        && same_settings(&x.settings, &base)
+                        && x.merge == MergeOptions::default()
                 })
                 .count();
             assert_eq!(defaults, 1, "{f}");

@@ -44,6 +44,7 @@ mod output;
 mod run;
 
 use serde::Serialize;
+use trisort_format::RecordSettings;
 
 pub use factors::Factor;
 pub use output::{to_csv, CSV_COLUMNS};
@@ -52,9 +53,6 @@ pub use run::run;
 /// Timed renders of each compared frame per point (after one untimed warm-up render of each);
 /// a frame's time is their median.
 pub const PLAY_REPEATS: u32 = 5;
-
-/// Layer bound of the sweep's recordings and references (the CLI's `--max-layers` default).
-pub const MAX_LAYERS: u32 = 256;
 
 /// The sweep's defaults and playback settings.
 #[derive(Clone, Debug, PartialEq)]
@@ -74,16 +72,28 @@ pub struct SweepConfig {
 }
 
 impl SweepConfig {
-    /// The CLI's defaults at playback `size` and `samples`: saturation 0.998, glass opacity 0,
-    /// every frame, every factor.
+    /// The CLI's defaults at playback `size` and `samples`: the recording defaults of
+    /// [`RecordSettings`] (saturation, glass opacity), every frame, every factor.
     pub fn new(size: (u32, u32), samples: u32) -> SweepConfig {
+        let defaults = RecordSettings::default();
         SweepConfig {
             size,
             samples,
-            saturation: 0.998,
-            glass_opacity: 0.0,
+            saturation: defaults.saturation,
+            glass_opacity: defaults.glass_opacity,
             frames: Vec::new(),
             factors: Factor::ALL.to_vec(),
+        }
+    }
+
+    /// The default point's recording settings: the playback size and samples, the
+    /// configuration's saturation and glass opacity, the default layer bound.
+    fn base_settings(&self) -> RecordSettings {
+        RecordSettings {
+            saturation: self.saturation,
+            // + 0.0: −0 is 0 here, so that it matches the listed value 0 bit for bit.
+            glass_opacity: self.glass_opacity + 0.0,
+            ..RecordSettings::new(self.size, self.samples)
         }
     }
 }

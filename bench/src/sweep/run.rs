@@ -1,6 +1,7 @@
 //! The sweep itself: one recording per distinct recording settings, one exact reference per
 //! glass opacity, one merge and measurement per distinct bake.
 
+use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 use std::path::Path;
 use std::time::Instant;
@@ -12,10 +13,10 @@ use trisort_player::Mode;
 use trisort_recorder::RecordJob;
 use trisort_reference::{ExactReference, ReferenceConfig};
 
-use super::factors::{default_merge, number, same_settings, variants, Factor, Variant};
+use super::factors::{number, same_settings, variants, Factor, Variant};
 use super::measurement::{max, mean, measure, Measured};
 use super::output::write_outputs;
-use super::{SweepConfig, SweepPoint, SweepReport, MAX_LAYERS};
+use super::{SweepConfig, SweepPoint, SweepReport};
 use crate::BenchError;
 
 /// Runs the sweep of `scene` along `timeline` and writes its outputs into `out_dir` (created
@@ -28,30 +29,9 @@ pub fn run(
     out_dir: &Path,
     progress: &dyn Fn(&str),
 ) -> Result<SweepReport, BenchError> {
-    let (w, h) = config.size;
-    if w == 0 || h == 0 {
-        return Err(BenchError::Invalid(format!(
-            "playback size {w}x{h}: both must be positive"
-        )));
-    }
-    if config.samples != 1 && config.samples != 4 {
-        return Err(BenchError::Invalid(format!(
-            "playback samples {}: 1 or 4",
-            config.samples
-        )));
-    }
-    if !(config.saturation > 0.0 && config.saturation <= 1.0) {
-        return Err(BenchError::Invalid(format!(
-            "saturation {}: in (0, 1]",
-            config.saturation
-        )));
-    }
-    if !(0.0..=1.0).contains(&config.glass_opacity) {
-        return Err(BenchError::Invalid(format!(
-            "glass opacity {}: in [0, 1]",
-            config.glass_opacity
-        )));
-    }
+    let base = config.base_settings();
+    base.validate()
+        .map_err(|e| BenchError::Invalid(format!("sweep settings: {e}")))?;
     let path_frames = timeline.frames.len() as u32;
     let frames: Vec<u32> = if config.frames.is_empty() {
         (0..path_frames).collect()
@@ -67,185 +47,27 @@ pub fn run(
         path: out_dir.to_path_buf(),
         source,
     })?;
-
-    let base = RecordSettings {
-        width: w,
-        height: h,
-        samples: config.samples,
-        saturation: config.saturation,
-        // + 0.0: −0 is 0 here, so that it matches the listed value 0 bit for bit.
-        glass_opacity: config.glass_opacity + 0.0,
-        max_layers: MAX_LAYERS,
-    };
     let variants = variants(config, base);
-    // Recordings in first-use order; the default recording first so that the merge factors
-    // share it.
-    let mut recording_order: Vec<RecordSettings> = vec![base];
-    for v in &variants {
-        if !recording_order
-            .iter()
-            .any(|s| same_settings(s, &v.settings))
-        {
-            recording_order.push(v.settings);
-        }
-    }
-
-    let mut references: HashMap<u32, Vec<Vec<u8>>> = HashMap::new();
-    let mut measured: Vec<(RecordSettings, MergeOptions, Measured)> = Vec::new();
-    let total = variants.len();
-    let mut done = 0usize;
-    for settings in &recording_order {
-        let users: Vec<&Variant> = variants
-            .iter()
-            .filter(|v| same_settings(&v.settings, settings))
-            .collect();
-        if users.is_empty() {
-            continue;
-        }
-        progress(&format!(
-            "sweep: recording {}x{}, {} samples, saturation {}, glass {} ({} frames)",
-            settings.width,
-            settings.height,
-            settings.samples,
-            number(settings.saturation),
-            number(settings.glass_opacity),
-            path_frames
-        ));
-        let t = Instant::now();
-        let rec = record(gpu, scene, timeline, *settings)?;
-        let record_seconds = t.elapsed().as_secs_f64();
-        progress(&format!(
-            "sweep: recorded in {record_seconds:.2} s: |G| = {} of {} triangles",
-            rec.unique_visible.len(),
-            rec.scene_triangles
-        ));
-        let glass_key = settings.glass_opacity.to_bits();
-        if let std::collections::hash_map::Entry::Vacant(slot) = references.entry(glass_key) {
-            progress(&format!(
-                "sweep: exact reference at {w}x{h}, {} samples, glass {}: {} frames",
-                config.samples,
-                number(settings.glass_opacity),
-                frames.len()
-            ));
-            slot.insert(reference_frames(
-                gpu,
-                scene,
-                timeline,
-                config,
-                settings.glass_opacity,
-                &frames,
-            )?);
-        }
-        let reference = &references[&glass_key];
-        for v in users {
-            done += 1;
-            let known = measured
-                .iter()
-                .any(|(s, m, _)| same_settings(s, settings) && *m == v.merge);
-            if known {
-                progress(&format!(
-                    "sweep [{done}/{total}] {} = {}: same bake as before",
-                    v.factor, v.value
-                ));
-                continue;
-            }
-            progress(&format!(
-                "sweep [{done}/{total}] {} = {}: merging",
-                v.factor, v.value
-            ));
-            let t = Instant::now();
-            let baked = trisort_merger::merge(std::slice::from_ref(&rec), &v.merge)?;
-            let merge_seconds = t.elapsed().as_secs_f64();
-            let m = measure(
-                gpu,
-                &baked,
-                config,
-                &frames,
-                reference,
-                record_seconds,
-                merge_seconds,
-            )?;
-            progress(&format!(
-                "sweep [{done}/{total}] {} = {}: merge {:.2} s, {} index triangles, {:.1} draws/frame, error {} px, FLIP {:.4}",
-                v.factor, v.value, merge_seconds, m.stats.index_triangles,
-                m.stats.draws_per_frame_mean, m.pixels_differing, mean(&m.flip)
-            ));
-            measured.push((*settings, v.merge, m));
-        }
-    }
-
-    let pixels = frames.len() as f64 * w as f64 * h as f64;
-    let find = |v: &Variant| -> &Measured {
-        &measured
-            .iter()
-            .find(|(s, m, _)| same_settings(s, &v.settings) && *m == v.merge)
-            .expect("every variant was measured")
-            .2
+    let sweep = Sweep {
+        gpu,
+        scene,
+        timeline,
+        config,
+        frames: &frames,
+        progress,
     };
-    let points: Vec<SweepPoint> = variants
-        .iter()
-        .map(|v| {
-            let m = find(v);
-            let includes = v.factor.records();
-            SweepPoint {
-                factor: v.factor.name().to_string(),
-                value: v.value.clone(),
-                is_default: same_settings(&v.settings, &base) && v.merge == default_merge(),
-                record_seconds: m.record_seconds,
-                merge_seconds: m.merge_seconds,
-                bake_seconds: if includes {
-                    m.record_seconds + m.merge_seconds
-                } else {
-                    m.merge_seconds
-                },
-                bake_includes_record: includes,
-                baked_bytes: m.baked_bytes,
-                index_triangles: m.stats.index_triangles,
-                unique_visible: m.stats.unique_visible,
-                unordered_samples: m.stats.unordered_samples,
-                drawn_not_visible_mean: m.stats.drawn_not_visible_mean,
-                draws_per_frame_mean: m.stats.draws_per_frame_mean,
-                draws_per_frame_max: m.stats.draws_per_frame_max,
-                play_ms_mean: mean(&m.play_ms),
-                play_ms_max: max(&m.play_ms),
-                wall_ms_mean: mean(&m.wall_ms),
-                pixels_differing: m.pixels_differing,
-                pixels_differing_fraction: if pixels > 0.0 {
-                    m.pixels_differing as f64 / pixels
-                } else {
-                    0.0
-                },
-                max_channel_diff: m.max_channel_diff,
-                flip_mean: mean(&m.flip),
-            }
-        })
-        .collect();
-    let default = measured
-        .iter()
-        .find(|(s, m, _)| same_settings(s, &base) && *m == default_merge())
-        .map(|x| &x.2);
-    let report = SweepReport {
-        device: gpu.describe(),
-        size: config.size,
-        samples: config.samples,
-        frames,
-        path_frames,
-        scene_triangles: scene.geometry.triangles.len() as u64,
-        default_merge: default.map_or(String::new(), |m| m.strategy_layout.clone()),
-        points,
-        draws_along_path: default.map_or(Vec::new(), |m| {
-            m.draws
-                .iter()
-                .enumerate()
-                .map(|(f, &d)| (f as u32, d))
-                .collect()
-        }),
-    };
+    let measured = sweep.bake_all(base, &variants)?;
+    let report = sweep.report(base, &variants, &measured);
     // Draws along the path of the segment variants too, when that factor ran.
     let segment_draws: Vec<(String, Vec<u32>)> = variants
         .iter()
         .filter(|v| v.factor == Factor::Segment && v.merge.segment.is_some())
-        .map(|v| (format!("segment {}", v.value), find(v).draws.clone()))
+        .map(|v| {
+            (
+                format!("segment {}", v.value),
+                find(&measured, v).draws.clone(),
+            )
+        })
         .collect();
     write_outputs(&report, &segment_draws, out_dir)?;
     progress(&format!(
@@ -255,64 +77,239 @@ pub fn run(
     Ok(report)
 }
 
-/// Records `settings` over the whole path (both phases), in memory.
-fn record(
-    gpu: &Gpu,
-    scene: &trisort_scene::Scene,
-    timeline: &trisort_paths::Timeline,
-    settings: RecordSettings,
-) -> Result<Recording, BenchError> {
-    let job = RecordJob {
-        geometry: &scene.geometry,
-        frames: &timeline.frames,
-        scene_hash: scene.hash(),
-        path_hash: timeline.hash(),
-        settings,
-        range: None,
-        phase: Phase::Graphs,
-        known_visible: None,
-    };
-    let rec = trisort_recorder::record(gpu, &job, None, |_| {})?;
-    if let Some(f) = rec.frames.iter().find(|f| f.truncated) {
-        return Err(BenchError::Invalid(format!(
-            "frame {} hit the layer bound ({MAX_LAYERS}) while recording {}x{}",
-            f.frame, settings.width, settings.height
-        )));
-    }
-    Ok(rec)
+/// Every distinct bake with the settings and merge options it was made with.
+type Bakes = Vec<(RecordSettings, MergeOptions, Measured)>;
+
+/// The measurement of `v`'s bake.
+fn find<'a>(measured: &'a Bakes, v: &Variant) -> &'a Measured {
+    &measured
+        .iter()
+        .find(|(s, m, _)| same_settings(s, &v.settings) && *m == v.merge)
+        .expect("every variant was measured")
+        .2
 }
 
-/// The exact reference's frames at the playback settings with glass opacity `glass`.
-fn reference_frames(
-    gpu: &Gpu,
-    scene: &trisort_scene::Scene,
-    timeline: &trisort_paths::Timeline,
-    config: &SweepConfig,
-    glass: f32,
-    frames: &[u32],
-) -> Result<Vec<Vec<u8>>, BenchError> {
-    let reference = ExactReference::new(
-        gpu,
-        &scene.geometry,
-        &timeline.frames,
-        ReferenceConfig {
-            size: config.size,
-            samples: config.samples,
-            mode: Mode::Blend,
-            glass_opacity: glass,
-            max_layers: 4096,
-        },
-    )?;
-    frames
-        .iter()
-        .map(|&f| {
-            let r = reference.render(f, None)?;
-            if r.truncated {
-                return Err(BenchError::Invalid(format!(
-                    "the exact reference of frame {f} hit its layer bound"
-                )));
+/// What every step of one sweep shares.
+struct Sweep<'a> {
+    gpu: &'a Gpu,
+    scene: &'a trisort_scene::Scene,
+    timeline: &'a trisort_paths::Timeline,
+    config: &'a SweepConfig,
+    /// The frames compared.
+    frames: &'a [u32],
+    progress: &'a dyn Fn(&str),
+}
+
+impl Sweep<'_> {
+    /// Records each distinct recording once (the default `base` first, so that the merge
+    /// factors share it), renders the exact reference once per glass opacity, and merges and
+    /// measures each distinct bake once.
+    fn bake_all(&self, base: RecordSettings, variants: &[Variant]) -> Result<Bakes, BenchError> {
+        let mut recording_order: Vec<RecordSettings> = vec![base];
+        for v in variants {
+            if !recording_order
+                .iter()
+                .any(|s| same_settings(s, &v.settings))
+            {
+                recording_order.push(v.settings);
             }
-            Ok(r.rgba8)
-        })
-        .collect()
+        }
+        let mut references: HashMap<u32, Vec<Vec<u8>>> = HashMap::new();
+        let mut measured: Bakes = Vec::new();
+        let mut done = 0usize;
+        for settings in &recording_order {
+            let users: Vec<&Variant> = variants
+                .iter()
+                .filter(|v| same_settings(&v.settings, settings))
+                .collect();
+            if users.is_empty() {
+                continue;
+            }
+            let (rec, record_seconds) = self.record(*settings)?;
+            let glass_key = settings.glass_opacity.to_bits();
+            if let Entry::Vacant(slot) = references.entry(glass_key) {
+                slot.insert(self.reference_frames(settings.glass_opacity)?);
+            }
+            let reference = &references[&glass_key];
+            for v in users {
+                done += 1;
+                let step = format!(
+                    "sweep [{done}/{}] {} = {}",
+                    variants.len(),
+                    v.factor,
+                    v.value
+                );
+                let known = measured
+                    .iter()
+                    .any(|(s, m, _)| same_settings(s, settings) && *m == v.merge);
+                if known {
+                    (self.progress)(&format!("{step}: same bake as before"));
+                    continue;
+                }
+                (self.progress)(&format!("{step}: merging"));
+                let t = Instant::now();
+                let baked = trisort_merger::merge(std::slice::from_ref(&rec), &v.merge)?;
+                let merge_seconds = t.elapsed().as_secs_f64();
+                let m = measure(
+                    self.gpu,
+                    &baked,
+                    self.config,
+                    self.frames,
+                    reference,
+                    record_seconds,
+                    merge_seconds,
+                )?;
+                (self.progress)(&format!(
+                    "{step}: merge {:.2} s, {} index triangles, {:.1} draws/frame, error {} px, FLIP {:.4}",
+                    merge_seconds, m.stats.index_triangles,
+                    m.stats.draws_per_frame_mean, m.pixels_differing, mean(&m.flip)
+                ));
+                measured.push((*settings, v.merge, m));
+            }
+        }
+        Ok(measured)
+    }
+
+    /// The report: one point per variant (the default recording is `base`), and the default
+    /// bake's draws along the path.
+    fn report(&self, base: RecordSettings, variants: &[Variant], measured: &Bakes) -> SweepReport {
+        let (w, h) = self.config.size;
+        let pixels = self.frames.len() as f64 * w as f64 * h as f64;
+        let points: Vec<SweepPoint> = variants
+            .iter()
+            .map(|v| {
+                let m = find(measured, v);
+                let includes = v.factor.records();
+                SweepPoint {
+                    factor: v.factor.name().to_string(),
+                    value: v.value.clone(),
+                    is_default: same_settings(&v.settings, &base)
+                        && v.merge == MergeOptions::default(),
+                    record_seconds: m.record_seconds,
+                    merge_seconds: m.merge_seconds,
+                    bake_seconds: if includes {
+                        m.record_seconds + m.merge_seconds
+                    } else {
+                        m.merge_seconds
+                    },
+                    bake_includes_record: includes,
+                    baked_bytes: m.baked_bytes,
+                    index_triangles: m.stats.index_triangles,
+                    unique_visible: m.stats.unique_visible,
+                    unordered_samples: m.stats.unordered_samples,
+                    drawn_not_visible_mean: m.stats.drawn_not_visible_mean,
+                    draws_per_frame_mean: m.stats.draws_per_frame_mean,
+                    draws_per_frame_max: m.stats.draws_per_frame_max,
+                    play_ms_mean: mean(&m.play_ms),
+                    play_ms_max: max(&m.play_ms),
+                    wall_ms_mean: mean(&m.wall_ms),
+                    pixels_differing: m.pixels_differing,
+                    pixels_differing_fraction: if pixels > 0.0 {
+                        m.pixels_differing as f64 / pixels
+                    } else {
+                        0.0
+                    },
+                    max_channel_diff: m.max_channel_diff,
+                    flip_mean: mean(&m.flip),
+                }
+            })
+            .collect();
+        let default = measured
+            .iter()
+            .find(|(s, m, _)| same_settings(s, &base) && *m == MergeOptions::default())
+            .map(|x| &x.2);
+        SweepReport {
+            device: self.gpu.describe(),
+            size: self.config.size,
+            samples: self.config.samples,
+            frames: self.frames.to_vec(),
+            path_frames: self.timeline.frames.len() as u32,
+            scene_triangles: self.scene.geometry.triangles.len() as u64,
+            default_merge: default.map_or(String::new(), |m| m.strategy_layout.clone()),
+            points,
+            draws_along_path: default.map_or(Vec::new(), |m| {
+                m.draws
+                    .iter()
+                    .enumerate()
+                    .map(|(f, &d)| (f as u32, d))
+                    .collect()
+            }),
+        }
+    }
+
+    /// Records `settings` over the whole path (both phases), in memory; returns the
+    /// recording and its wall time in seconds.
+    fn record(&self, settings: RecordSettings) -> Result<(Recording, f64), BenchError> {
+        (self.progress)(&format!(
+            "sweep: recording {}x{}, {} samples, saturation {}, glass {} ({} frames)",
+            settings.width,
+            settings.height,
+            settings.samples,
+            number(settings.saturation),
+            number(settings.glass_opacity),
+            self.timeline.frames.len()
+        ));
+        let t = Instant::now();
+        let job = RecordJob {
+            geometry: &self.scene.geometry,
+            frames: &self.timeline.frames,
+            scene_hash: self.scene.hash(),
+            path_hash: self.timeline.hash(),
+            settings,
+            range: None,
+            phase: Phase::Graphs,
+            known_visible: None,
+        };
+        let rec = trisort_recorder::record(self.gpu, &job, None, |_| {})?;
+        if let Some(f) = rec.frames.iter().find(|f| f.truncated) {
+            return Err(BenchError::Invalid(format!(
+                "frame {} hit the layer bound ({}) while recording {}x{}",
+                f.frame, settings.max_layers, settings.width, settings.height
+            )));
+        }
+        let seconds = t.elapsed().as_secs_f64();
+        (self.progress)(&format!(
+            "sweep: recorded in {seconds:.2} s: |G| = {} of {} triangles",
+            rec.unique_visible.len(),
+            rec.scene_triangles
+        ));
+        Ok((rec, seconds))
+    }
+
+    /// The exact reference's frames at the playback settings with glass opacity `glass`.
+    fn reference_frames(&self, glass: f32) -> Result<Vec<Vec<u8>>, BenchError> {
+        let config = self.config;
+        (self.progress)(&format!(
+            "sweep: exact reference at {}x{}, {} samples, glass {}: {} frames",
+            config.size.0,
+            config.size.1,
+            config.samples,
+            number(glass),
+            self.frames.len()
+        ));
+        let reference = ExactReference::new(
+            self.gpu,
+            &self.scene.geometry,
+            &self.timeline.frames,
+            ReferenceConfig {
+                size: config.size,
+                samples: config.samples,
+                mode: Mode::Blend,
+                glass_opacity: glass,
+                max_layers: 4096,
+            },
+        )?;
+        self.frames
+            .iter()
+            .map(|&f| {
+                let r = reference.render(f, None)?;
+                if r.truncated {
+                    return Err(BenchError::Invalid(format!(
+                        "the exact reference of frame {f} hit its layer bound"
+                    )));
+                }
+                Ok(r.rgba8)
+            })
+            .collect()
+    }
 }
