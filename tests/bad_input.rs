@@ -97,8 +97,8 @@ fn container_cases(bytes: &[u8]) -> Vec<(&'static str, Vec<u8>, &'static str)> {
     b[..8].copy_from_slice(b"NOTTRIS\0");
     v.push(("magic", b, "wrong magic"));
     let mut b = bytes.to_vec();
-    b[8..12].copy_from_slice(&2u32.to_le_bytes());
-    v.push(("version", b, "format version 2 is not supported"));
+    b[8..12].copy_from_slice(&(trisort_format::FORMAT_VERSION + 1).to_le_bytes());
+    v.push(("version", b, "is not supported (this trisort reads version"));
     let mut b = bytes.to_vec();
     let k = b.len() - 5;
     b[k] ^= 0x40;

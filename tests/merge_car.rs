@@ -5,18 +5,9 @@
 use std::path::Path;
 
 use trisort_format::{Baked, FileKind, Recording};
-use trisort_merger::{LayoutChoice, MergeOptions, StrategyChoice};
+use trisort_merger::{Choice, Layout, MergeOptions, Strategy};
 
 use crate::support::*;
-
-const STRATEGIES: [StrategyChoice; 6] = [
-    StrategyChoice::Lib,
-    StrategyChoice::Lbi,
-    StrategyChoice::Ilb,
-    StrategyChoice::Ibl,
-    StrategyChoice::Bli,
-    StrategyChoice::Bil,
-];
 
 fn read_baked(path: &Path) -> Baked {
     trisort_format::read_file(FileKind::Baked, path).unwrap()
@@ -51,11 +42,11 @@ fn car_concept_orbit_merges_validly_with_every_strategy_and_layout() {
         trisort_format::read_file(FileKind::Recording, &d.join("car.rec")).unwrap();
     let recs = std::slice::from_ref(&rec);
     let mut fewest = u64::MAX;
-    for strategy in STRATEGIES {
-        for layout in [LayoutChoice::Paper, LayoutChoice::Compact] {
+    for strategy in Strategy::ALL {
+        for layout in Layout::ALL {
             let opts = MergeOptions {
-                strategy,
-                layout,
+                strategy: Choice::Only(strategy),
+                layout: Choice::Only(layout),
                 ..MergeOptions::default()
             };
             let baked = trisort_merger::merge(recs, &opts).unwrap();
