@@ -716,96 +716,101 @@ pub fn write_outputs(rows: &[ScalingRow], out_dir: &Path, name: &str) -> Result<
     write_atomic(&file(".json"), text.as_bytes())?;
 
     let has = |axis: &str| rows.iter().any(|r| r.axis == axis);
-    let exp = |pts: &[(f64, f64)]| {
-        growth_exponent(pts).map_or(String::new(), |e| format!(" (log-log slope {e:.2})"))
-    };
-    let series = |label: &str, pts: Vec<(f64, f64)>| Series {
-        name: format!("{label}{}", exp(&pts)),
-        points: pts,
-    };
     if has(AXIS_TRIANGLES) {
-        let tri = |r: &ScalingRow| r.triangles as f64;
-        let chart = Chart {
-            title: "Bake cost against scene triangles".into(),
-            x_label: "scene triangles".into(),
-            y_label: "seconds".into(),
-            log_x: true,
-            log_y: true,
-            series: vec![
-                series(
-                    "record",
-                    points(rows, AXIS_TRIANGLES, tri, |r| r.record_seconds),
-                ),
-                series(
-                    "record (CPU time)",
-                    points(rows, AXIS_TRIANGLES, tri, |r| {
-                        r.record_cpu_seconds.unwrap_or(f64::NAN)
-                    }),
-                ),
-                series(
-                    "merge",
-                    points(rows, AXIS_TRIANGLES, tri, |r| r.merge_seconds),
-                ),
+        let c = log_x_chart(
+            rows,
+            [
+                "Bake cost against scene triangles",
+                "scene triangles",
+                "seconds",
             ],
-        };
-        write_svg(&file("-triangles.svg"), &chart, Style::Lines)?;
+            (|r| r.triangles as f64, true),
+            &[
+                ("record", AXIS_TRIANGLES, |r| r.record_seconds),
+                ("record (CPU time)", AXIS_TRIANGLES, |r| {
+                    r.record_cpu_seconds.unwrap_or(f64::NAN)
+                }),
+                ("merge", AXIS_TRIANGLES, |r| r.merge_seconds),
+            ],
+        );
+        write_svg(&file("-triangles.svg"), &c, Style::Lines)?;
     }
     if has(AXIS_FRAMES) || has(AXIS_FRAMES_SEGMENTED) || has(AXIS_SYNTHETIC) {
-        let fr = |r: &ScalingRow| f64::from(r.frames);
-        let chart = Chart {
-            title: "Bake cost against frames".into(),
-            x_label: "frames".into(),
-            y_label: "seconds".into(),
-            log_x: true,
-            log_y: true,
-            series: vec![
-                series(
-                    "record s/frame",
-                    points(rows, AXIS_FRAMES, fr, |r| r.record_seconds_per_frame),
-                ),
-                series(
-                    "merge s (one matrix)",
-                    points(rows, AXIS_FRAMES, fr, |r| r.merge_seconds),
-                ),
-                series(
-                    "merge s (segments)",
-                    points(rows, AXIS_FRAMES_SEGMENTED, fr, |r| r.merge_seconds),
-                ),
-                series(
-                    "merge s (synthetic, segments)",
-                    points(rows, AXIS_SYNTHETIC, fr, |r| r.merge_seconds),
-                ),
-            ]
-            .into_iter()
-            .filter(|s| !s.points.is_empty())
-            .collect(),
-        };
-        write_svg(&file("-frames.svg"), &chart, Style::Lines)?;
-        let chart = Chart {
-            title: "Copies per triangle of G against frames".into(),
-            x_label: "frames".into(),
-            y_label: "index triangles / |G|".into(),
-            log_x: true,
-            log_y: false,
-            series: vec![
-                series(
-                    "demo car, one matrix",
-                    points(rows, AXIS_FRAMES, fr, ScalingRow::index_ratio),
-                ),
-                series(
+        let frames = |r: &ScalingRow| f64::from(r.frames);
+        let c = log_x_chart(
+            rows,
+            ["Bake cost against frames", "frames", "seconds"],
+            (frames, true),
+            &[
+                ("record s/frame", AXIS_FRAMES, |r| {
+                    r.record_seconds_per_frame
+                }),
+                ("merge s (one matrix)", AXIS_FRAMES, |r| r.merge_seconds),
+                ("merge s (segments)", AXIS_FRAMES_SEGMENTED, |r| {
+                    r.merge_seconds
+                }),
+                ("merge s (synthetic, segments)", AXIS_SYNTHETIC, |r| {
+                    r.merge_seconds
+                }),
+            ],
+        );
+        write_svg(&file("-frames.svg"), &c, Style::Lines)?;
+        let c = log_x_chart(
+            rows,
+            [
+                "Copies per triangle of G against frames",
+                "frames",
+                "index triangles / |G|",
+            ],
+            (frames, false),
+            &[
+                ("demo car, one matrix", AXIS_FRAMES, ScalingRow::index_ratio),
+                (
                     "demo car, segments",
-                    points(rows, AXIS_FRAMES_SEGMENTED, fr, ScalingRow::index_ratio),
+                    AXIS_FRAMES_SEGMENTED,
+                    ScalingRow::index_ratio,
                 ),
-                series(
+                (
                     "synthetic, segments",
-                    points(rows, AXIS_SYNTHETIC, fr, ScalingRow::index_ratio),
+                    AXIS_SYNTHETIC,
+                    ScalingRow::index_ratio,
                 ),
-            ]
-            .into_iter()
-            .filter(|s| !s.points.is_empty())
-            .collect(),
-        };
-        write_svg(&file("-index.svg"), &chart, Style::Lines)?;
+            ],
+        );
+        write_svg(&file("-index.svg"), &c, Style::Lines)?;
     }
     Ok(())
+}
+
+/// One plotted line of a scaling chart: its label, the axis whose rows it shows, and y.
+type Line = (&'static str, &'static str, fn(&ScalingRow) -> f64);
+
+/// A chart of `rows` with a logarithmic x axis: `[title, x label, y label]`, x and whether y
+/// is logarithmic, and one series per line that has points, named with its log-log slope.
+fn log_x_chart(
+    rows: &[ScalingRow],
+    [title, x_label, y_label]: [&str; 3],
+    (x, log_y): (fn(&ScalingRow) -> f64, bool),
+    lines: &[Line],
+) -> Chart {
+    Chart {
+        title: title.into(),
+        x_label: x_label.into(),
+        y_label: y_label.into(),
+        log_x: true,
+        log_y,
+        series: lines
+            .iter()
+            .map(|&(label, axis, y)| {
+                let pts = points(rows, axis, x, y);
+                let slope = growth_exponent(&pts)
+                    .map_or(String::new(), |e| format!(" (log-log slope {e:.2})"));
+                Series {
+                    name: format!("{label}{slope}"),
+                    points: pts,
+                }
+            })
+            .filter(|s| !s.points.is_empty())
+            .collect(),
+    }
 }

@@ -8,9 +8,9 @@
 
 use serde::Serialize;
 use trisort_format::{Baked, FrameState, Geometry};
+use trisort_gpu::Gpu;
 use trisort_player::Mode;
 use trisort_reference::{compare, ExactReference, ReferenceConfig, ReferenceError, RemovedEdges};
-use trisort_gpu::Gpu;
 
 use crate::harness::{pipeline_statistics, time_methods, FragmentCounter, Summary, Timing};
 use crate::methods::{default_depth, BenchView, DefaultMethod, Method, PlayerMethod};

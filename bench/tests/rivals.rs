@@ -3,12 +3,12 @@
 //! its budget) and GPU depth peeling both equal the exact reference byte for byte, in `blend`
 //! and (peeling) `depth` mode; the default pipeline does not.
 
+use trisort_gpu::scene_gpu::View;
 use trisort_player::Mode;
 use trisort_reference::{
     DefaultRenderer, ExactReference, OitConfig, OitRenderer, PeelingConfig, PeelingRenderer,
     ReferenceConfig,
 };
-use trisort_gpu::scene_gpu::View;
 use trisort_testkit::gpu;
 
 #[test]
@@ -54,8 +54,7 @@ fn oit_and_peeling_equal_the_reference_on_glass_vase_flowers() {
                     glass_opacity: glass,
                     ..OitConfig::new(size, samples)
                 };
-                OitRenderer::new(&gpu, &scene.geometry, &frames, config)
-                .expect("oit")
+                OitRenderer::new(&gpu, &scene.geometry, &frames, config).expect("oit")
             });
             let default = (mode == Mode::Blend).then(|| {
                 DefaultRenderer::new(

@@ -87,134 +87,172 @@ fn break_component(edges: &[(u32, u32, u32)], ids: &[usize]) -> Vec<usize> {
         .iter()
         .map(|&k| (local(edges[k].0), local(edges[k].1), edges[k].2 as u64))
         .collect();
-    let (out_off, out_e) = csr(n, le.iter().enumerate().map(|(e, x)| (x.0, e as u32)));
-    let (in_off, in_e) = csr(n, le.iter().enumerate().map(|(e, x)| (x.1, e as u32)));
-
-    let mut alive = vec![true; n];
-    let mut indeg = vec![0u32; n];
-    let mut outdeg = vec![0u32; n];
-    let mut win = vec![0i64; n];
-    let mut wout = vec![0i64; n];
-    for &(a, b, w) in &le {
-        outdeg[a as usize] += 1;
-        indeg[b as usize] += 1;
-        wout[a as usize] += w as i64;
-        win[b as usize] += w as i64;
-    }
-    // Candidates by δ = w_out − w_in, largest first (ties: smallest vertex).
-    let mut by_delta: BTreeSet<(i64, std::cmp::Reverse<u32>)> = (0..n as u32)
-        .map(|v| (wout[v as usize] - win[v as usize], std::cmp::Reverse(v)))
-        .collect();
-    let mut sinks: Vec<u32> = Vec::new();
-    let mut sources: Vec<u32> = Vec::new();
-    let mut front: Vec<u32> = Vec::with_capacity(n);
-    let mut back: Vec<u32> = Vec::new();
-    let mut left = n;
-    // Removes v from the graph, updating neighbours' degrees, weights and queues.
-    let mut remove = |v: u32,
-                      alive: &mut Vec<bool>,
-                      by_delta: &mut BTreeSet<(i64, std::cmp::Reverse<u32>)>,
-                      sinks: &mut Vec<u32>,
-                      sources: &mut Vec<u32>| {
-        alive[v as usize] = false;
-        by_delta.remove(&(wout[v as usize] - win[v as usize], std::cmp::Reverse(v)));
-        for &e in &out_e[out_off[v as usize] as usize..out_off[v as usize + 1] as usize] {
-            let (_, b, w) = le[e as usize];
-            if alive[b as usize] {
-                let old = (wout[b as usize] - win[b as usize], std::cmp::Reverse(b));
-                by_delta.remove(&old);
-                indeg[b as usize] -= 1;
-                win[b as usize] -= w as i64;
-                by_delta.insert((wout[b as usize] - win[b as usize], std::cmp::Reverse(b)));
-                if indeg[b as usize] == 0 {
-                    sources.push(b);
-                }
-            }
-        }
-        for &e in &in_e[in_off[v as usize] as usize..in_off[v as usize + 1] as usize] {
-            let (a, _, w) = le[e as usize];
-            if alive[a as usize] {
-                let old = (wout[a as usize] - win[a as usize], std::cmp::Reverse(a));
-                by_delta.remove(&old);
-                outdeg[a as usize] -= 1;
-                wout[a as usize] -= w as i64;
-                by_delta.insert((wout[a as usize] - win[a as usize], std::cmp::Reverse(a)));
-                if outdeg[a as usize] == 0 {
-                    sinks.push(a);
-                }
-            }
-        }
-    };
-    while left > 0 {
-        if let Some(v) = sinks.pop() {
-            if alive[v as usize] {
-                back.push(v);
-                left -= 1;
-                remove(v, &mut alive, &mut by_delta, &mut sinks, &mut sources);
-            }
-            continue;
-        }
-        if let Some(v) = sources.pop() {
-            if alive[v as usize] {
-                front.push(v);
-                left -= 1;
-                remove(v, &mut alive, &mut by_delta, &mut sinks, &mut sources);
-            }
-            continue;
-        }
-        let &(_, std::cmp::Reverse(v)) = by_delta.iter().next_back().expect("a live vertex");
-        front.push(v);
-        left -= 1;
-        remove(v, &mut alive, &mut by_delta, &mut sinks, &mut sources);
-    }
-    back.reverse();
-    front.extend(back);
+    let order = Els::new(n, &le).order();
     let mut pos = vec![0u32; n];
-    for (p, &v) in front.iter().enumerate() {
+    for (p, &v) in order.iter().enumerate() {
         pos[v as usize] = p as u32;
     }
     let mut cut: Vec<usize> = (0..le.len())
         .filter(|&e| pos[le[e].0 as usize] > pos[le[e].1 as usize])
         .collect();
-
-    // Minimality: put back every removed edge that closes no cycle, heaviest first.
     if (cut.len() as u64).saturating_mul(le.len() as u64) <= 50_000_000 {
-        cut.sort_by_key(|&e| (std::cmp::Reverse(le[e].2), e));
-        let mut kept = vec![true; le.len()];
-        for &e in &cut {
-            kept[e] = false;
-        }
-        let mut mark = vec![u32::MAX; n];
-        let mut stack = Vec::new();
-        for (round, &e) in cut.iter().enumerate() {
-            let (a, b, _) = le[e];
-            // Does b reach a through kept edges? Then a → b would close a cycle.
-            stack.clear();
-            stack.push(b);
-            mark[b as usize] = round as u32;
-            let mut closes = false;
-            while let Some(v) = stack.pop() {
-                if v == a {
-                    closes = true;
-                    break;
-                }
-                for &o in &out_e[out_off[v as usize] as usize..out_off[v as usize + 1] as usize] {
-                    let t = le[o as usize].1;
-                    if kept[o as usize] && mark[t as usize] != round as u32 {
-                        mark[t as usize] = round as u32;
-                        stack.push(t);
-                    }
-                }
-            }
-            if !closes {
-                kept[e] = true;
-            }
-        }
-        cut.retain(|&e| !kept[e]);
+        put_back_harmless(n, &le, &mut cut);
     }
     let mut out: Vec<usize> = cut.into_iter().map(|e| ids[e]).collect();
     out.sort_unstable();
     out
+}
+
+/// Edge sides: an edge leaves its source by the `OUT` side and enters its target by the `IN`
+/// side; the per-side arrays of [`Els`] are indexed by them.
+const OUT: usize = 0;
+const IN: usize = 1;
+
+/// The state of the greedy Eades–Lin–Smyth order on one component (local vertex ids).
+struct Els<'a> {
+    /// Edges `(from, to, weight)`.
+    le: &'a [(u32, u32, u64)],
+    /// Per side, the [`csr`] lists of edge ids: `OUT` by source, `IN` by target.
+    adj: [(Vec<u32>, Vec<u32>); 2],
+    alive: Vec<bool>,
+    /// Per side, live edges and their total weight at each vertex.
+    degree: [Vec<u32>; 2],
+    weight: [Vec<i64>; 2],
+    /// Candidates by δ = w_out − w_in, largest last (ties: smallest vertex).
+    by_delta: BTreeSet<(i64, std::cmp::Reverse<u32>)>,
+    /// Per side, vertices whose degree on that side fell to 0: `OUT` sinks, `IN` sources.
+    empty: [Vec<u32>; 2],
+}
+
+impl<'a> Els<'a> {
+    fn new(n: usize, le: &'a [(u32, u32, u64)]) -> Els<'a> {
+        let adj = [
+            csr(n, le.iter().enumerate().map(|(e, x)| (x.0, e as u32))),
+            csr(n, le.iter().enumerate().map(|(e, x)| (x.1, e as u32))),
+        ];
+        let mut degree = [vec![0u32; n], vec![0u32; n]];
+        let mut weight = [vec![0i64; n], vec![0i64; n]];
+        for &(a, b, w) in le {
+            for (side, v) in [(OUT, a), (IN, b)] {
+                degree[side][v as usize] += 1;
+                weight[side][v as usize] += w as i64;
+            }
+        }
+        let mut els = Els {
+            le,
+            adj,
+            alive: vec![true; n],
+            degree,
+            weight,
+            by_delta: BTreeSet::new(),
+            empty: [Vec::new(), Vec::new()],
+        };
+        els.by_delta = (0..n as u32).map(|v| els.key(v)).collect();
+        els
+    }
+
+    fn key(&self, v: u32) -> (i64, std::cmp::Reverse<u32>) {
+        let v = v as usize;
+        (
+            self.weight[OUT][v] - self.weight[IN][v],
+            std::cmp::Reverse(v as u32),
+        )
+    }
+
+    /// Removes v from the graph, updating its live neighbours' degrees, weights and queues.
+    fn remove(&mut self, v: u32) {
+        self.alive[v as usize] = false;
+        self.by_delta.remove(&self.key(v));
+        // v's out-edges change their targets' IN side, its in-edges their sources' OUT side.
+        for side in [OUT, IN] {
+            let (off, list) = &self.adj[side];
+            let edges = &list[off[v as usize] as usize..off[v as usize + 1] as usize];
+            for &e in edges {
+                let (a, b, w) = self.le[e as usize];
+                let (u, other) = if side == OUT { (b, IN) } else { (a, OUT) };
+                if self.alive[u as usize] {
+                    self.by_delta.remove(&self.key(u));
+                    self.degree[other][u as usize] -= 1;
+                    self.weight[other][u as usize] -= w as i64;
+                    self.by_delta.insert(self.key(u));
+                    if self.degree[other][u as usize] == 0 {
+                        self.empty[other].push(u);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The greedy order: sinks peeled to the back, sources to the front, otherwise the
+    /// vertex with the largest δ to the front.
+    fn order(mut self) -> Vec<u32> {
+        let n = self.alive.len();
+        let mut front: Vec<u32> = Vec::with_capacity(n);
+        let mut back: Vec<u32> = Vec::new();
+        let mut left = n;
+        while left > 0 {
+            let (v, to_back) = if let Some(v) = self.empty[OUT].pop() {
+                (v, true)
+            } else if let Some(v) = self.empty[IN].pop() {
+                (v, false)
+            } else {
+                let &(_, std::cmp::Reverse(v)) =
+                    self.by_delta.iter().next_back().expect("a live vertex");
+                (v, false)
+            };
+            if !self.alive[v as usize] {
+                continue;
+            }
+            if to_back {
+                back.push(v)
+            } else {
+                front.push(v)
+            }
+            left -= 1;
+            self.remove(v);
+        }
+        back.reverse();
+        front.extend(back);
+        front
+    }
+}
+
+/// Minimality: puts back every edge of `cut` whose re-insertion closes no cycle with the
+/// edges kept, heaviest first, and leaves in `cut` the edges still removed.
+fn put_back_harmless(n: usize, le: &[(u32, u32, u64)], cut: &mut Vec<usize>) {
+    let (out_off, out_e) = csr(n, le.iter().enumerate().map(|(e, x)| (x.0, e as u32)));
+    cut.sort_by_key(|&e| (std::cmp::Reverse(le[e].2), e));
+    let mut kept = vec![true; le.len()];
+    for &e in cut.iter() {
+        kept[e] = false;
+    }
+    let mut mark = vec![u32::MAX; n];
+    let mut stack = Vec::new();
+    for (round, &e) in cut.iter().enumerate() {
+        let (a, b, _) = le[e];
+        // Does b reach a through kept edges? Then a → b would close a cycle.
+        stack.clear();
+        stack.push(b);
+        mark[b as usize] = round as u32;
+        let mut closes = false;
+        while let Some(v) = stack.pop() {
+            if v == a {
+                closes = true;
+                break;
+            }
+            for &o in &out_e[out_off[v as usize] as usize..out_off[v as usize + 1] as usize] {
+                let t = le[o as usize].1;
+                if kept[o as usize] && mark[t as usize] != round as u32 {
+                    mark[t as usize] = round as u32;
+                    stack.push(t);
+                }
+            }
+        }
+        if !closes {
+            kept[e] = true;
+        }
+    }
+    cut.retain(|&e| !kept[e]);
 }
 
 /// Compressed adjacency: `(offsets, items)` with the items of key k at

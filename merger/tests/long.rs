@@ -1,40 +1,47 @@
 //! Long synthetic paths: draws per frame stay bounded, cells stay sparse, and the result
 //! still validates.
 
+use trisort_format::Baked;
 use trisort_merger::synth::{turntable, Turntable};
 use trisort_merger::{merge, Choice, Layout, MergeOptions, Strategy};
 use trisort_verify::check_graph;
 
-fn ibl_compact(segment: Option<u32>) -> MergeOptions {
-    MergeOptions {
+/// Merges the turntable `t` (IBL, compact layout, segments of `segment` frames), prints the
+/// figures and the time under `what`, and checks the result with the validator.
+fn merged_and_valid(what: &str, t: Turntable, segment: Option<u32>) -> Baked {
+    let rec = turntable(&t);
+    let opts = MergeOptions {
         strategy: Choice::Only(Strategy::Ibl),
         layout: Choice::Only(Layout::Compact),
         segment,
         ..MergeOptions::default()
-    }
+    };
+    let t = std::time::Instant::now();
+    let baked = merge(std::slice::from_ref(&rec), &opts).unwrap();
+    let secs = t.elapsed().as_secs_f64();
+    eprintln!(
+        "{what}: {:?}, cells {}, {secs:.2} s",
+        baked.stats,
+        baked.merge.cells.len()
+    );
+    let report = check_graph(std::slice::from_ref(&rec), &baked);
+    assert!(report.ok, "{what}: {:?}", report.problems);
+    baked
 }
 
 /// 1,000 frames (a full turn) in one matrix.
 #[test]
 fn thousand_frames_merge_with_bounded_draws() {
-    let rec = turntable(&Turntable {
+    let turn = Turntable {
         objects: 12,
         sides: 16,
         frames: 1000,
         samples: 128,
         degrees: 360.0,
         ..Turntable::default()
-    });
-    let t = std::time::Instant::now();
-    let baked = merge(std::slice::from_ref(&rec), &ibl_compact(None)).unwrap();
-    let secs = t.elapsed().as_secs_f64();
-    let report = check_graph(std::slice::from_ref(&rec), &baked);
-    assert!(report.ok, "{:?}", report.problems);
+    };
+    let baked = merged_and_valid("1,000 frames", turn, None);
     let s = &baked.stats;
-    eprintln!(
-        "1,000 frames: {s:?}, cells {}, {secs:.2} s",
-        baked.merge.cells.len()
-    );
     assert!(s.unique_visible <= s.index_triangles && s.index_triangles <= s.source_triangles);
     // A window is a set of cells; merged ranges can never outnumber the frame's cells, and
     // the compact layout bounds them by max(f+1, F−f). Far fewer are used in practice.
@@ -60,22 +67,16 @@ fn thousand_frames_merge_with_bounded_draws() {
 /// 10,000 frames in segments of 100: every segment has its own matrix.
 #[test]
 fn ten_thousand_frames_in_segments() {
-    let rec = turntable(&Turntable {
+    let turn = Turntable {
         objects: 6,
         sides: 12,
         frames: 10_000,
         samples: 64,
         degrees: 3600.0,
         ..Turntable::default()
-    });
-    let t = std::time::Instant::now();
-    let baked = merge(std::slice::from_ref(&rec), &ibl_compact(Some(100))).unwrap();
-    let secs = t.elapsed().as_secs_f64();
+    };
+    let baked = merged_and_valid("10,000 frames", turn, Some(100));
     let s = &baked.stats;
-    eprintln!(
-        "10,000 frames: {s:?}, cells {}, {secs:.2} s",
-        baked.merge.cells.len()
-    );
     assert!(s.index_triangles <= s.source_triangles);
     // No cell crosses a segment boundary, and a window never holds more ranges than its
     // segment's compact bound.
@@ -91,6 +92,4 @@ fn ten_thousand_frames_in_segments() {
         "{} cells",
         baked.merge.cells.len()
     );
-    let report = check_graph(std::slice::from_ref(&rec), &baked);
-    assert!(report.ok, "{:?}", report.problems);
 }

@@ -132,42 +132,30 @@ pub(super) fn write_outputs(
         report.samples,
         report.frames.len()
     );
-    let error_label = "pixels differing from the exact reference (fraction)";
-    let (series, labels) = per_factor(
-        &report.points,
+    // Error (pixels differing) against a cost, one labelled series per factor.
+    let error_vs = |file: &str, cost: &str, x_label: &str, x: fn(&SweepPoint) -> f64| {
+        let (series, labels) = per_factor(&report.points, x, |p| p.pixels_differing_fraction);
+        let chart = Chart {
+            title: format!("Sweep: error vs {cost} ({subtitle}; * default)"),
+            x_label: x_label.into(),
+            y_label: "pixels differing from the exact reference (fraction)".into(),
+            log_x: true,
+            log_y: false,
+            series,
+        };
+        write_svg_labelled(&out_dir.join(file), &chart, Style::Points, &labels)
+    };
+    error_vs(
+        "sweep-error-vs-bake-time.svg",
+        "bake time",
+        "bake seconds (record + merge; merge only for merge factors)",
         |p| p.bake_seconds,
-        |p| p.pixels_differing_fraction,
-    );
-    write_svg_labelled(
-        &out_dir.join("sweep-error-vs-bake-time.svg"),
-        &Chart {
-            title: format!("Sweep: error vs bake time ({subtitle}; * default)"),
-            x_label: "bake seconds (record + merge; merge only for merge factors)".into(),
-            y_label: error_label.into(),
-            log_x: true,
-            log_y: false,
-            series,
-        },
-        Style::Points,
-        &labels,
     )?;
-    let (series, labels) = per_factor(
-        &report.points,
+    error_vs(
+        "sweep-error-vs-baked-size.svg",
+        "baked size",
+        "baked file size (MiB)",
         |p| p.baked_bytes as f64 / (1024.0 * 1024.0),
-        |p| p.pixels_differing_fraction,
-    );
-    write_svg_labelled(
-        &out_dir.join("sweep-error-vs-baked-size.svg"),
-        &Chart {
-            title: format!("Sweep: error vs baked size ({subtitle}; * default)"),
-            x_label: "baked file size (MiB)".into(),
-            y_label: error_label.into(),
-            log_x: true,
-            log_y: false,
-            series,
-        },
-        Style::Points,
-        &labels,
     )?;
     let along = |name: String, draws: &[u32]| Series {
         name,
