@@ -393,37 +393,13 @@ where
         }
         draw_markers(&mut ctx, *i, pts).map_err(|x| e(&x))?;
     }
-    // Point labels after every series, each where it overlaps no earlier label (points that
-    // coincide would otherwise print their labels on top of each other): the first of a
-    // cluster is shown.
-    let mut taken: Vec<(i32, i32, i32, i32)> = Vec::new();
-    for (i, _, pts, point_labels) in series {
+    // Point labels after every series.
+    let shown = shown_labels(series, |p| ctx.backend_coord(p));
+    for ((i, ..), shown) in series.iter().zip(shown) {
         let font = ("sans-serif", 12)
             .into_font()
             .color(&colour(*i))
             .pos(Pos::new(HPos::Left, VPos::Bottom));
-        let mut shown = Vec::new();
-        for (&p, &l) in pts.iter().zip(point_labels) {
-            if l.is_empty() {
-                continue;
-            }
-            let (px, py) = ctx.backend_coord(&p);
-            // Box of the label at (6, −4) from the point: ≈ 7 px a character, 12 px high.
-            let b = (
-                px + 5,
-                py - 17,
-                px + 7 + 7 * l.chars().count() as i32,
-                py - 3,
-            );
-            if taken
-                .iter()
-                .any(|t| b.0 < t.2 && t.0 < b.2 && b.1 < t.3 && t.1 < b.3)
-            {
-                continue;
-            }
-            taken.push(b);
-            shown.push((p, l));
-        }
         ctx.draw_series(
             shown.into_iter().map(|(p, l)| {
                 EmptyElement::at(p) + Text::new(l.to_string(), (6, -4), font.clone())
@@ -455,6 +431,43 @@ where
     }
     root.present().map_err(|x| e(&x))?;
     Ok(())
+}
+
+/// The point labels to draw, per series: a label is shown where its box (at (6, −4) from
+/// its point, ≈ 7 px a character, 12 px high; `at` gives a point's pixel) overlaps no label
+/// shown before it, so points that coincide show the first label of the cluster only.
+fn shown_labels<'s>(
+    series: &[Series3<'s>],
+    at: impl Fn(&(f64, f64)) -> (i32, i32),
+) -> Vec<Vec<((f64, f64), &'s str)>> {
+    let mut taken: Vec<(i32, i32, i32, i32)> = Vec::new();
+    series
+        .iter()
+        .map(|(_, _, pts, point_labels)| {
+            let mut shown = Vec::new();
+            for (&p, &l) in pts.iter().zip(point_labels) {
+                if l.is_empty() {
+                    continue;
+                }
+                let (px, py) = at(&p);
+                let b = (
+                    px + 5,
+                    py - 17,
+                    px + 7 + 7 * l.chars().count() as i32,
+                    py - 3,
+                );
+                if taken
+                    .iter()
+                    .any(|t| b.0 < t.2 && t.0 < b.2 && b.1 < t.3 && t.1 < b.3)
+                {
+                    continue;
+                }
+                taken.push(b);
+                shown.push((p, l));
+            }
+            shown
+        })
+        .collect()
 }
 
 fn marker_style(index: usize) -> ShapeStyle {

@@ -192,15 +192,51 @@ impl GroupReport {
     }
 }
 
-/// Runs one group. `progress(message)` reports each step.
+/// Runs one group: builds its methods, measures each frame's error and counts against the
+/// exact reference, times the methods interleaved, and returns one row per method.
+/// `progress(message)` reports each step.
 pub fn run_group(
     gpu: &Gpu,
     input: &GroupInput<'_>,
     progress: &dyn Fn(&str),
 ) -> Result<GroupReport, BenchError> {
+    let (methods, skipped) = build_methods(gpu, input, progress)?;
+    let counts = count_frames(gpu, input, &methods, progress)?;
+
+    progress("timing");
+    let refs: Vec<&dyn Method> = methods.iter().map(|m| m.as_ref()).collect();
+    let timings = time_methods(&refs, input.frames, input.repeats, &|done, total| {
+        if done % methods.len().max(1) == 0 {
+            progress(&format!("timing: {done}/{total} calls"));
+        }
+    })?;
+    let rows = methods
+        .iter()
+        .zip(counts)
+        .zip(timings)
+        .map(|((m, c), t)| c.row(m.as_ref(), input, &t))
+        .collect();
+    Ok(GroupReport {
+        samples: input.view.samples,
+        mode: input.mode.name().into(),
+        rows,
+        skipped,
+    })
+}
+
+/// A group's methods, in table order.
+type Methods<'a> = Vec<Box<dyn Method + 'a>>;
+
+/// The group's methods that support its mode, in table order, and the rivals left out
+/// because the device cannot run them at this configuration.
+fn build_methods<'a>(
+    gpu: &'a Gpu,
+    input: &GroupInput<'a>,
+    progress: &dyn Fn(&str),
+) -> Result<(Methods<'a>, Vec<Skipped>), BenchError> {
     let view = input.view;
     let mode = input.mode;
-    let mut methods: Vec<Box<dyn Method + '_>> = Vec::new();
+    let mut methods: Methods<'a> = Vec::new();
     let mut skipped = Vec::new();
     for &kind in input.methods {
         if !kind.supports(mode) {
@@ -274,8 +310,33 @@ pub fn run_group(
             }
         }
     }
+    Ok((methods, skipped))
+}
 
-    // The exact reference of each frame, with the merged bake's unordered samples.
+/// One method's error and counts, summed over the measured frames.
+struct Counts {
+    errors: ErrorSummary,
+    triangles: f64,
+    draws: f64,
+    draws_max: u32,
+    /// Pipeline-statistics invocations; `None` where the device has no such queries.
+    fragments_dev: Option<f64>,
+    vertices_dev: Option<f64>,
+    shaded: f64,
+    covered: f64,
+    overdraw: f64,
+}
+
+/// Each method's [`Counts`] over the group's frames: its image against the exact reference
+/// (with the merged bake's unordered samples), triangles and draws, pipeline statistics,
+/// and the counting pass's fragments and covered pixels.
+fn count_frames(
+    gpu: &Gpu,
+    input: &GroupInput<'_>,
+    methods: &[Box<dyn Method + '_>],
+    progress: &dyn Fn(&str),
+) -> Result<Vec<Counts>, BenchError> {
+    let view = input.view;
     progress("exact reference");
     let reference = ExactReference::new(
         gpu,
@@ -284,7 +345,7 @@ pub fn run_group(
         ReferenceConfig {
             size: view.size,
             samples: view.samples,
-            mode,
+            mode: input.mode,
             glass_opacity: view.glass_opacity,
             max_layers: 4096,
         },
@@ -297,35 +358,7 @@ pub fn run_group(
         view.size,
         view.glass_opacity,
     )?;
-
-    struct Acc {
-        errors: ErrorSummary,
-        triangles: f64,
-        draws: f64,
-        draws_max: u32,
-        fragments_dev: Option<f64>,
-        vertices_dev: Option<f64>,
-        shaded: f64,
-        covered: f64,
-        overdraw: f64,
-    }
-    let mut acc: Vec<Acc> = methods
-        .iter()
-        .map(|_| Acc {
-            errors: ErrorSummary {
-                psnr_min: f64::INFINITY,
-                ..Default::default()
-            },
-            triangles: 0.0,
-            draws: 0.0,
-            draws_max: 0,
-            fragments_dev: Some(0.0),
-            vertices_dev: Some(0.0),
-            shaded: 0.0,
-            covered: 0.0,
-            overdraw: 0.0,
-        })
-        .collect();
+    let mut counts: Vec<Counts> = methods.iter().map(|_| Counts::new()).collect();
     let (w, h) = view.size;
     let pixels = (w as f64) * (h as f64);
     for (i, &f) in input.frames.iter().enumerate() {
@@ -335,7 +368,8 @@ pub fn run_group(
             input.frames.len()
         ));
         let reference_frame = reference.render(f, Some(&removed))?;
-        for (m, a) in methods.iter().zip(&mut acc) {
+        let unordered = reference_frame.unordered.iter().filter(|&&u| u).count() as f64;
+        for (m, a) in methods.iter().zip(&mut counts) {
             m.prepare(f)?;
             let image = m.image(f)?;
             let c = compare(
@@ -349,9 +383,8 @@ pub fn run_group(
             e.frames += 1;
             e.frames_exact += (c.pixels_differing_ordered == 0) as u32;
             e.pixels_differing_fraction += c.pixels_differing as f64 / pixels;
-            let ordered = pixels - reference_frame.unordered.iter().filter(|&&u| u).count() as f64;
             e.pixels_differing_ordered_fraction +=
-                c.pixels_differing_ordered as f64 / ordered.max(1.0);
+                c.pixels_differing_ordered as f64 / (pixels - unordered).max(1.0);
             e.max_channel_diff = e.max_channel_diff.max(c.max_channel_diff);
             e.flip_mean += c.flip_mean;
             e.psnr_min = e.psnr_min.min(c.psnr);
@@ -380,62 +413,65 @@ pub fn run_group(
             };
         }
     }
+    Ok(counts)
+}
 
-    progress("timing");
-    let refs: Vec<&dyn Method> = methods.iter().map(|m| m.as_ref()).collect();
-    let timings = time_methods(&refs, input.frames, input.repeats, &|done, total| {
-        if done % methods.len().max(1) == 0 {
-            progress(&format!("timing: {done}/{total} calls"));
+impl Counts {
+    fn new() -> Counts {
+        Counts {
+            errors: ErrorSummary {
+                psnr_min: f64::INFINITY,
+                ..Default::default()
+            },
+            triangles: 0.0,
+            draws: 0.0,
+            draws_max: 0,
+            fragments_dev: Some(0.0),
+            vertices_dev: Some(0.0),
+            shaded: 0.0,
+            covered: 0.0,
+            overdraw: 0.0,
         }
-    })?;
+    }
 
-    let n = input.frames.len().max(1) as f64;
-    let rows = methods
-        .iter()
-        .zip(acc)
-        .zip(timings)
-        .map(|((m, a), t)| {
-            let gpu: Vec<f64> = t.iter().filter_map(|x| x.gpu_ms).collect();
-            let gpu_ms = (gpu.len() == t.len() && !t.is_empty()).then(|| Summary::of(&gpu));
-            let wall_ms = Summary::of(&t.iter().map(|x| x.wall_ms).collect::<Vec<_>>());
-            let headline = gpu_ms.unwrap_or(wall_ms);
-            let mut errors = a.errors;
-            if errors.frames > 0 {
-                errors.pixels_differing_fraction /= errors.frames as f64;
-                errors.pixels_differing_ordered_fraction /= errors.frames as f64;
-                errors.flip_mean /= errors.frames as f64;
-            } else {
-                errors.psnr_min = 0.0;
-            }
-            MethodRow {
-                method: m.name().to_string(),
-                variant: m.variant(),
-                mode: mode.name().into(),
-                samples: view.samples,
-                ms_per_frame: headline.mean,
-                ms_p95: headline.p95,
-                ms_max: headline.max,
-                gpu_ms,
-                wall_ms,
-                ms_along_path: along_path(input.frames, &t, gpu_ms.is_some()),
-                triangles_per_frame: a.triangles / n,
-                draws_per_frame_mean: a.draws / n,
-                draws_per_frame_max: a.draws_max,
-                fragment_invocations_per_frame: a.fragments_dev.map(|x| x / n),
-                vertex_invocations_per_frame: a.vertices_dev.map(|x| x / n),
-                fragments_shaded_per_frame: a.shaded / n,
-                pixels_covered_per_frame: a.covered / n,
-                overdraw: a.overdraw / n,
-                error: errors,
-            }
-        })
-        .collect();
-    Ok(GroupReport {
-        samples: view.samples,
-        mode: mode.name().into(),
-        rows,
-        skipped,
-    })
+    /// The table row of method `m` from these sums (means over the group's frames) and its
+    /// timings `t`.
+    fn row(self, m: &dyn Method, input: &GroupInput<'_>, t: &[Timing]) -> MethodRow {
+        let n = input.frames.len().max(1) as f64;
+        let gpu: Vec<f64> = t.iter().filter_map(|x| x.gpu_ms).collect();
+        let gpu_ms = (gpu.len() == t.len() && !t.is_empty()).then(|| Summary::of(&gpu));
+        let wall_ms = Summary::of(&t.iter().map(|x| x.wall_ms).collect::<Vec<_>>());
+        let headline = gpu_ms.unwrap_or(wall_ms);
+        let mut errors = self.errors;
+        if errors.frames > 0 {
+            errors.pixels_differing_fraction /= errors.frames as f64;
+            errors.pixels_differing_ordered_fraction /= errors.frames as f64;
+            errors.flip_mean /= errors.frames as f64;
+        } else {
+            errors.psnr_min = 0.0;
+        }
+        MethodRow {
+            method: m.name().to_string(),
+            variant: m.variant(),
+            mode: input.mode.name().into(),
+            samples: input.view.samples,
+            ms_per_frame: headline.mean,
+            ms_p95: headline.p95,
+            ms_max: headline.max,
+            gpu_ms,
+            wall_ms,
+            ms_along_path: along_path(input.frames, t, gpu_ms.is_some()),
+            triangles_per_frame: self.triangles / n,
+            draws_per_frame_mean: self.draws / n,
+            draws_per_frame_max: self.draws_max,
+            fragment_invocations_per_frame: self.fragments_dev.map(|x| x / n),
+            vertex_invocations_per_frame: self.vertices_dev.map(|x| x / n),
+            fragments_shaded_per_frame: self.shaded / n,
+            pixels_covered_per_frame: self.covered / n,
+            overdraw: self.overdraw / n,
+            error: errors,
+        }
+    }
 }
 
 /// Mean headline time per measured frame, in frame order.

@@ -175,42 +175,10 @@ pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
             }
         }
         // Rule 3.
-        let source: &[Edge] = if baked.merge.depth_only {
-            &fr.ties
-        } else {
-            &fr.edges
-        };
         let removed = baked.removed_edges.get(f).map(Vec::as_slice).unwrap_or(&[]);
         fm.unordered_samples = removed.iter().map(|e| e.weight as u64).sum();
         total_unordered += fm.unordered_samples;
-        let mut edges: Vec<(usize, usize, u32)> = Vec::with_capacity(source.len());
-        for e in source {
-            match (local(e.from), local(e.to)) {
-                (Some(a), Some(b)) => edges.push((a, b, e.weight)),
-                _ => report.problem(format!("frame {f}: edge {}→{} leaves G", e.from, e.to)),
-            }
-        }
-        edges.sort_unstable();
-        let mut cut = vec![false; edges.len()];
-        for r in removed {
-            let hit = edges
-                .iter()
-                .enumerate()
-                .skip(edges.partition_point(|e| (e.0, e.1) < (r.from as usize, r.to as usize)))
-                .take_while(|(_, e)| (e.0, e.1) == (r.from as usize, r.to as usize))
-                .find(|&(k, e)| !cut[k] && e.2 == r.weight)
-                .map(|(k, _)| k);
-            match hit {
-                Some(k) => cut[k] = true,
-                None => {
-                    fm.graph_violations += 1;
-                    report.problem(format!(
-                        "frame {f}: removed edge {}→{} is not an edge of E_f",
-                        r.from, r.to
-                    ));
-                }
-            }
-        }
+        let (edges, cut) = frame_edges(baked, fr, f, &local, &mut fm, &mut report);
         fm.graph_violations +=
             order_violations(&edges, &cut, &|t| drawn(t).then(|| pos[t]), f, &mut report);
         report.frames.push(fm);
@@ -239,6 +207,55 @@ pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
         && report.bad_copies == 0
         && report.frames.iter().all(FrameReport::ok);
     report
+}
+
+/// Frame f's graph for rule 3: its edges (ties only for a depth-only bake) in G-local ids,
+/// sorted, and which of them the merger removed, each of the file's removed edges matched to
+/// one edge of E_f of the same weight. A removed edge that is not in E_f is a graph violation
+/// of the frame; an edge leaving G is a problem of the file.
+fn frame_edges(
+    baked: &Baked,
+    fr: &FrameRecord,
+    f: usize,
+    local: &dyn Fn(u32) -> Option<usize>,
+    fm: &mut FrameReport,
+    report: &mut GraphReport,
+) -> (Vec<(usize, usize, u32)>, Vec<bool>) {
+    let source: &[Edge] = if baked.merge.depth_only {
+        &fr.ties
+    } else {
+        &fr.edges
+    };
+    let mut edges: Vec<(usize, usize, u32)> = Vec::with_capacity(source.len());
+    for e in source {
+        match (local(e.from), local(e.to)) {
+            (Some(a), Some(b)) => edges.push((a, b, e.weight)),
+            _ => report.problem(format!("frame {f}: edge {}→{} leaves G", e.from, e.to)),
+        }
+    }
+    edges.sort_unstable();
+    let mut cut = vec![false; edges.len()];
+    let removed = baked.removed_edges.get(f).map(Vec::as_slice).unwrap_or(&[]);
+    for r in removed {
+        let hit = edges
+            .iter()
+            .enumerate()
+            .skip(edges.partition_point(|e| (e.0, e.1) < (r.from as usize, r.to as usize)))
+            .take_while(|(_, e)| (e.0, e.1) == (r.from as usize, r.to as usize))
+            .find(|&(k, e)| !cut[k] && e.2 == r.weight)
+            .map(|(k, _)| k);
+        match hit {
+            Some(k) => cut[k] = true,
+            None => {
+                fm.graph_violations += 1;
+                report.problem(format!(
+                    "frame {f}: removed edge {}→{} is not an edge of E_f",
+                    r.from, r.to
+                ));
+            }
+        }
+    }
+    (edges, cut)
 }
 
 /// Rule 3 for one frame: the number of drawn vertices drawn before some drawn ancestor in
