@@ -95,7 +95,7 @@ impl ScalingConfig {
             ],
             frame_counts: vec![10, 30, 100, 300, 1_000],
             synthetic_frames: vec![100, 300, 1_000, 3_000, 10_000],
-            segment: 64,
+            segment: MergeOptions::DEFAULT_SEGMENT,
             path: "orbit:frames={frames},degrees={frames*3.6},elevation=15,distance=2.75".into(),
             triangle_axis_frames: 4,
             triangle_path: "orbit:frames={frames},degrees=360,elevation=15,distance=2.75".into(),
