@@ -12,9 +12,9 @@
 use std::time::Instant;
 
 use trisort_format::{Phase, RecordSettings};
-use trisort_recorder::{bench::pass_cost, record, RecordJob};
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::View;
+use trisort_gpu::Gpu;
+use trisort_recorder::{bench::pass_cost, record, RecordJob};
 
 fn peak_rss_mib() -> f64 {
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();

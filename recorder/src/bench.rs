@@ -4,8 +4,8 @@
 use std::time::Instant;
 
 use trisort_format::{FrameState, Geometry};
-use trisort_gpu::Gpu;
 use trisort_gpu::scene_gpu::View;
+use trisort_gpu::Gpu;
 
 use crate::peeler::Peeler;
 use crate::RecordError;

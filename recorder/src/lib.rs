@@ -99,7 +99,8 @@ fn check_job(job: &RecordJob) -> Result<Range<u32>, RecordError> {
             range.start, range.end
         )));
     }
-    s.validate().map_err(|e| RecordError::Invalid(e.to_string()))?;
+    s.validate()
+        .map_err(|e| RecordError::Invalid(e.to_string()))?;
     Ok(range)
 }
 

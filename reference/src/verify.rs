@@ -17,8 +17,8 @@
 
 use serde::Serialize;
 use trisort_format::{Baked, Geometry};
-use trisort_player::{HeadlessConfig, HeadlessRenderer, Mode};
 use trisort_gpu::Gpu;
+use trisort_player::{HeadlessConfig, HeadlessRenderer, Mode};
 
 use crate::compare::{compare, Comparison};
 use crate::deploy::Srgb8Player;

@@ -7,11 +7,11 @@
 
 use glam::DVec3;
 use trisort_format::{FrameState, Geometry, Vertex};
+use trisort_gpu::Gpu;
 use trisort_player::Mode;
 use trisort_reference::{
     ExactReference, PeelingConfig, PeelingRenderer, ReferenceConfig, ReferenceError,
 };
-use trisort_gpu::Gpu;
 use trisort_testkit::fixtures::{frame_at, material, quad, scene};
 use trisort_testkit::gpu;
 
@@ -321,7 +321,13 @@ fn encode_records_a_frame_without_readback_and_counts_passes() {
     let Some(gpu) = gpu() else { return };
     let g = stack(3);
     let fs = [frame_at(DVec3::ZERO)];
-    let peeling = PeelingRenderer::new(&gpu, &g, &fs, PeelingConfig::new((32, 32), 4, Mode::Blend, 16)).unwrap();
+    let peeling = PeelingRenderer::new(
+        &gpu,
+        &g,
+        &fs,
+        PeelingConfig::new((32, 32), 4, Mode::Blend, 16),
+    )
+    .unwrap();
     let layers = peeling.layers(0).unwrap();
     assert_eq!(layers, 3);
     let stats = gpu
@@ -354,7 +360,9 @@ fn saturate_and_bad_patterns_are_rejected() {
     let Some(gpu) = gpu() else { return };
     let g = stack(1);
     let fs = [frame_at(DVec3::ZERO)];
-    let new = |size, samples, mode| PeelingRenderer::new(&gpu, &g, &fs, PeelingConfig::new(size, samples, mode, 8));
+    let new = |size, samples, mode| {
+        PeelingRenderer::new(&gpu, &g, &fs, PeelingConfig::new(size, samples, mode, 8))
+    };
     assert!(matches!(
         new((8, 8), 4, Mode::Saturate),
         Err(ReferenceError::Invalid(_))

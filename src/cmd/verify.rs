@@ -18,10 +18,10 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::{json, Value};
 use trisort_format::{Baked, Geometry};
+use trisort_gpu::Gpu;
 use trisort_player::Mode;
 use trisort_reference::compare::{difference_image, mask_image};
 use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
-use trisort_gpu::Gpu;
 
 use crate::cmd::merge::read_recordings;
 use crate::cmd::play::write_png;
