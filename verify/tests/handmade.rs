@@ -121,7 +121,7 @@ fn baked(
         });
         draws.extend(ranges.iter().map(|&(a, n)| draw(a, n)));
     }
-    Baked {
+    let mut b = Baked {
         tool_version: "test".into(),
         scene_hash: rec.scene_hash,
         path_hash: rec.path_hash,
@@ -140,7 +140,35 @@ fn baked(
         frames,
         frame_states: rec.frame_states.clone(),
         removed_edges: vec![vec![], vec![]],
-    }
+    };
+    restat(&mut b, rec);
+    b
+}
+
+/// Sets the statistics the file states to what its draws, its removed edges and the
+/// recording give (what an honest merger writes).
+fn restat(b: &mut Baked, rec: &Recording) {
+    let frames = b.frames.len().max(1) as f64;
+    let drawn: i64 = (0..b.frames.len())
+        .flat_map(|f| b.frame_draws(f))
+        .map(|d| d.index_count as i64 / 3)
+        .sum();
+    let visible: u64 = rec.frames.iter().map(|f| f.visible.len() as u64).sum();
+    b.stats = MergeStats {
+        index_triangles: b.copies.len() as u64,
+        source_triangles: visible,
+        unique_visible: rec.unique_visible.len() as u64,
+        draws_per_frame_mean: b.frames.iter().map(|w| w.count as f64).sum::<f64>() / frames,
+        draws_per_frame_max: b.frames.iter().map(|w| w.count).max().unwrap_or(0),
+        drawn_not_visible_mean: (drawn - visible as i64) as f64 / frames,
+        unordered_samples: b
+            .removed_edges
+            .iter()
+            .flatten()
+            .map(|e| e.weight as u64)
+            .sum(),
+        ..MergeStats::default()
+    };
 }
 
 #[test]
@@ -171,6 +199,14 @@ fn order_through_an_undrawn_triangle() {
     let r = check_graph(recs, &bad);
     assert!(!r.ok);
     assert_eq!(r.frames[0].graph_violations, 1, "{:?}", r.frames);
+    // The message names the frame and the order broken (scene ids), through H.
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.starts_with("frame 0: order 10→30 (scene ids) is violated")),
+        "{:?}",
+        r.problems
+    );
     // Frame 1 draws A, H, then B: fine.
     assert_eq!(r.frames[1].graph_violations, 0);
 }
@@ -275,4 +311,167 @@ fn malformed_recording_is_reported() {
         "{:?}",
         r.problems
     );
+}
+
+/// Frame 1 of [`recording`] with B → A added: the cycle A → H → B → A.
+fn cyclic_recording() -> Recording {
+    let mut rec = recording();
+    rec.frames[1].edges.push(Edge {
+        from: B,
+        to: A,
+        weight: 1,
+    });
+    rec.frames[1].edges.sort();
+    rec
+}
+
+/// `baked` over [`cyclic_recording`] (A, H, B drawn in order at frame 1) with `removed`
+/// (G-local edges per frame) and honest statistics.
+fn with_removed(rec: &Recording, removed: [Vec<Edge>; 2]) -> Baked {
+    let mut b = baked(
+        rec,
+        Bridge::Ignored,
+        vec![0, 1, 2],
+        &[(0, 1), (2, 1)],
+        &[(0, 3)],
+    );
+    b.removed_edges = removed.to_vec();
+    restat(&mut b, rec);
+    b
+}
+
+fn local(from: u32, to: u32, weight: u32) -> Edge {
+    Edge { from, to, weight }
+}
+
+#[test]
+fn removed_edges_must_lie_on_a_cycle_and_be_needed() {
+    let rec = cyclic_recording();
+    let recs = std::slice::from_ref(&rec);
+    let good = with_removed(&rec, [vec![], vec![local(2, 0, 1)]]);
+    let r = check_graph(recs, &good);
+    assert!(r.ok, "{:?}", r.problems);
+
+    // A → H of frame 0, where there is no cycle: its order was never in doubt.
+    let acyclic = with_removed(&rec, [vec![local(0, 1, 2)], vec![local(2, 0, 1)]]);
+    let r = check_graph(recs, &acyclic);
+    assert!(!r.ok);
+    assert_eq!(r.frames[0].removed_not_on_cycle, 1, "{:?}", r.frames[0]);
+    assert_eq!(r.frames[0].graph_violations, 1);
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p
+                .starts_with("frame 0: removed edge 10→20 (scene ids, weight 2) lies on no cycle")),
+        "{:?}",
+        r.problems
+    );
+
+    // B → A and A → H of frame 1: once both are gone, neither closes a cycle on its own.
+    let both = with_removed(&rec, [vec![], vec![local(2, 0, 1), local(0, 1, 2)]]);
+    let r = check_graph(recs, &both);
+    assert!(!r.ok);
+    assert_eq!(r.frames[1].removed_not_needed, 2, "{:?}", r.frames[1]);
+    assert_eq!(r.frames[1].removed_not_on_cycle, 0);
+    for edge in ["30→10", "10→20"] {
+        let start = format!("frame 1: removed edge {edge} (scene ids");
+        assert!(
+            r.problems
+                .iter()
+                .any(|p| p.starts_with(&start) && p.contains("is not needed")),
+            "{start}: {:?}",
+            r.problems
+        );
+    }
+}
+
+#[test]
+fn what_the_file_repeats_must_match_the_recording() {
+    let rec = cyclic_recording();
+    let recs = std::slice::from_ref(&rec);
+    let good = with_removed(&rec, [vec![], vec![local(2, 0, 1)]]);
+    type Edit = fn(&mut Baked);
+    let cases: [(Edit, &str); 9] = [
+        (
+            |b| b.frame_states[1].camera.view[12] += 0.5,
+            "frame 1: the baked camera differs from recording 0's",
+        ),
+        (
+            |b| b.geometry.vertices[2].position[1] = 7.0,
+            "the baked geometry differs from recording 0's: vertices 2 differs",
+        ),
+        (
+            |b| b.device.adapter = "another".into(),
+            "the device () differs from the baked file's (another)",
+        ),
+        (
+            |b| b.stats.index_triangles = 2,
+            "statistic index_triangles: the file states 2, its copies give 3",
+        ),
+        (
+            |b| b.stats.unique_visible = 4,
+            "statistic unique_visible: the file states 4, the recordings give 3",
+        ),
+        (
+            |b| b.stats.source_triangles = 1,
+            "statistic source_triangles: the file states 1, the recordings give 5",
+        ),
+        (
+            |b| b.stats.draws_per_frame_max = 1,
+            "statistic draws_per_frame_max: the file states 1, its frames give 2",
+        ),
+        (
+            |b| b.stats.draws_per_frame_mean = 1.0,
+            "statistic draws_per_frame_mean: the file states 1, its frames give 1.5",
+        ),
+        (
+            |b| b.stats.drawn_not_visible_mean = f64::NAN,
+            "statistic drawn_not_visible_mean: the file states NaN",
+        ),
+    ];
+    for (edit, needle) in cases {
+        let mut b = good.clone();
+        edit(&mut b);
+        let r = check_graph(recs, &b);
+        assert!(!r.ok, "{needle}");
+        assert!(
+            r.problems.iter().any(|p| p.contains(needle)),
+            "{needle}: {:?}",
+            r.problems
+        );
+    }
+}
+
+/// One frame whose graph is a chain through 40,000 triangles closed into one cycle by its
+/// last edge, which the file removes: the components and the search must not recurse.
+#[test]
+fn a_cycle_through_forty_thousand_triangles() {
+    let n = 40_000u32;
+    let mut edges: Vec<Edge> = (0..n - 1).map(|k| local(k, k + 1, 1)).collect();
+    edges.push(local(n - 1, 0, 1));
+    edges.sort();
+    let all: Vec<u32> = (0..n).collect();
+    let rec = Recording {
+        frame_states: vec![state()],
+        frames: vec![FrameRecord {
+            frame: 0,
+            visible: all.clone(),
+            covered: all.clone(),
+            edges,
+            ..Default::default()
+        }],
+        unique_visible: all.clone(),
+        scene_triangles: n,
+        geometry: geometry(n),
+        ..recording()
+    };
+    let mut b = baked(&rec, Bridge::Visible, all, &[(0, n)], &[]);
+    b.frames.truncate(1);
+    b.frame_states.truncate(1);
+    b.removed_edges.truncate(1);
+    b.removed_edges[0] = vec![local(n - 1, 0, 1)];
+    restat(&mut b, &rec);
+    let r = check_graph(std::slice::from_ref(&rec), &b);
+    assert!(r.ok, "{:?}", r.problems);
+    assert_eq!(r.frames[0].unordered_samples, 1);
 }
