@@ -187,3 +187,29 @@ pub fn open_gpu() -> Result<trisort_gpu::Gpu> {
     });
     Ok(gpu)
 }
+
+/// Makes `scene` the scene a recording with `settings` is made of: with
+/// `settings.split_intersections`, its triangles that pass through each other within a rigid
+/// group are split along their intersection (`trisort_intersect::working_geometry`), which
+/// changes the scene's triangles and hash. Says on stderr what was split; returns the report.
+pub fn working_scene(
+    scene: &mut Scene,
+    frames: &[trisort_format::FrameState],
+    settings: &trisort_format::RecordSettings,
+) -> Option<trisort_intersect::SplitReport> {
+    let t0 = std::time::Instant::now();
+    let split = trisort_intersect::working_geometry(&scene.geometry, frames, settings)?;
+    let r = split.report;
+    if r.pairs_split > 0 || r.pairs_skipped_sliver > 0 {
+        eprintln!(
+            "trisort: split {} pairs of triangles that pass through each other (+{} triangles; \
+             {} pairs left, their pieces would be slivers) in {:.2} s",
+            r.pairs_split,
+            r.triangles_added,
+            r.pairs_skipped_sliver,
+            t0.elapsed().as_secs_f64()
+        );
+    }
+    *scene.geometry_mut() = split.geometry;
+    Some(r)
+}

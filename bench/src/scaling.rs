@@ -103,8 +103,13 @@ impl ScalingConfig {
         }
     }
 
+    /// The recording settings of every run. Scaling measures the recorder and the merger on
+    /// the procedural car as generated, so nothing is split before recording.
     fn settings(&self) -> RecordSettings {
-        RecordSettings::new(self.size, self.samples)
+        RecordSettings {
+            split_intersections: false,
+            ..RecordSettings::new(self.size, self.samples)
+        }
     }
 }
 

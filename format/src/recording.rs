@@ -23,6 +23,12 @@ pub struct RecordSettings {
     pub glass_opacity: f32,
     /// Safety bound on peel layers per frame; a frame that hits it is truncated.
     pub max_layers: u32,
+    /// Whether interpenetrating triangles (within a rigid group of nodes) were split along
+    /// their intersection before recording (`trisort_intersect::working_geometry`): the
+    /// recorded scene, and the one `verify --scene` rebuilds, is then the split one. Default
+    /// [`RecordSettings::DEFAULT_SPLIT_INTERSECTIONS`]; `record --keep-intersections` turns
+    /// it off.
+    pub split_intersections: bool,
 }
 
 impl RecordSettings {
@@ -36,6 +42,8 @@ impl RecordSettings {
     pub const DEFAULT_GLASS_OPACITY: f32 = 0.0;
     /// The default bound on peel layers per frame.
     pub const DEFAULT_MAX_LAYERS: u32 = 256;
+    /// Split interpenetrating triangles before recording by default.
+    pub const DEFAULT_SPLIT_INTERSECTIONS: bool = true;
     /// The largest width or height [`RecordSettings::validate`] accepts.
     pub const MAX_SIDE: u32 = 16384;
 
@@ -82,6 +90,7 @@ impl Default for RecordSettings {
             saturation: Self::DEFAULT_SATURATION,
             glass_opacity: Self::DEFAULT_GLASS_OPACITY,
             max_layers: Self::DEFAULT_MAX_LAYERS,
+            split_intersections: Self::DEFAULT_SPLIT_INTERSECTIONS,
         }
     }
 }

@@ -10,9 +10,9 @@ use trisort_format::{Baked, Phase, Recording};
 use trisort_gpu::Gpu;
 
 use crate::cmd::merge::{baked_json, merge_to_file, print_summary, MergeOpts};
-use crate::cmd::record::{record_to_file, recording_json};
+use crate::cmd::record::{add_split_json, record_to_file, recording_json};
 use crate::cmd::RecordOpts;
-use crate::common::{load_path, load_scene, print_json};
+use crate::common::{load_path, load_scene, print_json, working_scene};
 
 /// Arguments of `bake`.
 #[derive(Args, Debug)]
@@ -65,8 +65,9 @@ pub fn bake(
 }
 
 pub fn run(a: BakeArgs) -> Result<ExitCode> {
-    let scene = load_scene(&a.scene)?;
+    let mut scene = load_scene(&a.scene)?;
     let timeline = load_path(&a.path, &scene, a.record.fps)?;
+    let split = working_scene(&mut scene, &timeline.frames, &a.record.settings());
     let gpu = crate::common::open_gpu()?;
     let (rec, baked, record_s, merge_s) =
         bake(&gpu, &scene, &timeline, &a.record, &a.merge, &a.output)?;
@@ -76,6 +77,7 @@ pub fn run(a: BakeArgs) -> Result<ExitCode> {
         for (k, val) in m.as_object().expect("object") {
             v[k] = val.clone();
         }
+        add_split_json(&mut v, split.as_ref());
         v["record_seconds"] = record_s.into();
         v["merge_seconds"] = merge_s.into();
         v["seconds"] = (record_s + merge_s).into();

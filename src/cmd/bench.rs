@@ -22,7 +22,7 @@ use crate::cmd::merge::MergeOpts;
 use crate::cmd::RecordOpts;
 use crate::common::{
     default_size, load_path, load_scene, option_parser, parse_range, parse_size, print_json,
-    FrameRange,
+    working_scene, FrameRange,
 };
 
 /// Arguments of `bench`.
@@ -241,8 +241,10 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
         bail!("--repeats must be at least 1");
     }
     let t0 = Instant::now();
-    let scene = load_scene(&a.scene)?;
+    let mut scene = load_scene(&a.scene)?;
     let timeline = load_path(&a.path, &scene, a.fps)?;
+    // Every bake and rival below sees the scene as the default settings record it.
+    working_scene(&mut scene, &timeline.frames, &RecordSettings::default());
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let gpu = crate::common::open_gpu()?;
     let n = timeline.frames.len() as u32;

@@ -40,7 +40,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     let triangles = a
         .triangles
         .unwrap_or(trisort_scene::demo_car::DEFAULT_TRIANGLES);
-    let scene = trisort_scene::demo_car::demo_car(triangles);
+    let mut scene = trisort_scene::demo_car::demo_car(triangles);
     let path = trisort_paths::demo_default(&scene);
     std::fs::create_dir_all(&a.out_dir)?;
     if let Some(p) = &a.export_scene {
@@ -55,6 +55,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         path.frames.len()
     );
     let record = RecordOpts::new(RecordSettings::new(a.size, a.samples), path.fps);
+    crate::common::working_scene(&mut scene, &path.frames, &record.settings());
     let merge = MergeOpts::defaults();
     let gpu = crate::common::open_gpu()?;
     println!("device: {}", gpu.describe());

@@ -100,6 +100,12 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         "draws_per_frame_max": s.draws_per_frame_max, "drawn_not_visible_mean": s.drawn_not_visible_mean,
         "unordered_samples": s.unordered_samples, "seconds": s.seconds,
         "frames": baked.frames.len(),
+        "split_intersections": baked.settings.split_intersections,
+        // The edges the merger removed to break depth-order cycles (scene ids of the
+        // recorded scene, front → back): the samples they weigh are the unordered ones.
+        "removed_edges": baked.removed_edges.iter().enumerate().flat_map(|(f, edges)| {
+            edges.iter().map(move |e| json!({"frame": f, "from": e.from, "to": e.to, "weight": e.weight}))
+        }).collect::<Vec<_>>(),
     });
     if let Some(png) = &a.matrix {
         let m = draw_matrix(&baked, png)?;
@@ -142,6 +148,23 @@ fn inspect_scene(a: &InspectArgs) -> Result<ExitCode> {
     let bounds = scene
         .bounds()
         .map(|(lo, hi)| json!({"min": lo.to_array(), "max": hi.to_array()}));
+    // What `record` would split with every node at rest (a path that moves nodes apart
+    // splits only within the groups that stay rigid on it).
+    let rest = trisort_format::FrameState {
+        camera: trisort_format::Camera {
+            view: glam::DMat4::IDENTITY.to_cols_array(),
+            yfov: 1.0,
+            znear: 0.1,
+            zfar: None,
+        },
+        poses: Vec::new(),
+    };
+    let split = trisort_intersect::split_intersections(
+        g,
+        std::slice::from_ref(&rest),
+        &trisort_intersect::SplitOptions::default(),
+    )
+    .report;
     let v = json!({
         "scene": scene.name,
         "triangles": st.triangles, "zero_area_triangles": st.zero_area_triangles,
@@ -153,6 +176,9 @@ fn inspect_scene(a: &InspectArgs) -> Result<ExitCode> {
         "animated_nodes": animated,
         "bounds": bounds,
         "notes": scene.notes,
+        "intersections_split": split.pairs_split,
+        "triangles_added": split.triangles_added,
+        "intersections_left": split.pairs_skipped_sliver,
     });
     if a.json {
         print_json(&v);
@@ -170,6 +196,11 @@ fn inspect_scene(a: &InspectArgs) -> Result<ExitCode> {
             count_mode(trisort_format::AlphaMode::Blend),
             transmissive,
             st.textures
+        );
+        println!(
+            "  triangles passing through each other at rest: {} pairs (record splits them: +{} \
+             triangles; {} pairs would leave slivers)",
+            split.pairs_split, split.triangles_added, split.pairs_skipped_sliver
         );
         println!(
             "  animations {} (moving {} nodes: {}), cameras {}",

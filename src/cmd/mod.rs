@@ -72,6 +72,12 @@ pub struct RecordOpts {
     /// Sampling rate for `--path gltf` and generated paths.
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
+    /// Record the scene as it is: do not split triangles that pass through each other
+    /// (within a group of nodes that never move relative to each other) along their
+    /// intersection first. Such pairs make depth-order cycles, which the bake can only break
+    /// by leaving some samples unordered.
+    #[arg(long)]
+    pub keep_intersections: bool,
 }
 
 impl RecordOpts {
@@ -85,6 +91,7 @@ impl RecordOpts {
             max_layers: settings.max_layers,
             frames: None,
             fps,
+            keep_intersections: !settings.split_intersections,
         }
     }
 
@@ -97,6 +104,7 @@ impl RecordOpts {
             saturation: self.saturation,
             glass_opacity: self.glass_opacity,
             max_layers: self.max_layers,
+            split_intersections: !self.keep_intersections,
         }
     }
 }

@@ -13,7 +13,7 @@ use trisort_recorder::partial::{partial_path, PartialDir};
 use trisort_recorder::{record, RecordJob};
 
 use crate::cmd::RecordOpts;
-use crate::common::{load_path, load_scene, print_json, progress_bar};
+use crate::common::{load_path, load_scene, print_json, progress_bar, working_scene};
 
 /// Which phases to run.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -88,6 +88,14 @@ pub fn recording_json(rec: &Recording, seconds: Option<f64>) -> serde_json::Valu
     })
 }
 
+/// Adds `record --json`'s `intersections_split` (pairs of triangles split along their
+/// intersection before recording) and `triangles_added` (0 and 0 with `--keep-intersections`).
+pub fn add_split_json(v: &mut serde_json::Value, split: Option<&trisort_intersect::SplitReport>) {
+    v["intersections_split"] = split.map_or(0, |r| r.pairs_split).into();
+    v["triangles_added"] = split.map_or(0, |r| r.triangles_added).into();
+    v["intersections_left"] = split.map_or(0, |r| r.pairs_skipped_sliver).into();
+}
+
 /// Records with a progress display, resuming from `OUT.partial/`, and writes `output`
 /// atomically. Used by `record`, `bake` and `demo`.
 pub fn record_to_file(
@@ -137,8 +145,9 @@ pub fn record_to_file(
 
 pub fn run(a: RecordArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
-    let scene = load_scene(&a.scene)?;
+    let mut scene = load_scene(&a.scene)?;
     let timeline = load_path(&a.path, &scene, a.opts.fps)?;
+    let split = working_scene(&mut scene, &timeline.frames, &a.opts.settings());
     let (phase, known) = match a.phase {
         PhaseArg::Visibility => {
             if !a.visibility.is_empty() {
@@ -161,7 +170,9 @@ pub fn run(a: RecordArgs) -> Result<ExitCode> {
     let rec = record_to_file(&gpu, &scene, &timeline, &a.opts, phase, known, &a.output)?;
     let secs = t0.elapsed().as_secs_f64();
     if a.json {
-        print_json(&recording_json(&rec, Some(secs)));
+        let mut v = recording_json(&rec, Some(secs));
+        add_split_json(&mut v, split.as_ref());
+        print_json(&v);
     } else {
         println!(
             "recorded frames {:?} of {} ({:?}) on {}: |G| = {} of {} triangles, {:.1} s; wrote {}",

@@ -25,7 +25,7 @@ use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFra
 
 use crate::cmd::merge::read_recordings;
 use crate::cmd::play::write_png;
-use crate::common::{load_scene, parse_range, parse_size, print_json, FrameRange};
+use crate::common::{load_scene, parse_range, parse_size, print_json, working_scene, FrameRange};
 
 /// Exit code of a verification that ran and found the baked file wrong.
 pub const VERIFY_FAILED: u8 = 3;
@@ -156,7 +156,9 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
     let images = match &a.scene {
         None => None,
         Some(spec) => {
-            let scene = load_scene(spec)?;
+            let mut scene = load_scene(spec)?;
+            // The scene as it was recorded: split where the recording split it.
+            working_scene(&mut scene, &baked.frame_states, &baked.settings);
             check_scene(&baked, &scene, spec)?;
             let n = baked.frames.len() as u32;
             let range = match a.frames {
