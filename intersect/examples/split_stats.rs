@@ -3,7 +3,7 @@
 //!
 //! ```sh
 //! cargo run --release -p trisort-intersect --example split_stats -- SCENE [--path SPEC] \
-//!     [--min-fraction F] [--one-side] [--keep-t-junctions] [--verify]
+//!     [--min-fraction F] [--both-sides] [--keep-t-junctions] [--verify]
 //! ```
 //!
 //! `SCENE` is a `.glb`/`.gltf` file or `demo[:TRIANGLES]`; `--path` any path spec of
@@ -43,7 +43,7 @@ fn run() -> Result<(), String> {
             }
             "--verify" => verify = true,
             "--keep-t-junctions" => options.close_t_junctions = false,
-            "--one-side" => options.cut_both_sides = false,
+            "--both-sides" => options.cut_both_sides = true,
             _ if scene_spec.is_none() && !arg.starts_with("--") => scene_spec = Some(arg),
             _ => return Err(format!("unexpected argument {arg:?}")),
         }

@@ -11,8 +11,17 @@ use crate::common::{
     x_quads, Expect,
 };
 
+/// Both triangles of each crossing pair cut (the default cuts one): these cases check the
+/// cuts on both sides.
+fn both_sides() -> SplitOptions {
+    SplitOptions {
+        cut_both_sides: true,
+        ..SplitOptions::default()
+    }
+}
+
 fn split(g: &Geometry) -> SplitScene {
-    split_intersections(g, &[], &SplitOptions::default())
+    split_intersections(g, &[], &both_sides())
 }
 
 /// Exact where the cut points are representable in f32.
@@ -167,7 +176,7 @@ fn two_nodes(frames: &[trisort_format::FrameState]) -> (Geometry, SplitScene) {
     ];
     quad(&mut g, a, 1, 0);
     quad(&mut g, b, 2, 1);
-    let out = split_intersections(&g, frames, &SplitOptions::default());
+    let out = split_intersections(&g, frames, &both_sides());
     (g, out)
 }
 
@@ -288,7 +297,7 @@ fn slivers_are_skipped_and_counted() {
 
     let fine = SplitOptions {
         min_piece_area_fraction: 1e-12,
-        ..SplitOptions::default()
+        ..both_sides()
     };
     let out = split_intersections(&g, &[], &fine);
     assert_eq!(out.report.pairs_split, 1);
@@ -364,7 +373,7 @@ fn cut_points_are_shared_across_edges() {
 
     let keep = SplitOptions {
         close_t_junctions: false,
-        ..SplitOptions::default()
+        ..both_sides()
     };
     let open = split_intersections(&g, &[], &keep);
     assert_eq!(open.report.neighbours_split, 0);
