@@ -101,10 +101,12 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         "unordered_samples": s.unordered_samples, "seconds": s.seconds,
         "frames": baked.frames.len(),
         "split_intersections": baked.settings.split_intersections,
-        // The edges the merger removed to break depth-order cycles (scene ids of the
-        // recorded scene, front → back): the samples they weigh are the unordered ones.
+        // The edges the merger removed to break depth-order cycles, front → back, as scene
+        // ids of the recorded scene (the file stores G-local ids): the samples they weigh are
+        // the unordered ones.
         "removed_edges": baked.removed_edges.iter().enumerate().flat_map(|(f, edges)| {
-            edges.iter().map(move |e| json!({"frame": f, "from": e.from, "to": e.to, "weight": e.weight}))
+            let id = |t: u32| baked.scene_ids.get(t as usize).copied().unwrap_or(t);
+            edges.iter().map(move |e| json!({"frame": f, "from": id(e.from), "to": id(e.to), "weight": e.weight}))
         }).collect::<Vec<_>>(),
     });
     if let Some(png) = &a.matrix {
