@@ -1,7 +1,8 @@
 //! `trisort verify --scene` through the real binary: the JSON keys of DESIGN's CLI contract,
 //! graph and image checks together, difference images, a scene that is not the baked one,
-//! the off-pattern measure with `--max-error`, and the mutation check (a file whose order was
-//! corrupted on purpose fails with exit code 3).
+//! the off-pattern measure with `--max-error`, the mutation check (a file whose order was
+//! corrupted on purpose fails with exit code 3), and frames captured elsewhere
+//! (`--frames-dir`).
 
 use trisort_format::{Baked, FileKind, Recording};
 
@@ -165,4 +166,67 @@ fn corrupted_order_fails_verification() {
         false,
     );
     assert_eq!(out.status.code(), Some(3));
+}
+
+/// Frames drawn elsewhere (here: `play --out-dir`) are checked with `--frames-dir` against the
+/// exact reference with the recorded pattern's tolerance: as played they pass; one pixel
+/// changed by more than 1/255 fails its frame (exit 3); a missing or wrong-size frame is an
+/// error naming the file (exit 1); without `--scene` the option is refused (exit 2).
+#[test]
+fn captured_frames_are_checked_against_the_reference() {
+    let Some(dir) = baked_car() else {
+        return;
+    };
+    let d = dir.path();
+    run(d, &args("play car.baked --out-dir captured"), true);
+    let verify =
+        format!("verify car.baked --recording car.baked.rec --scene {SCENE} --frames-dir captured");
+    let v = run_json(d, &args(&verify));
+    assert_eq!(v["ok"], true, "{v}");
+    assert_eq!(v["captured"], true);
+    assert_eq!(v["at_recorded_pattern"], true);
+    assert_eq!(v["frames"].as_array().unwrap().len(), 2);
+    assert_eq!(v["frames"][1]["pixels_differing"], 0, "{v}");
+    assert!(v["frames"][1]["srgb8"].is_null(), "no player ran here");
+
+    // One background pixel of frame 1 off by 40/255.
+    let frame1 = d.join("captured/frame-00001.png");
+    let mut img = image::open(&frame1).unwrap().to_rgba8();
+    let p = img.get_pixel_mut(0, 0);
+    p.0[0] = if p.0[0] >= 128 {
+        p.0[0] - 40
+    } else {
+        p.0[0] + 40
+    };
+    img.save(&frame1).unwrap();
+    let out = run(d, &[&args(&verify)[..], &["--json"]].concat(), false);
+    assert_eq!(out.status.code(), Some(3));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (f0, f1) = (&v["frames"][0], &v["frames"][1]);
+    assert_eq!(f0["ok"], true, "{f0}");
+    assert_eq!(f1["ok"], false, "{f1}");
+    assert_eq!(f1["pixels_differing_ordered"], 1, "{f1}");
+    assert_eq!(f1["max_channel_diff_ordered"], 40, "{f1}");
+
+    // A frame of another size, then none at all: errors naming the file.
+    let frame0 = d.join("captured/frame-00000.png");
+    image::RgbaImage::new(32, 32).save(&frame0).unwrap();
+    let out = run(d, &args(&verify), false);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("frame-00000.png") && err.contains("32x32"),
+        "{err}"
+    );
+    std::fs::remove_file(&frame0).unwrap();
+    let out = run(d, &args(&verify), false);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("frame-00000.png") && err.contains("missing"),
+        "{err}"
+    );
+
+    let out = run(d, &args("verify car.baked --frames-dir captured"), false);
+    assert_eq!(out.status.code(), Some(2));
 }

@@ -10,7 +10,7 @@ use serde::Serialize;
 use trisort_format::{Baked, FrameState, Geometry};
 use trisort_gpu::Gpu;
 use trisort_player::Mode;
-use trisort_reference::{compare, ExactReference, ReferenceConfig, ReferenceError, RemovedEdges};
+use trisort_reference::{compare, ExactReference, ReferenceConfig, ReferenceError, UnorderedEdges};
 
 use crate::harness::{pipeline_statistics, time_methods, FragmentCounter, Summary, Timing};
 use crate::methods::{default_depth, BenchView, DefaultMethod, Method, PlayerMethod};
@@ -350,7 +350,7 @@ fn count_frames(
             max_layers: 4096,
         },
     )?;
-    let removed = RemovedEdges::of_baked(input.baked, input.geometry.triangles.len())?;
+    let removed = UnorderedEdges::of_baked(input.baked, input.geometry.triangles.len())?;
     let counter = FragmentCounter::new(
         gpu,
         input.geometry,

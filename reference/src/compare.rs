@@ -1,7 +1,7 @@
 //! Comparing a frame with its reference: pure functions over 8-bit sRGB RGBA images.
 //!
 //! Only the colour channels are compared (every frame has alpha 255). A pixel is *ordered*
-//! when none of its samples is unordered (see [`crate::RemovedEdges`]); the `_ordered` figures
+//! when none of its samples is unordered (see [`crate::UnorderedEdges`]); the `_ordered` figures
 //! ignore the others.
 
 use serde::Serialize;

@@ -26,7 +26,7 @@
 use std::collections::HashSet;
 
 use trisort_format::{
-    Baked, DrawIndexedIndirectArgs, FrameState, FrameWindow, Geometry, RecordSettings,
+    Baked, DrawIndexedIndirectArgs, FrameState, FrameWindow, Geometry, RecordSettings, Recording,
 };
 use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
 use trisort_gpu::Gpu;
@@ -76,48 +76,107 @@ impl ReferenceConfig {
     }
 }
 
-/// The intra-frame cycle edges a merger removed, looked up by scene id: a sample is
-/// *unordered* when two consecutive fragments of the peel of G there, a then b, form a removed
-/// edge a → b (DESIGN rule 3).
-pub struct RemovedEdges {
-    /// Per scene triangle: G-local id + 1, 0 for triangles outside G.
-    local: Vec<u32>,
-    /// Per frame: the removed edges (G-local ids).
+/// The edges whose samples the image check may excuse, by scene id: a sample is *unordered*
+/// when two consecutive fragments of the peel of G there, a then b, form one of them.
+///
+/// [`UnorderedEdges::of_recordings`] derives them from the recordings alone: the edges of E_f
+/// that lie on a cycle (both ends in one strongly connected component,
+/// [`trisort_verify::cycle_edges`]), the only ones any bake may leave unordered (DESIGN rule
+/// 3). Verification uses nothing else; without a recording no sample is excused.
+/// [`UnorderedEdges::of_baked`] takes the edges a baked file says its merger removed, for
+/// measurements that describe that bake (`bench`), never to verify it.
+pub struct UnorderedEdges {
+    /// Per scene triangle: whether it is in G (the peel of G skips the others).
+    in_g: Vec<bool>,
+    /// Per frame: the edges (scene ids).
     per_frame: Vec<HashSet<(u32, u32)>>,
-    /// Per frame: their total weight as the baked file records it.
+    /// Per frame: their total weight in samples.
     recorded: Vec<u64>,
 }
 
-impl RemovedEdges {
-    /// The removed edges of `baked`, for a scene of `scene_triangles` triangles. Errors when
-    /// the file names scene ids the scene lacks.
-    pub fn of_baked(baked: &Baked, scene_triangles: usize) -> Result<RemovedEdges, ReferenceError> {
-        let mut local = vec![0u32; scene_triangles];
-        for (k, &s) in baked.scene_ids.iter().enumerate() {
-            let slot = local.get_mut(s as usize).ok_or_else(|| {
-                ReferenceError::Invalid(format!(
-                    "the baked file names scene triangle {s}; the scene has {scene_triangles}"
-                ))
-            })?;
-            *slot = k as u32 + 1;
+impl UnorderedEdges {
+    /// Per frame of `recordings` (frame ranges of one path, any order), the edges of E_f on a
+    /// cycle of E_f; of its tie edges for a depth-only bake (`depth_only`), which keeps only
+    /// those. Errors when a recording names scene ids beyond the scene's `scene_triangles`.
+    pub fn of_recordings(
+        recordings: &[Recording],
+        depth_only: bool,
+        scene_triangles: usize,
+    ) -> Result<UnorderedEdges, ReferenceError> {
+        let mut edges = UnorderedEdges::empty(scene_triangles);
+        for r in recordings {
+            edges.add_g(&r.unique_visible, "a recording")?;
+            for fr in &r.frames {
+                let source = if depth_only { &fr.ties } else { &fr.edges };
+                edges.set_frame(
+                    fr.frame as usize,
+                    trisort_verify::cycle_edges(source)
+                        .iter()
+                        .map(|e| (e.from, e.to, e.weight)),
+                );
+            }
         }
-        Ok(RemovedEdges {
-            local,
-            per_frame: baked
-                .removed_edges
-                .iter()
-                .map(|es| es.iter().map(|e| (e.from, e.to)).collect())
-                .collect(),
-            recorded: baked
-                .removed_edges
-                .iter()
-                .map(|es| es.iter().map(|e| e.weight as u64).sum())
-                .collect(),
-        })
+        Ok(edges)
     }
 
-    /// The removed edges' total weight of frame `f` as the file records it (its claimed
-    /// `unordered_samples`).
+    /// The edges `baked` says its merger removed, for a scene of `scene_triangles` triangles.
+    /// Errors when the file names scene ids the scene lacks.
+    pub fn of_baked(
+        baked: &Baked,
+        scene_triangles: usize,
+    ) -> Result<UnorderedEdges, ReferenceError> {
+        let mut edges = UnorderedEdges::empty(scene_triangles);
+        edges.add_g(&baked.scene_ids, "the baked file")?;
+        let scene = |t: u32| baked.scene_ids.get(t as usize).copied().unwrap_or(u32::MAX);
+        for (f, removed) in baked.removed_edges.iter().enumerate() {
+            edges.set_frame(
+                f,
+                removed
+                    .iter()
+                    .map(|e| (scene(e.from), scene(e.to), e.weight)),
+            );
+        }
+        Ok(edges)
+    }
+
+    fn empty(scene_triangles: usize) -> UnorderedEdges {
+        UnorderedEdges {
+            in_g: vec![false; scene_triangles],
+            per_frame: Vec::new(),
+            recorded: Vec::new(),
+        }
+    }
+
+    /// Marks the members of `g` (scene ids, from `what`) as triangles of G.
+    fn add_g(&mut self, g: &[u32], what: &str) -> Result<(), ReferenceError> {
+        let n = self.in_g.len();
+        for &s in g {
+            *self.in_g.get_mut(s as usize).ok_or_else(|| {
+                ReferenceError::Invalid(format!(
+                    "{what} names scene triangle {s}; the scene has {n}"
+                ))
+            })? = true;
+        }
+        Ok(())
+    }
+
+    /// Frame `f`'s edges `(from, to, weight)` in scene ids.
+    fn set_frame(&mut self, f: usize, edges: impl Iterator<Item = (u32, u32, u32)>) {
+        if self.per_frame.len() <= f {
+            self.per_frame.resize_with(f + 1, HashSet::new);
+            self.recorded.resize(f + 1, 0);
+        }
+        let (mut set, mut weight) = (HashSet::new(), 0u64);
+        for (a, b, w) in edges {
+            set.insert((a, b));
+            weight += w as u64;
+        }
+        self.per_frame[f] = set;
+        self.recorded[f] = weight;
+    }
+
+    /// The edges' total weight in frame `f`: the unordered samples the recording (or the
+    /// file, for [`UnorderedEdges::of_baked`]) counts there.
     pub fn recorded_weight(&self, f: u32) -> u64 {
         self.recorded.get(f as usize).copied().unwrap_or(0)
     }
@@ -130,12 +189,13 @@ pub struct ReferenceFrame {
     pub frame: u32,
     /// `width × height` pixels, RGBA8, sRGB-encoded, alpha 255 (as [`quantize_rgba16f`]).
     pub rgba8: Vec<u8>,
-    /// Per pixel: whether it has an unordered sample (all false without [`RemovedEdges`]).
+    /// Per pixel: whether it has an unordered sample (all false without [`UnorderedEdges`]).
     pub unordered: Vec<bool>,
-    /// Number of (sample, removed edge) occurrences found by the peel.
+    /// Number of samples whose consecutive fragments form one of the [`UnorderedEdges`], as
+    /// the peel finds them.
     pub unordered_samples: u64,
-    /// Peel layers peeled (`depth` mode stops after the first where the frame has no removed
-    /// edge).
+    /// Peel layers peeled (`depth` mode stops after the first where the frame has no
+    /// unordered edge).
     pub layers: u32,
     /// Whether the peel stopped at `max_layers` with fragments left.
     pub truncated: bool,
@@ -296,11 +356,11 @@ impl<'g> ExactReference<'g> {
         &self.config
     }
 
-    /// Renders frame `frame`. With `removed`, also finds the unordered samples of the frame.
+    /// Renders frame `frame`. With `unordered`, also finds the unordered samples of the frame.
     pub fn render(
         &self,
         frame: u32,
-        removed: Option<&RemovedEdges>,
+        unordered: Option<&UnorderedEdges>,
     ) -> Result<ReferenceFrame, ReferenceError> {
         let (w, h) = self.config.size;
         let pixels = w as usize * h as usize;
@@ -308,31 +368,29 @@ impl<'g> ExactReference<'g> {
         let samples = self.config.samples as usize;
         let slots = self.peeler.slots();
         let mut layer_ids: Vec<Vec<u32>> = Vec::new();
-        let mut last_g = vec![0u32; if removed.is_some() { slots } else { 0 }];
+        // Per sample: the scene id + 1 of its last fragment of G (0: none yet).
+        let mut last_g = vec![0u32; if unordered.is_some() { slots } else { 0 }];
         let mut unordered_sample = vec![false; pixels];
         let mut unordered_samples = 0u64;
         let no_edges = HashSet::new();
-        let edges = removed.map(|r| r.per_frame.get(frame as usize).unwrap_or(&no_edges));
+        let edges = unordered.map(|r| r.per_frame.get(frame as usize).unwrap_or(&no_edges));
         // `depth` composites only the first layer; it peels on only to find unordered samples.
         let full = !depth_mode || edges.is_some_and(|e| !e.is_empty());
         let (layers, truncated) =
             self.peeler
                 .peel(frame, self.config.max_layers, |k, layer, _| {
-                    if let (Some(r), Some(edges)) = (removed, edges) {
+                    if let (Some(r), Some(edges)) = (unordered, edges) {
                         for (i, &id) in layer.ids.iter().enumerate() {
-                            if id == 0 {
-                                continue;
-                            }
-                            let local = r.local.get((id - 1) as usize).copied().unwrap_or(0);
-                            if local == 0 {
+                            let in_g = id != 0 && r.in_g.get((id - 1) as usize) == Some(&true);
+                            if !in_g {
                                 continue;
                             }
                             let prev = last_g[i];
-                            if prev != 0 && edges.contains(&(prev - 1, local - 1)) {
+                            if prev != 0 && edges.contains(&(prev - 1, id - 1)) {
                                 unordered_samples += 1;
                                 unordered_sample[i / samples] = true;
                             }
-                            last_g[i] = local;
+                            last_g[i] = id;
                         }
                     }
                     if !depth_mode || k == 0 {

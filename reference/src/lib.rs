@@ -30,7 +30,7 @@ pub mod verify;
 pub use compare::{compare, Comparison};
 pub use default_pipeline::DefaultRenderer;
 pub use deploy::Srgb8Player;
-pub use exact::{ExactReference, ReferenceConfig, ReferenceFrame, RemovedEdges};
+pub use exact::{ExactReference, ReferenceConfig, ReferenceFrame, UnorderedEdges};
 pub use oit::{OitConfig, OitFrame, OitRenderer};
 pub use peeling::{PeeledFrame, PeelingConfig, PeelingRenderer};
 pub use verify::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};

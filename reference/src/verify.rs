@@ -1,14 +1,22 @@
 //! Image verification of a baked file (`trisort verify --scene`): each frame played by the
-//! player against the exact reference of the full scene, at the same size, sample count and
-//! mode.
+//! player (or captured elsewhere: `--frames-dir`) against the exact reference of the full
+//! scene, at the same size, sample count and mode.
+//!
+//! What may differ comes from the recordings, never from the baked file (DESIGN § Second
+//! wave): a pixel is *unordered*, and excused, only when one of its samples has consecutive
+//! peel fragments a, b with a → b an edge on a cycle of the recording's E_f
+//! ([`UnorderedEdges::of_recordings`]). Without a recording no pixel is excused. With one, the
+//! reference also takes the path (cameras, poses), the recorded pattern and the recording
+//! device from it, not from the file.
 //!
 //! The rule ([`ImageCheck`]):
-//! - At the recorded pattern (the file's size and sample count, on its recording device):
-//!   `depth` fails a frame that is not bit-exact on its ordered pixels (those without an
-//!   unordered sample: there the file itself says the order is broken, and a transparent
+//! - At the recorded pattern (the recorded size and sample count, on the recording device):
+//!   `depth` fails a frame that is not bit-exact on its ordered pixels (a transparent
 //!   fragment drawn after a farther one still blends over it); `blend` and `saturate` fail a
 //!   frame with an ordered pixel more than 1/255 off in a colour channel. A truncated
-//!   reference peel fails too.
+//!   reference peel fails too. Frames captured elsewhere are held to the same rule at the
+//!   recorded size and sample count, whatever their device (that is what signing off a head
+//!   unit's frames means).
 //! - Off the pattern (another size, sample count or device): the error is measured, and a
 //!   frame fails only when `max_error` is given and its `max_channel_diff_ordered` (the largest
 //!   colour-channel difference on ordered pixels, in 1/255 units) exceeds it.
@@ -16,13 +24,13 @@
 //! The 8-bit sRGB deployment error is measured alongside when asked and never gates.
 
 use serde::Serialize;
-use trisort_format::{Baked, Geometry};
+use trisort_format::{Baked, DeviceInfo, FrameState, Geometry, RecordSettings, Recording};
 use trisort_gpu::Gpu;
 use trisort_player::{HeadlessConfig, HeadlessRenderer, Mode};
 
 use crate::compare::{compare, Comparison};
 use crate::deploy::Srgb8Player;
-use crate::exact::{ExactReference, ReferenceConfig, ReferenceFrame, RemovedEdges};
+use crate::exact::{ExactReference, ReferenceConfig, ReferenceFrame, UnorderedEdges};
 use crate::ReferenceError;
 
 /// What to verify.
@@ -39,6 +47,10 @@ pub struct ImageCheck {
     pub max_error: Option<u8>,
     /// Also measure the player on an 8-bit sRGB target.
     pub srgb8: bool,
+    /// The frames are captured elsewhere ([`ImageVerifier::verify_captured`]): no player and
+    /// no sRGB figure here, and the recorded pattern is the recorded size and sample count
+    /// whatever the device that drew them.
+    pub captured: bool,
 }
 
 impl ImageCheck {
@@ -50,6 +62,7 @@ impl ImageCheck {
             mode,
             max_error: None,
             srgb8: true,
+            captured: false,
         }
     }
 }
@@ -61,14 +74,15 @@ pub struct FrameImageReport {
     pub frame: u32,
     /// Whether the frame passes the rule (see the module documentation).
     pub ok: bool,
-    /// Samples whose consecutive peel fragments form an edge the merger removed, as the
-    /// reference's peel finds them.
+    /// Samples whose consecutive peel fragments form an edge on a cycle of the recording's
+    /// E_f (excusable), as the reference's peel finds them; 0 without a recording.
     pub unordered_samples: u64,
-    /// The removed edges' total weight as the baked file records it.
+    /// The recording's weight of those edges in this frame: at the recorded pattern the peel
+    /// finds exactly these samples.
     pub unordered_samples_recorded: u64,
     /// Pixels with at least one unordered sample.
     pub unordered_pixels: u64,
-    /// The player's frame against the reference.
+    /// The player's (or the captured) frame against the reference.
     #[serde(flatten)]
     pub comparison: Comparison,
     /// Peel layers of the reference.
@@ -83,60 +97,120 @@ pub struct FrameImageReport {
 pub struct VerifiedFrame {
     /// The figures.
     pub report: FrameImageReport,
-    /// The player's frame.
+    /// The player's frame, or the captured one.
     pub player: Vec<u8>,
     /// The reference.
     pub reference: ReferenceFrame,
+}
+
+/// What the reference is rendered from: the recordings where given, else the baked file.
+struct Truth<'a> {
+    settings: RecordSettings,
+    device: &'a DeviceInfo,
+    frame_states: &'a [FrameState],
+    /// Excusable edges; `None`: no pixel is excused.
+    unordered: Option<UnorderedEdges>,
+}
+
+impl<'a> Truth<'a> {
+    fn new(
+        baked: &'a Baked,
+        recordings: &'a [Recording],
+        scene_triangles: usize,
+    ) -> Result<Truth<'a>, ReferenceError> {
+        let Some(first) = recordings.first() else {
+            return Ok(Truth {
+                settings: baked.settings,
+                device: &baked.device,
+                frame_states: &baked.frame_states,
+                unordered: None,
+            });
+        };
+        let path = first.frame_states.len();
+        if recordings
+            .iter()
+            .any(|r| r.frame_states != first.frame_states)
+        {
+            return Err(ReferenceError::Invalid(
+                "the recordings are of different paths".into(),
+            ));
+        }
+        if path != baked.frames.len() {
+            return Err(ReferenceError::Invalid(format!(
+                "the recorded path has {path} frames, the baked file {}",
+                baked.frames.len()
+            )));
+        }
+        let unordered =
+            UnorderedEdges::of_recordings(recordings, baked.merge.depth_only, scene_triangles)?;
+        Ok(Truth {
+            settings: first.settings,
+            device: &first.device,
+            frame_states: &first.frame_states,
+            unordered: Some(unordered),
+        })
+    }
 }
 
 /// A baked file, its full scene and the renderers to compare them frame by frame.
 pub struct ImageVerifier<'g> {
     check: ImageCheck,
     at_pattern: bool,
-    player: HeadlessRenderer<'g>,
+    /// `None` for frames captured elsewhere.
+    player: Option<HeadlessRenderer<'g>>,
     reference: ExactReference<'g>,
     srgb8: Option<Srgb8Player<'g>>,
-    removed: RemovedEdges,
+    unordered: Option<UnorderedEdges>,
 }
 
 impl<'g> ImageVerifier<'g> {
     /// Sets up verification of `baked` against the full scene `geometry` (the one whose hash
-    /// the file records; the caller checks the hash). Errors on a scene that lacks triangles
-    /// the file names, or where the renderers cannot be created.
+    /// the file records; the caller checks the hash) and, where given, the `recordings` it was
+    /// merged from (the caller checks they are of this scene): they decide which pixels may
+    /// be unordered and give the reference its path and pattern. Errors on a scene that lacks
+    /// triangles the files name, recordings of another path or length, or where the renderers
+    /// cannot be created.
     pub fn new(
         gpu: &'g Gpu,
         baked: &Baked,
         geometry: &Geometry,
         check: ImageCheck,
+        recordings: &[Recording],
     ) -> Result<ImageVerifier<'g>, ReferenceError> {
-        let removed = RemovedEdges::of_baked(baked, geometry.triangles.len())?;
-        let s = &baked.settings;
+        let truth = Truth::new(baked, recordings, geometry.triangles.len())?;
+        let s = &truth.settings;
         let at_pattern = check.size == (s.width, s.height)
             && check.samples == s.samples.max(1)
-            && gpu.device_info() == baked.device;
-        let player = HeadlessRenderer::new(
-            gpu,
-            baked,
-            &HeadlessConfig {
-                size: check.size,
-                samples: check.samples,
-                mode: check.mode,
-                glass_opacity: None,
-                draw_path: None,
-                force_u32: false,
-            },
-        )?;
+            && (check.captured || gpu.device_info() == *truth.device);
+        let player = if check.captured {
+            None
+        } else {
+            Some(HeadlessRenderer::new(
+                gpu,
+                baked,
+                &HeadlessConfig {
+                    size: check.size,
+                    samples: check.samples,
+                    mode: check.mode,
+                    glass_opacity: None,
+                    draw_path: None,
+                    force_u32: false,
+                },
+            )?)
+        };
         let reference = ExactReference::new(
             gpu,
             geometry,
-            &baked.frame_states,
+            truth.frame_states,
             ReferenceConfig {
                 size: check.size,
                 samples: check.samples,
-                ..ReferenceConfig::recorded(baked, check.mode)
+                mode: check.mode,
+                glass_opacity: s.glass_opacity,
+                max_layers: 4096,
             },
         )?;
-        let srgb8 = if check.srgb8 {
+        let srgb8 = if check.srgb8 && !check.captured {
             Some(Srgb8Player::new(
                 gpu,
                 baked,
@@ -153,31 +227,59 @@ impl<'g> ImageVerifier<'g> {
             player,
             reference,
             srgb8,
-            removed,
+            unordered: truth.unordered,
         })
     }
 
-    /// Whether frames are checked at the recorded pattern (size, samples and device).
+    /// Whether frames are checked at the recorded pattern (size, samples and, for frames
+    /// played here, device).
     pub fn at_recorded_pattern(&self) -> bool {
         self.at_pattern
     }
 
-    /// Plays, references and compares frame `frame`.
+    /// Plays, references and compares frame `frame`. Errors for a verifier of captured
+    /// frames.
     pub fn verify(&self, frame: u32) -> Result<VerifiedFrame, ReferenceError> {
-        let (w, h) = self.check.size;
-        let played = self.player.render(frame)?;
-        let reference = self.reference.render(frame, Some(&self.removed))?;
-        let comparison = compare(&played.rgba8, &reference.rgba8, w, h, &reference.unordered);
+        let player = self.player.as_ref().ok_or_else(|| {
+            ReferenceError::Invalid("this verifier checks captured frames: it has no player".into())
+        })?;
+        let played = player.render(frame)?.rgba8;
         let srgb8 = match &self.srgb8 {
-            Some(p) => Some(compare(
-                &p.render(frame)?,
-                &reference.rgba8,
-                w,
-                h,
-                &reference.unordered,
-            )),
+            Some(p) => Some(p.render(frame)?),
             None => None,
         };
+        self.judge(frame, played, srgb8)
+    }
+
+    /// References frame `frame` and compares `rgba8`, the frame as drawn elsewhere (size ×
+    /// 4 bytes, sRGB; alpha ignored), with it. Errors when the image has the wrong length.
+    pub fn verify_captured(
+        &self,
+        frame: u32,
+        rgba8: Vec<u8>,
+    ) -> Result<VerifiedFrame, ReferenceError> {
+        let (w, h) = self.check.size;
+        if rgba8.len() != w as usize * h as usize * 4 {
+            return Err(ReferenceError::Invalid(format!(
+                "frame {frame}: the captured image holds {} bytes, not {w}x{h} RGBA8",
+                rgba8.len()
+            )));
+        }
+        self.judge(frame, rgba8, None)
+    }
+
+    /// Renders the reference of `frame` and judges `test` (and the sRGB target's frame)
+    /// against it.
+    fn judge(
+        &self,
+        frame: u32,
+        test: Vec<u8>,
+        srgb8: Option<Vec<u8>>,
+    ) -> Result<VerifiedFrame, ReferenceError> {
+        let (w, h) = self.check.size;
+        let reference = self.reference.render(frame, self.unordered.as_ref())?;
+        let comparison = compare(&test, &reference.rgba8, w, h, &reference.unordered);
+        let srgb8 = srgb8.map(|img| compare(&img, &reference.rgba8, w, h, &reference.unordered));
         let ok = if self.at_pattern {
             !reference.truncated
                 && match self.check.mode {
@@ -193,7 +295,10 @@ impl<'g> ImageVerifier<'g> {
             frame,
             ok,
             unordered_samples: reference.unordered_samples,
-            unordered_samples_recorded: self.removed.recorded_weight(frame),
+            unordered_samples_recorded: self
+                .unordered
+                .as_ref()
+                .map_or(0, |u| u.recorded_weight(frame)),
             unordered_pixels: reference.unordered.iter().filter(|&&u| u).count() as u64,
             comparison,
             layers: reference.layers,
@@ -202,7 +307,7 @@ impl<'g> ImageVerifier<'g> {
         };
         Ok(VerifiedFrame {
             report,
-            player: played.rgba8,
+            player: test,
             reference,
         })
     }

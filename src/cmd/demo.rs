@@ -78,7 +78,9 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         &baked,
         &scene.geometry,
         trisort_reference::ImageCheck::recorded(&baked, trisort_player::Mode::Blend),
+        std::slice::from_ref(&rec),
         0..baked.frames.len() as u32,
+        None,
         |_| Ok(()),
     )?;
     let images_s = t_images.elapsed().as_secs_f64();

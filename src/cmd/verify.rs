@@ -1,14 +1,16 @@
 //! `trisort verify BAKED`: the graph rules against recordings (`--recording`), the images
 //! against the exact reference of the full scene (`--scene`), or both.
 //!
-//! Images: each frame of `--frames` is played by the player and rendered by the exact
-//! reference (`trisort_reference`) at the same size, sample count and mode. At the recorded
-//! pattern (the file's size and samples, on its recording device) a frame fails when `depth`
-//! mode is not bit-exact, or when `blend`/`saturate` differ by more than 1/255 in a colour
-//! channel at a pixel without an unordered sample. Off the pattern the error is measured and a
-//! frame fails only above `--max-error N`: the largest colour-channel difference on ordered
-//! pixels, in 1/255 units (no `--max-error`: measure only). The error of an 8-bit sRGB
-//! deployment target is reported separately (`srgb8`) and never gated on.
+//! Images: each frame of `--frames` is played by the player (or read from `--frames-dir`,
+//! frames drawn elsewhere) and rendered by the exact reference (`trisort_reference`) at the
+//! same size, sample count and mode. At the recorded pattern (the recorded size and samples,
+//! on the recording device; for captured frames, whatever the device) a frame fails when
+//! `depth` mode is not bit-exact, or when `blend`/`saturate` differ by more than 1/255 in a
+//! colour channel at an ordered pixel. Which pixels are unordered (excused) comes from the
+//! recordings' cycles only: with `--scene` alone no pixel is excused. Off the pattern the error
+//! is measured and a frame fails only above `--max-error N`: the largest colour-channel
+//! difference on ordered pixels, in 1/255 units (no `--max-error`: measure only). The error of
+//! an 8-bit sRGB deployment target is reported separately (`srgb8`) and never gated on.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -17,7 +19,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::{json, Value};
-use trisort_format::{Baked, Geometry};
+use trisort_format::{Baked, Geometry, RecordSettings, Recording};
 use trisort_gpu::Gpu;
 use trisort_player::Mode;
 use trisort_reference::compare::{difference_image, mask_image};
@@ -35,7 +37,8 @@ pub const VERIFY_FAILED: u8 = 3;
 pub struct VerifyArgs {
     /// Baked file.
     baked: PathBuf,
-    /// Recording(s) the file was merged from: checks the graph rules.
+    /// Recording(s) the file was merged from: checks the graph rules, and gives the image
+    /// check its unordered pixels (the recordings' cycles), path and recorded pattern.
     #[arg(long, num_args = 1..)]
     recording: Vec<PathBuf>,
     /// Scene (.glb/.gltf or `demo[:TRIANGLES]`): checks the images against the exact reference.
@@ -64,6 +67,11 @@ pub struct VerifyArgs {
     /// With `--diff-dir`: write the images of every checked frame, not only failing ones.
     #[arg(long)]
     diff_all: bool,
+    /// Check frames drawn elsewhere (another GPU, the target device, a browser) instead of
+    /// playing them here: PNGs named as `play --out-dir` writes them (`frame-NNNNN.png`), at
+    /// the checked size. Needs `--scene`.
+    #[arg(long, value_name = "DIR", requires = "scene")]
+    frames_dir: Option<PathBuf>,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -94,30 +102,65 @@ pub fn check_scene(baked: &Baked, scene: &trisort_scene::Scene, spec: &str) -> R
 }
 
 /// Verifies `frames` of `baked` against the exact reference of `geometry`, calling `each`
-/// with every verified frame (for difference images and progress).
+/// with every verified frame (for difference images and progress). `recordings` (may be
+/// empty) decide which pixels may be unordered and give the reference its path and pattern;
+/// `captured` is a directory of frames drawn elsewhere to check instead of playing them
+/// (`check.captured` must then be set).
+#[allow(clippy::too_many_arguments)]
 pub fn verify_images(
     gpu: &Gpu,
     baked: &Baked,
     geometry: &Geometry,
     check: ImageCheck,
+    recordings: &[Recording],
     frames: Range<u32>,
+    captured: Option<&Path>,
     mut each: impl FnMut(&VerifiedFrame) -> Result<()>,
 ) -> Result<ImageReport> {
-    let verifier = ImageVerifier::new(gpu, baked, geometry, check)?;
+    let verifier = ImageVerifier::new(gpu, baked, geometry, check, recordings)?;
     let mut report = ImageReport {
         ok: true,
         at_recorded_pattern: verifier.at_recorded_pattern(),
         frames: Vec::with_capacity(frames.len()),
     };
     for f in frames {
-        let v = verifier
-            .verify(f)
-            .with_context(|| format!("verifying frame {f}"))?;
+        let v = match captured {
+            Some(dir) => verifier.verify_captured(f, read_captured(dir, f, check.size)?),
+            None => verifier.verify(f),
+        }
+        .with_context(|| format!("verifying frame {f}"))?;
         each(&v)?;
         report.ok &= v.report.ok;
         report.frames.push(v.report);
     }
     Ok(report)
+}
+
+/// Frame `f` as drawn elsewhere: `DIR/frame-NNNNN.png` (the name `play --out-dir` gives it),
+/// which must be `size`, as RGBA8. A missing, unreadable or wrong-size file is an error
+/// naming it.
+fn read_captured(dir: &Path, f: u32, size: (u32, u32)) -> Result<Vec<u8>> {
+    let path = dir.join(format!("frame-{f:05}.png"));
+    if !path.is_file() {
+        bail!(
+            "{}: frame {f} is missing (--frames-dir holds one PNG per checked frame, named frame-NNNNN.png as play --out-dir writes them)",
+            path.display()
+        );
+    }
+    let image = image::open(&path)
+        .with_context(|| format!("{}: not a readable image", path.display()))?
+        .to_rgba8();
+    if image.dimensions() != size {
+        bail!(
+            "{}: the image is {}x{}, the frames are checked at {}x{} (the recorded size, or --size)",
+            path.display(),
+            image.width(),
+            image.height(),
+            size.0,
+            size.1
+        );
+    }
+    Ok(image.into_raw())
 }
 
 fn write_diff(dir: &Path, v: &VerifiedFrame, size: (u32, u32)) -> Result<()> {
@@ -147,55 +190,27 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
     if a.recording.is_empty() && a.scene.is_none() {
         bail!("nothing to verify against: give --recording REC (graph rules) and/or --scene SCENE (images)");
     }
-    let graph = if a.recording.is_empty() {
-        None
-    } else {
-        let recs = read_recordings(&a.recording)?;
-        Some(trisort_verify::check_graph(&recs, &baked))
-    };
+    let recs = read_recordings(&a.recording)?;
+    let graph = (!recs.is_empty()).then(|| trisort_verify::check_graph(&recs, &baked));
     let images = match &a.scene {
         None => None,
-        Some(spec) => {
-            let mut scene = load_scene(spec)?;
-            // The scene as it was recorded: split where the recording split it.
-            working_scene(&mut scene, &baked.frame_states, &baked.settings);
-            check_scene(&baked, &scene, spec)?;
-            let n = baked.frames.len() as u32;
-            let range = match a.frames {
-                Some(r) => r.resolve(n)?,
-                None if n == 0 => bail!("the baked file has no frames"),
-                None => 0..n,
-            };
-            let check = ImageCheck {
-                size: a
-                    .size
-                    .unwrap_or((baked.settings.width, baked.settings.height)),
-                samples: a.samples.unwrap_or(baked.settings.samples.max(1)),
-                max_error: a.max_error,
-                ..ImageCheck::recorded(&baked, a.mode)
-            };
-            if check.samples != 1 && check.samples != 4 {
-                bail!("--samples {}: only 1 and 4 are supported", check.samples);
+        Some(spec) => match image_check(&a, spec, &baked, &recs) {
+            Ok(r) => Some(r),
+            // The graph rules failed already (the files disagree): that is the verdict.
+            Err(e) if graph.as_ref().is_some_and(|g| !g.ok) => {
+                eprintln!("trisort: the images were not compared: {e:#}");
+                None
             }
-            let gpu = crate::common::open_gpu()?;
-            if !a.json {
-                println!("device: {}", gpu.describe());
-            }
-            let size = check.size;
-            let report = verify_images(&gpu, &baked, &scene.geometry, check, range, |v| {
-                if let Some(dir) = &a.diff_dir {
-                    if a.diff_all || !v.report.ok {
-                        write_diff(dir, v, size)?;
-                    }
-                }
-                Ok(())
-            })?;
-            Some((report, check))
-        }
+            Err(e) => return Err(e),
+        },
     };
     let ok = graph.as_ref().is_none_or(|g| g.ok) && images.as_ref().is_none_or(|i| i.0.ok);
     if a.json {
-        print_json(&json_report(ok, graph.as_ref(), images.as_ref()));
+        let mut v = json_report(ok, graph.as_ref(), images.as_ref());
+        if let Some(dir) = &a.frames_dir {
+            v["frames_dir"] = json!(dir.display().to_string());
+        }
+        print_json(&v);
     } else {
         print_report(&a.baked, graph.as_ref(), images.as_ref());
         println!(
@@ -209,6 +224,65 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
     } else {
         ExitCode::from(VERIFY_FAILED)
     })
+}
+
+/// The image check of `verify --scene SPEC`: the scene as recorded (split where the
+/// recording split it, by the recording's path and settings where given), checked against the
+/// files' scene hashes, then every frame of `--frames`.
+fn image_check(
+    a: &VerifyArgs,
+    spec: &str,
+    baked: &Baked,
+    recs: &[Recording],
+) -> Result<(ImageReport, ImageCheck)> {
+    let (states, settings): (&[_], RecordSettings) = match recs.first() {
+        Some(r) => (&r.frame_states, r.settings),
+        None => (&baked.frame_states, baked.settings),
+    };
+    let mut scene = load_scene(spec)?;
+    // The scene as it was recorded: split where the recording split it.
+    working_scene(&mut scene, states, &settings);
+    check_scene(baked, &scene, spec)?;
+    for (file, r) in a.recording.iter().zip(recs) {
+        if r.scene_hash != scene.hash() {
+            bail!(
+                "{}: the recording is not of scene {spec}: its pixels cannot excuse the scene's",
+                file.display()
+            );
+        }
+    }
+    let n = baked.frames.len() as u32;
+    let range = match a.frames {
+        Some(r) => r.resolve(n)?,
+        None if n == 0 => bail!("the baked file has no frames"),
+        None => 0..n,
+    };
+    let check = ImageCheck {
+        size: a.size.unwrap_or((settings.width, settings.height)),
+        samples: a.samples.unwrap_or(settings.samples.max(1)),
+        max_error: a.max_error,
+        captured: a.frames_dir.is_some(),
+        ..ImageCheck::recorded(baked, a.mode)
+    };
+    if check.samples != 1 && check.samples != 4 {
+        bail!("--samples {}: only 1 and 4 are supported", check.samples);
+    }
+    let gpu = crate::common::open_gpu()?;
+    if !a.json {
+        println!("device: {}", gpu.describe());
+    }
+    let size = check.size;
+    let geometry = &scene.geometry;
+    let captured = a.frames_dir.as_deref();
+    let report = verify_images(&gpu, baked, geometry, check, recs, range, captured, |v| {
+        if let Some(dir) = &a.diff_dir {
+            if a.diff_all || !v.report.ok {
+                write_diff(dir, v, size)?;
+            }
+        }
+        Ok(())
+    })?;
+    Ok((report, check))
 }
 
 fn json_report(
@@ -252,6 +326,8 @@ fn json_report(
         out["samples"] = json!(check.samples);
         out["at_recorded_pattern"] = json!(report.at_recorded_pattern);
         out["max_error"] = json!(check.max_error);
+        out["captured"] = json!(check.captured);
+        out["unordered_from_recording"] = json!(graph.is_some());
     }
     out
 }
@@ -284,7 +360,12 @@ fn print_report(
     if let Some((report, check)) = images {
         let bad = report.frames.iter().filter(|f| !f.ok).count();
         println!(
-            "images of {} ({} mode, {}x{}, {}x MSAA, {}): {} ({} frames checked, {} failing)",
+            "{} of {} ({} mode, {}x{}, {}x MSAA, {}): {} ({} frames checked, {} failing)",
+            if check.captured {
+                "captured frames"
+            } else {
+                "images"
+            },
             baked.display(),
             check.mode,
             check.size.0,
@@ -301,6 +382,14 @@ fn print_report(
             if report.ok { "OK" } else { "FAILED" },
             report.frames.len(),
             bad
+        );
+        println!(
+            "  unordered (excused) pixels: {}",
+            if graph.is_some() {
+                "those with a sample on a cycle of the recording's E_f"
+            } else {
+                "none (no --recording)"
+            }
         );
         println!(
             "  frame  ok  differing  ordered  max  max_ord  psnr   flip     unordered  srgb8_max"
