@@ -15,5 +15,6 @@ mod long_paths;
 mod merge_car;
 mod record_cli;
 mod verify_cli;
+mod verify_forged;
 mod verify_images;
 mod window_cli;

@@ -134,7 +134,7 @@ impl Rule3<'_> {
             queue: Vec::new(),
         };
         let kept = |k: usize| !fe.cut[k];
-        let mut stamp = 0u32;
+        // Each search stamps the vertices it reaches with its edge's id.
         for k in (0..fe.edges.len()).filter(|&k| fe.cut[k]) {
             let (u, v) = graph.ends(k);
             let (a, b, w) = fe.edges[k];
@@ -145,7 +145,7 @@ impl Rule3<'_> {
                     "frame {f}: removed edge {} (scene ids, weight {w}) lies on no cycle of E_f: its order was never in doubt",
                     self.edge(a, b)
                 ));
-            } else if !search.reaches(v, u, stamp, &kept) {
+            } else if !search.reaches(v, u, k as u32, &kept) {
                 fm.removed_not_needed += 1;
                 fm.graph_violations += 1;
                 report.problem_if(fm.removed_not_needed <= EXAMPLES, || format!(
@@ -154,7 +154,6 @@ impl Rule3<'_> {
                     self.edge(b, a)
                 ));
             }
-            stamp += 1;
         }
     }
 
