@@ -92,6 +92,14 @@ pub struct MergeStats {
     pub cell_constraint_edges: u64,
     /// The same after transitive reduction (its gain: how many edges were redundant).
     pub cell_constraint_edges_reduced: u64,
+    /// Strongly connected components of the frames' graphs (two or more triangles, summed
+    /// over frames) whose cycles were broken by an exact minimum-weight feedback arc set.
+    pub exact_components: u64,
+    /// Those too big to solve exactly, broken by the weighted Eades–Lin–Smyth heuristic.
+    pub heuristic_components: u64,
+    /// The part of `unordered_samples` removed in heuristic components (not proven minimal;
+    /// the rest is minimum weight per component, self-loops included).
+    pub heuristic_unordered_samples: u64,
 }
 
 /// A baked path: everything the player needs, and what the validator needs to check it.

@@ -72,6 +72,9 @@ impl Assembled {
             seconds: 0.0,
             cell_constraint_edges: self.edges.0,
             cell_constraint_edges_reduced: self.edges.1,
+            exact_components: graphs.iter().map(|g| g.components.0 as u64).sum(),
+            heuristic_components: graphs.iter().map(|g| g.components.1 as u64).sum(),
+            heuristic_unordered_samples: graphs.iter().map(|g| g.components.2).sum(),
         };
         Baked {
             tool_version: trisort_format::TOOL_VERSION.to_string(),

@@ -1,82 +1,119 @@
-//! Cycle breaking inside one frame's graph: a small-weight feedback arc set by the weighted
-//! Eades–Lin–Smyth heuristic, run per strongly connected component.
+//! Cycle breaking inside one frame's graph: a minimum-weight feedback arc set, per strongly
+//! connected component.
 //!
-//! P. Eades, X. Lin, W. F. Smyth, "A fast and effective heuristic for the feedback arc set
-//! problem", Information Processing Letters 47 (1993). The greedy order peels sinks to the
-//! back and sources to the front, and otherwise moves the vertex with the largest
-//! (outgoing − incoming) *weight* to the front; the edges that point backwards in that order
-//! form the arc set. petgraph's `greedy_feedback_arc_set` ignores weights, so this one is
-//! written here; petgraph only finds the components. Afterwards every removed edge whose
-//! re-insertion closes no cycle is put back (heaviest first), so the set is minimal.
+//! Components are found without recursion (`scc.rs`; petgraph's `tarjan_scc`
+//! recurses once per vertex and overflows a rayon worker's stack on long chains). Each
+//! component that the exact reductions shrink to at most 16 vertices is solved exactly
+//! (`exact.rs`: every component of up to 24 edges or 16 vertices; real frames' cycles are
+//! tiny), the others by the weighted Eades–Lin–Smyth heuristic (`els.rs`). Afterwards every
+//! removed edge whose re-insertion closes no cycle is put back (heaviest first), so the set is
+//! minimal on both paths: each removed edge lies on a cycle of the frame's graph and is
+//! needed, which the independent validator checks. Where the heuristic's set already has the
+//! minimum weight it is the one kept, so a bake changes only where the exact solution
+//! removes less weight.
 
-use std::collections::BTreeSet;
+mod els;
+mod exact;
+mod scc;
 
-use petgraph::graph::{DiGraph, NodeIndex};
+/// The result of [`feedback_arc_set`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ArcSet {
+    /// One flag per edge: `true` if the edge is removed.
+    pub removed: Vec<bool>,
+    /// Strongly connected components (of two or more vertices) solved exactly.
+    pub exact_components: u32,
+    /// Strongly connected components left to the heuristic (too big to solve exactly).
+    pub heuristic_components: u32,
+    /// The weight removed from the heuristic components: the part of the removed weight that
+    /// is not proven minimal.
+    pub heuristic_weight: u64,
+}
 
-/// Finds a small-weight set of edges whose removal makes the graph acyclic.
+/// Finds a minimum-weight set of edges whose removal makes the graph acyclic, exactly where
+/// a strongly connected component is small and by a heuristic otherwise.
 ///
 /// `nodes` is the number of vertices; `edges` are `(from, to, weight)` with endpoints below
-/// `nodes` (parallel edges and self-loops allowed; a self-loop is always removed). Returns one
-/// flag per edge: `true` if the edge is removed. Only edges inside a strongly connected
-/// component can be removed. The result is deterministic. Complexity O(E log V) for the
-/// greedy order plus, for the minimality pass, O(E_c) per removed edge of a component with
-/// E_c edges (skipped for components where that would exceed ~5·10⁷ steps).
+/// `nodes` (parallel edges and self-loops allowed; a self-loop is always removed). Only
+/// edges inside a strongly connected component can be removed, and every removed edge is
+/// needed: put back alone, it closes a cycle. The result is deterministic: of several
+/// minimum-weight sets of a component, the heuristic's is kept if it is one of them, else the
+/// one the exact programme's tie rule picks (`exact.rs`); both depend only on the edges and
+/// their order.
+///
+/// Complexity: O(V + E) for the components; per component of E_c edges, O(E_c) for the exact
+/// reductions, then either at most 2¹⁶ · 16 steps for the exact programme or O(E_c log V)
+/// for the heuristic; and O(E_c) per removed edge for the minimality pass (skipped for
+/// heuristic components where that would exceed ~5·10⁷ steps).
 ///
 /// ```
 /// use trisort_merger::cycles::feedback_arc_set;
 /// // A three-triangle cyclic overlap: the lightest edge goes.
-/// let removed = feedback_arc_set(3, &[(0, 1, 5), (1, 2, 4), (2, 0, 1)]);
-/// assert_eq!(removed, vec![false, false, true]);
+/// let set = feedback_arc_set(3, &[(0, 1, 5), (1, 2, 4), (2, 0, 1)]);
+/// assert_eq!(set.removed, vec![false, false, true]);
+/// assert_eq!((set.exact_components, set.heuristic_components), (1, 0));
 /// ```
-pub fn feedback_arc_set(nodes: usize, edges: &[(u32, u32, u32)]) -> Vec<bool> {
-    let mut removed = vec![false; edges.len()];
-    if edges.is_empty() {
-        return removed;
-    }
-    let mut graph = DiGraph::<(), usize>::with_capacity(nodes, edges.len());
-    for _ in 0..nodes {
-        graph.add_node(());
-    }
+pub fn feedback_arc_set(nodes: usize, edges: &[(u32, u32, u32)]) -> ArcSet {
+    feedback_arc_set_up_to(nodes, edges, exact::MAX_VERTICES)
+}
+
+/// [`feedback_arc_set`], solving exactly the components that reduce to at most
+/// `max_exact` vertices (0: none, so tests can run the heuristic on small graphs).
+fn feedback_arc_set_up_to(nodes: usize, edges: &[(u32, u32, u32)], max_exact: usize) -> ArcSet {
+    let mut set = ArcSet {
+        removed: vec![false; edges.len()],
+        exact_components: 0,
+        heuristic_components: 0,
+        heuristic_weight: 0,
+    };
     for (k, &(a, b, _)) in edges.iter().enumerate() {
-        if a == b {
-            removed[k] = true;
-        } else {
-            graph.add_edge(NodeIndex::new(a as usize), NodeIndex::new(b as usize), k);
-        }
+        set.removed[k] = a == b;
     }
-    let mut component = vec![u32::MAX; nodes];
-    let sccs = petgraph::algo::tarjan_scc(&graph);
-    for (c, scc) in sccs.iter().enumerate() {
-        if scc.len() > 1 {
-            for n in scc {
-                component[n.index()] = c as u32;
-            }
-        }
+    let (off, succ) = csr(
+        nodes,
+        edges.iter().filter(|e| e.0 != e.1).map(|&(a, b, _)| (a, b)),
+    );
+    let (component, count) = scc::strongly_connected(&off, &succ);
+    let mut size = vec![0u32; count as usize];
+    for &c in &component {
+        size[c as usize] += 1;
     }
-    // Edges of each non-trivial component.
+    // Edges of each component of two or more vertices, grouped by component.
     let mut by_component: Vec<(u32, usize)> = edges
         .iter()
         .enumerate()
         .filter(|&(_, &(a, b, _))| {
-            a != b
-                && component[a as usize] != u32::MAX
-                && component[a as usize] == component[b as usize]
+            let c = component[a as usize];
+            a != b && c == component[b as usize] && size[c as usize] > 1
         })
         .map(|(k, &(a, _, _))| (component[a as usize], k))
         .collect();
     by_component.sort_unstable();
     for group in by_component.chunk_by(|x, y| x.0 == y.0) {
         let ids: Vec<usize> = group.iter().map(|&(_, k)| k).collect();
-        for k in break_component(edges, &ids) {
-            removed[k] = true;
+        let (cut, exact) = break_component(edges, &ids, max_exact);
+        if exact {
+            set.exact_components += 1;
+        } else {
+            set.heuristic_components += 1;
+            set.heuristic_weight += cut.iter().map(|&k| edges[k].2 as u64).sum::<u64>();
+        }
+        for k in cut {
+            set.removed[k] = true;
         }
     }
-    removed
+    set
 }
 
-/// Weighted ELS on one strongly connected component given by its edge ids; returns the ids
-/// of the edges to remove.
-fn break_component(edges: &[(u32, u32, u32)], ids: &[usize]) -> Vec<usize> {
+/// Breaks the cycles of one strongly connected component given by its edge ids: exactly if
+/// it reduces to at most `max_exact` vertices, else by the heuristic, either way keeping
+/// only needed edges. Returns the ids of the edges to remove (ascending) and whether the
+/// result is exact (of minimum weight).
+fn break_component(
+    edges: &[(u32, u32, u32)],
+    ids: &[usize],
+    max_exact: usize,
+) -> (Vec<usize>, bool) {
     // Local vertex numbering.
     let mut verts: Vec<u32> = ids.iter().flat_map(|&k| [edges[k].0, edges[k].1]).collect();
     verts.sort_unstable();
@@ -87,139 +124,41 @@ fn break_component(edges: &[(u32, u32, u32)], ids: &[usize]) -> Vec<usize> {
         .iter()
         .map(|&k| (local(edges[k].0), local(edges[k].1), edges[k].2 as u64))
         .collect();
-    let order = Els::new(n, &le).order();
-    let mut pos = vec![0u32; n];
-    for (p, &v) in order.iter().enumerate() {
-        pos[v as usize] = p as u32;
+    // The heuristic's set, made minimal (skipped where that would take over ~5·10⁷ steps).
+    let mut heuristic = els::backward_edges(n, &le);
+    let minimal = (heuristic.len() as u64).saturating_mul(le.len() as u64) <= 50_000_000;
+    if minimal {
+        put_back_harmless(n, &le, &mut heuristic, true);
     }
-    let mut cut: Vec<usize> = (0..le.len())
-        .filter(|&e| pos[le[e].0 as usize] > pos[le[e].1 as usize])
-        .collect();
-    if (cut.len() as u64).saturating_mul(le.len() as u64) <= 50_000_000 {
-        put_back_harmless(n, &le, &mut cut);
-    }
+    let (cut, exact) = match exact::solve(n, &le, max_exact) {
+        // Of two minimum-weight sets, the heuristic's is kept: bakes change only where the
+        // exact solution removes less.
+        Some(cut) if minimal && weight(&le, &heuristic) == weight(&le, &cut) => (heuristic, true),
+        Some(mut cut) => {
+            // An optimum is minimal but for edges of weight 0 (it never holds a positive
+            // edge it could do without): only those are tried.
+            let zeros = cut.iter().filter(|&&e| le[e].2 == 0).count() as u64;
+            if zeros.saturating_mul(le.len() as u64) <= 50_000_000 {
+                put_back_harmless(n, &le, &mut cut, false);
+            }
+            (cut, true)
+        }
+        None => (heuristic, false),
+    };
     let mut out: Vec<usize> = cut.into_iter().map(|e| ids[e]).collect();
     out.sort_unstable();
-    out
+    (out, exact)
 }
 
-/// Edge sides: an edge leaves its source by the `OUT` side and enters its target by the `IN`
-/// side; the per-side arrays of [`Els`] are indexed by them.
-const OUT: usize = 0;
-const IN: usize = 1;
-
-/// The state of the greedy Eades–Lin–Smyth order on one component (local vertex ids).
-struct Els<'a> {
-    /// Edges `(from, to, weight)`.
-    le: &'a [(u32, u32, u64)],
-    /// Per side, the [`csr`] lists of edge ids: `OUT` by source, `IN` by target.
-    adj: [(Vec<u32>, Vec<u32>); 2],
-    alive: Vec<bool>,
-    /// Per side, live edges and their total weight at each vertex.
-    degree: [Vec<u32>; 2],
-    weight: [Vec<i64>; 2],
-    /// Candidates by δ = w_out − w_in, largest last (ties: smallest vertex).
-    by_delta: BTreeSet<(i64, std::cmp::Reverse<u32>)>,
-    /// Per side, vertices whose degree on that side fell to 0: `OUT` sinks, `IN` sources.
-    empty: [Vec<u32>; 2],
-}
-
-impl<'a> Els<'a> {
-    fn new(n: usize, le: &'a [(u32, u32, u64)]) -> Els<'a> {
-        let adj = [
-            csr(n, le.iter().enumerate().map(|(e, x)| (x.0, e as u32))),
-            csr(n, le.iter().enumerate().map(|(e, x)| (x.1, e as u32))),
-        ];
-        let mut degree = [vec![0u32; n], vec![0u32; n]];
-        let mut weight = [vec![0i64; n], vec![0i64; n]];
-        for &(a, b, w) in le {
-            for (side, v) in [(OUT, a), (IN, b)] {
-                degree[side][v as usize] += 1;
-                weight[side][v as usize] += w as i64;
-            }
-        }
-        let mut els = Els {
-            le,
-            adj,
-            alive: vec![true; n],
-            degree,
-            weight,
-            by_delta: BTreeSet::new(),
-            empty: [Vec::new(), Vec::new()],
-        };
-        els.by_delta = (0..n as u32).map(|v| els.key(v)).collect();
-        els
-    }
-
-    fn key(&self, v: u32) -> (i64, std::cmp::Reverse<u32>) {
-        let v = v as usize;
-        (
-            self.weight[OUT][v] - self.weight[IN][v],
-            std::cmp::Reverse(v as u32),
-        )
-    }
-
-    /// Removes v from the graph, updating its live neighbours' degrees, weights and queues.
-    fn remove(&mut self, v: u32) {
-        self.alive[v as usize] = false;
-        self.by_delta.remove(&self.key(v));
-        // v's out-edges change their targets' IN side, its in-edges their sources' OUT side.
-        for side in [OUT, IN] {
-            let (off, list) = &self.adj[side];
-            let edges = &list[off[v as usize] as usize..off[v as usize + 1] as usize];
-            for &e in edges {
-                let (a, b, w) = self.le[e as usize];
-                let (u, other) = if side == OUT { (b, IN) } else { (a, OUT) };
-                if self.alive[u as usize] {
-                    self.by_delta.remove(&self.key(u));
-                    self.degree[other][u as usize] -= 1;
-                    self.weight[other][u as usize] -= w as i64;
-                    self.by_delta.insert(self.key(u));
-                    if self.degree[other][u as usize] == 0 {
-                        self.empty[other].push(u);
-                    }
-                }
-            }
-        }
-    }
-
-    /// The greedy order: sinks peeled to the back, sources to the front, otherwise the
-    /// vertex with the largest δ to the front.
-    fn order(mut self) -> Vec<u32> {
-        let n = self.alive.len();
-        let mut front: Vec<u32> = Vec::with_capacity(n);
-        let mut back: Vec<u32> = Vec::new();
-        let mut left = n;
-        while left > 0 {
-            let (v, to_back) = if let Some(v) = self.empty[OUT].pop() {
-                (v, true)
-            } else if let Some(v) = self.empty[IN].pop() {
-                (v, false)
-            } else {
-                let &(_, std::cmp::Reverse(v)) =
-                    self.by_delta.iter().next_back().expect("a live vertex");
-                (v, false)
-            };
-            if !self.alive[v as usize] {
-                continue;
-            }
-            if to_back {
-                back.push(v)
-            } else {
-                front.push(v)
-            }
-            left -= 1;
-            self.remove(v);
-        }
-        back.reverse();
-        front.extend(back);
-        front
-    }
+/// The total weight of the edges `cut` of `le`.
+fn weight(le: &[(u32, u32, u64)], cut: &[usize]) -> u64 {
+    cut.iter().map(|&e| le[e].2).sum()
 }
 
 /// Minimality: puts back every edge of `cut` whose re-insertion closes no cycle with the
-/// edges kept, heaviest first, and leaves in `cut` the edges still removed.
-fn put_back_harmless(n: usize, le: &[(u32, u32, u64)], cut: &mut Vec<usize>) {
+/// edges kept, heaviest first (only the edges of weight 0 unless `all`), and leaves in `cut`
+/// the edges still removed.
+fn put_back_harmless(n: usize, le: &[(u32, u32, u64)], cut: &mut Vec<usize>, all: bool) {
     let (out_off, out_e) = csr(n, le.iter().enumerate().map(|(e, x)| (x.0, e as u32)));
     cut.sort_by_key(|&e| (std::cmp::Reverse(le[e].2), e));
     let mut kept = vec![true; le.len()];
@@ -229,7 +168,10 @@ fn put_back_harmless(n: usize, le: &[(u32, u32, u64)], cut: &mut Vec<usize>) {
     let mut mark = vec![u32::MAX; n];
     let mut stack = Vec::new();
     for (round, &e) in cut.iter().enumerate() {
-        let (a, b, _) = le[e];
+        let (a, b, w) = le[e];
+        if !all && w > 0 {
+            continue;
+        }
         // Does b reach a through kept edges? Then a → b would close a cycle.
         stack.clear();
         stack.push(b);
@@ -307,32 +249,130 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    proptest! {
-        /// After removal the graph is acyclic, and the removal is minimal: putting back any
-        /// single removed edge closes a cycle.
-        #[test]
-        fn removal_leaves_an_acyclic_minimal_graph(
-            n in 1usize..12,
-            raw in proptest::collection::vec((0u32..12, 0u32..12, 1u32..20), 0..40),
-        ) {
-            let edges: Vec<(u32, u32, u32)> =
-                raw.into_iter().map(|(a, b, w)| (a % n as u32, b % n as u32, w)).collect();
-            let removed = feedback_arc_set(n, &edges);
-            let kept = |skip: Option<usize>| {
-                let pairs: Vec<(u32, u32)> = edges
-                    .iter()
-                    .enumerate()
-                    .filter(|&(k, _)| !removed[k] || Some(k) == skip)
-                    .map(|(_, &(a, b, _))| (a, b))
+    /// Random weighted digraphs on at most `n` vertices (parallel edges and self-loops too).
+    fn graphs(
+        n: usize,
+        m: usize,
+        weights: std::ops::Range<u32>,
+    ) -> impl Strategy<Value = (usize, Vec<(u32, u32, u32)>)> {
+        (
+            1..=n,
+            proptest::collection::vec((0..n as u32, 0..n as u32, weights), 0..=m),
+        )
+            .prop_map(|(n, raw)| {
+                let edges = raw
+                    .into_iter()
+                    .map(|(a, b, w)| (a % n as u32, b % n as u32, w))
                     .collect();
-                let (o, s) = csr(n, pairs.iter().copied());
-                topological_order(&o, &s).is_some()
-            };
-            prop_assert!(kept(None));
-            for k in 0..edges.len() {
-                if removed[k] && edges[k].0 != edges[k].1 {
-                    prop_assert!(!kept(Some(k)), "edge {k} was removed needlessly");
+                (n, edges)
+            })
+    }
+
+    /// Whether the edges not removed (plus edge `back`, if any) form an acyclic graph.
+    fn acyclic(n: usize, edges: &[(u32, u32, u32)], removed: &[bool], back: Option<usize>) -> bool {
+        let pairs = (0..edges.len())
+            .filter(|&k| !removed[k] || Some(k) == back)
+            .map(|k| (edges[k].0, edges[k].1));
+        let (o, s) = csr(n, pairs);
+        topological_order(&o, &s).is_some()
+    }
+
+    /// The result is acyclic and minimal (each removed edge, put back alone, closes a cycle).
+    fn check_acyclic_and_minimal(n: usize, edges: &[(u32, u32, u32)], set: &ArcSet) {
+        assert!(acyclic(n, edges, &set.removed, None), "a cycle is left");
+        for k in (0..edges.len()).filter(|&k| set.removed[k]) {
+            assert!(
+                !acyclic(n, edges, &set.removed, Some(k)),
+                "edge {k} was removed needlessly"
+            );
+        }
+    }
+
+    /// The least weight of any edge subset whose removal leaves `edges` acyclic, by trying
+    /// them all (vertices at most 32, edges at most ~16).
+    fn brute_force(n: usize, edges: &[(u32, u32, u32)]) -> u64 {
+        let m = edges.len();
+        (0u32..1 << m)
+            .filter(|&cut| {
+                let mut succ = vec![0u32; n];
+                for (k, &(a, b, _)) in edges.iter().enumerate() {
+                    if cut & (1 << k) == 0 {
+                        succ[a as usize] |= 1 << b;
+                    }
                 }
+                // Peel vertices with no successor left; a cycle stops the peel.
+                let mut left = if n == 32 { u32::MAX } else { (1u32 << n) - 1 };
+                while left != 0 {
+                    let Some(v) = (0..n).find(|&v| left & 1 << v != 0 && succ[v] & left == 0)
+                    else {
+                        return false;
+                    };
+                    left &= !(1 << v);
+                }
+                true
+            })
+            .map(|cut| {
+                (0..m)
+                    .filter(|&k| cut & 1 << k != 0)
+                    .map(|k| edges[k].2 as u64)
+                    .sum()
+            })
+            .min()
+            .expect("removing every edge leaves no cycle")
+    }
+
+    fn weight(edges: &[(u32, u32, u32)], set: &ArcSet) -> u64 {
+        (0..edges.len())
+            .filter(|&k| set.removed[k])
+            .map(|k| edges[k].2 as u64)
+            .sum()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+
+        /// Small graphs are solved exactly: the removed weight is the least of all edge
+        /// subsets, the rest is acyclic, the removal minimal (weights of 0 included), and the
+        /// same input gives the same result.
+        #[test]
+        fn exact_weight_equals_brute_force((n, edges) in graphs(7, 14, 0..20)) {
+            let set = feedback_arc_set(n, &edges);
+            prop_assert_eq!(weight(&edges, &set), brute_force(n, &edges));
+            check_acyclic_and_minimal(n, &edges, &set);
+            prop_assert_eq!(set.heuristic_components, 0);
+            prop_assert_eq!(set.heuristic_weight, 0);
+            prop_assert_eq!(&feedback_arc_set(n, &edges), &set);
+            // Where the heuristic is optimal its set is kept.
+            let els = feedback_arc_set_up_to(n, &edges, 0);
+            if weight(&edges, &els) == weight(&edges, &set) {
+                prop_assert_eq!(els.removed, set.removed);
+            }
+        }
+
+        /// The heuristic alone (on the same small graphs) also leaves an acyclic graph with a
+        /// minimal removal, never beats the optimum, and is deterministic.
+        #[test]
+        fn heuristic_is_acyclic_and_minimal((n, edges) in graphs(7, 14, 1..20)) {
+            let set = feedback_arc_set_up_to(n, &edges, 0);
+            check_acyclic_and_minimal(n, &edges, &set);
+            prop_assert!(weight(&edges, &set) >= brute_force(n, &edges));
+            prop_assert_eq!(set.exact_components, 0);
+            let loops: u64 = edges.iter().filter(|e| e.0 == e.1).map(|e| e.2 as u64).sum();
+            prop_assert_eq!(set.heuristic_weight, weight(&edges, &set) - loops);
+            prop_assert_eq!(feedback_arc_set_up_to(n, &edges, 0), set);
+        }
+    }
+
+    proptest! {
+        /// Bigger graphs, where components are solved exactly or not by their size: acyclic,
+        /// minimal, and never heavier than the heuristic alone on an exact component.
+        #[test]
+        fn mixed_graphs_are_acyclic_and_minimal((n, edges) in graphs(40, 90, 1..20)) {
+            let set = feedback_arc_set(n, &edges);
+            check_acyclic_and_minimal(n, &edges, &set);
+            if set.heuristic_components == 0 {
+                let els = feedback_arc_set_up_to(n, &edges, 0);
+                prop_assert!(weight(&edges, &set) <= weight(&edges, &els));
             }
         }
     }
@@ -340,8 +380,22 @@ mod tests {
     #[test]
     fn heavier_direction_wins_a_two_cycle() {
         assert_eq!(
-            feedback_arc_set(2, &[(0, 1, 3), (1, 0, 7)]),
+            feedback_arc_set(2, &[(0, 1, 3), (1, 0, 7)]).removed,
             vec![true, false]
         );
+    }
+
+    /// The heuristic misses the optimum even on a three-cycle 0 → 1 → 2 → 0 of weights 6, 2,
+    /// 3: vertex 0 has the largest out − in weight, so ELS puts it first and removes 2 → 0
+    /// (weight 3); the exact solution removes the lightest edge, 1 → 2.
+    #[test]
+    fn exact_beats_the_heuristic_where_it_errs() {
+        let edges = [(0, 1, 6), (1, 2, 2), (2, 0, 3)];
+        let els = feedback_arc_set_up_to(3, &edges, 0);
+        assert_eq!(els.removed, vec![false, false, true]);
+        assert_eq!((els.heuristic_components, els.heuristic_weight), (1, 3));
+        let exact = feedback_arc_set(3, &edges);
+        assert_eq!(exact.removed, vec![false, true, false]);
+        assert_eq!((exact.exact_components, exact.heuristic_weight), (1, 0));
     }
 }

@@ -27,6 +27,9 @@ pub(crate) struct FrameGraph {
     pub topo: Vec<u32>,
     /// The removed cycle edges (G-local ids), sorted.
     pub removed: Vec<Edge>,
+    /// Strongly connected components solved exactly / by the heuristic, and the weight the
+    /// heuristic removed ([`crate::cycles::ArcSet`]).
+    pub components: (u32, u32, u64),
 }
 
 impl FrameGraph {
@@ -197,7 +200,7 @@ pub(crate) fn frame_graph(
     let cut = feedback_arc_set(nodes.len(), &local_edges);
     let mut removed = Vec::new();
     let mut kept = Vec::with_capacity(edges.len());
-    for (e, &c) in edges.iter().zip(&cut) {
+    for (e, &c) in edges.iter().zip(&cut.removed) {
         if c {
             removed.push(*e);
         } else {
@@ -218,5 +221,10 @@ pub(crate) fn frame_graph(
         pred,
         topo,
         removed,
+        components: (
+            cut.exact_components,
+            cut.heuristic_components,
+            cut.heuristic_weight,
+        ),
     })
 }

@@ -6,7 +6,7 @@
 //! | step | file |
 //! |---|---|
 //! | input checks, G-local frame graphs | `graph.rs` |
-//! | cycle breaking inside a frame (weighted Eades–Lin–Smyth per SCC) | [`cycles`] |
+//! | cycle breaking inside a frame (minimum-weight feedback arc set per SCC: exact for small components, weighted Eades–Lin–Smyth above) | [`cycles`] |
 //! | strategy order and layouts (cell keys) | [`strategy`] |
 //! | cells, copies, per-cell constraint graphs | `cells.rs` |
 //! | seeding and interval splitting | `split.rs` |
