@@ -99,6 +99,8 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         "unique_visible": s.unique_visible, "draws_per_frame_mean": s.draws_per_frame_mean,
         "draws_per_frame_max": s.draws_per_frame_max, "drawn_not_visible_mean": s.drawn_not_visible_mean,
         "unordered_samples": s.unordered_samples, "seconds": s.seconds,
+        "exact_components": s.exact_components, "heuristic_components": s.heuristic_components,
+        "heuristic_unordered_samples": s.heuristic_unordered_samples,
         "frames": baked.frames.len(),
         "split_intersections": baked.settings.split_intersections,
         // The edges the merger removed to break depth-order cycles, front → back, as scene

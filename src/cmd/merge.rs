@@ -104,6 +104,9 @@ pub fn baked_json(b: &Baked, seconds: f64) -> serde_json::Value {
         "draws_per_frame_max": s.draws_per_frame_max,
         "drawn_not_visible_mean": s.drawn_not_visible_mean,
         "unordered_samples": s.unordered_samples,
+        "exact_components": s.exact_components,
+        "heuristic_components": s.heuristic_components,
+        "heuristic_unordered_samples": s.heuristic_unordered_samples,
         "seconds": seconds,
     })
 }
@@ -169,7 +172,7 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
 pub fn print_summary(b: &Baked, seconds: f64) {
     let s = &b.stats;
     println!(
-        "merged {} frames ({} {}, bridge {}): {} index triangles for |G| = {} ({:.2}x), Σ|V_f| = {}; draws per frame {:.1} mean, {} max; drawn-not-visible {:.0} per frame; {} unordered samples; {:.2} s",
+        "merged {} frames ({} {}, bridge {}): {} index triangles for |G| = {} ({:.2}x), Σ|V_f| = {}; draws per frame {:.1} mean, {} max; drawn-not-visible {:.0} per frame; {} unordered samples (cycle components: {} solved exactly, {} by heuristic); {:.2} s",
         b.frames.len(),
         b.merge.strategy,
         b.merge.layout,
@@ -182,6 +185,8 @@ pub fn print_summary(b: &Baked, seconds: f64) {
         s.draws_per_frame_max,
         s.drawn_not_visible_mean,
         s.unordered_samples,
+        s.exact_components,
+        s.heuristic_components,
         seconds
     );
 }
