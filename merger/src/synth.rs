@@ -362,3 +362,42 @@ pub fn split_frames(rec: &Recording, starts: &[u32]) -> Vec<Recording> {
         })
         .collect()
 }
+
+/// `pairs` pairs of triangles (2k, 2k + 1) that swap order halfway through frames 0..4, in
+/// front of a chain of `chain` covered but hidden triangles (ids from 2 · `pairs` on): in
+/// frames 0–1 every 2k lies in front of the chain and the chain in front of every 2k + 1; in
+/// frames 2–3, 2k + 1 lies directly in front of 2k and 2k still in front of the chain. The
+/// chain is visible in frame 4 only. The swaps make the splitter cut copies and then try to
+/// join them back, and each try searches through the whole hidden chain: the case that made
+/// that search quadratic.
+pub fn hidden_chain(chain: u32, pairs: u32) -> Recording {
+    let (first, last) = (2 * pairs, 2 * pairs + chain - 1);
+    let mut links: Vec<(u32, u32, u32)> = (first..last).map(|t| (t, t + 1, 1)).collect();
+    links.extend((0..pairs).map(|k| (2 * k, first, 1)));
+    let hidden: Vec<u32> = (first..=last).collect();
+    let frames: Vec<FrameSpec> = (0..5)
+        .map(|f| {
+            if f == 4 {
+                return FrameSpec {
+                    visible: hidden.clone(),
+                    ..FrameSpec::default()
+                };
+            }
+            let mut edges = links.clone();
+            edges.extend((0..pairs).map(|k| {
+                if f < 2 {
+                    (last, 2 * k + 1, 1)
+                } else {
+                    (2 * k + 1, 2 * k, 2)
+                }
+            }));
+            FrameSpec {
+                visible: (0..first).collect(),
+                hidden: hidden.clone(),
+                edges,
+                ties: Vec::new(),
+            }
+        })
+        .collect();
+    recording_from_frames(first + chain, &frames)
+}
