@@ -12,9 +12,10 @@ use trisort_format::{
 
 use crate::cells::{cell_edges, CellGraph, CellOrder, Copy, CopyTable, NONE};
 use crate::graph::FrameGraph;
+use crate::limits::{checked, Limit};
 use crate::serialize::serialize_cell;
 use crate::split::{seed_intervals, split_until_valid, Budget, Context};
-use crate::{paper, Layout, MergeOptions, Seeding, Strategy};
+use crate::{paper, Layout, MergeError, MergeOptions, Seeding, Strategy};
 
 /// One strategy × layout, merged.
 pub(crate) struct Assembled {
@@ -111,7 +112,8 @@ struct SegmentCells {
 }
 
 /// Merges every segment with one strategy and layout and lays the result out; `None` when
-/// its copies exceed `limit` while splitting (see [`Budget`]).
+/// its copies exceed `limit` while splitting (see [`Budget`]); an error when its copies or
+/// draws exceed what the baked file's u32 offsets address ([`Limit`]).
 pub(crate) fn build(
     cx: &Context<'_>,
     segments: &[Range<u32>],
@@ -120,7 +122,7 @@ pub(crate) fn build(
     seeding: Seeding,
     triangles: &[[u32; 3]],
     limit: u64,
-) -> Option<Assembled> {
+) -> Result<Option<Assembled>, MergeError> {
     let budget = Budget {
         limit,
         used: AtomicU64::new(0),
@@ -148,8 +150,16 @@ pub(crate) fn build(
             ))
         })
         .collect();
-    let per_segment = per_segment?;
-    let mut copies = Vec::new();
+    let Some(per_segment) = per_segment else {
+        return Ok(None);
+    };
+    let total: usize = per_segment
+        .iter()
+        .flat_map(|s| &s.cells)
+        .map(|c| c.2.len())
+        .sum();
+    checked(Limit::Copies, total as u64)?;
+    let mut copies = Vec::with_capacity(total);
     let mut cells = Vec::new();
     let mut edges = (0, 0);
     let mut seg_cells: Vec<Range<usize>> = Vec::new();
@@ -172,7 +182,7 @@ pub(crate) fn build(
     let mut windows = Vec::new();
     for (seg, range) in segments.iter().zip(&seg_cells) {
         for f in seg.clone() {
-            let first = draws.len() as u32;
+            let first = checked(Limit::Draws, draws.len() as u64)?;
             let mut open: Option<(u32, u32)> = None; // (first copy, count)
             for c in &cells[range.clone()] {
                 if c.first_frame > f || f > c.last_frame {
@@ -192,11 +202,12 @@ pub(crate) fn build(
             }
             windows.push(FrameWindow {
                 first,
-                count: draws.len() as u32 - first,
+                count: (draws.len() - first as usize) as u32,
             });
         }
     }
-    Some(Assembled {
+    checked(Limit::Draws, draws.len() as u64)?;
+    Ok(Some(Assembled {
         strategy,
         layout,
         seeding,
@@ -205,7 +216,7 @@ pub(crate) fn build(
         draws,
         windows,
         edges,
-    })
+    }))
 }
 
 fn draw(first_copy: u32, count: u32) -> DrawIndexedIndirectArgs {

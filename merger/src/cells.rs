@@ -88,7 +88,9 @@ impl CopyTable {
         for (r, fg) in frames.iter().enumerate() {
             for (v, &t) in fg.nodes.iter().enumerate() {
                 let p = &mut count[t as usize];
-                slots[*p as usize] = (seg.start + r as u32, (frame_off[r] + v) as u32);
+                let at = u32::try_from(frame_off[r] + v)
+                    .expect("vertex-frames per segment are checked by `limits::check_segments`");
+                slots[*p as usize] = (seg.start + r as u32, at);
                 *p += 1;
             }
         }

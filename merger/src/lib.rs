@@ -14,6 +14,7 @@
 //! | serialization (Kahn levels, vertex-cache order) | `serialize.rs` |
 //! | transitive reduction of final graphs | [`reduction`] |
 //! | index buffer, windows and statistics | `assemble.rs` |
+//! | 32-bit counts, checked | `limits.rs` ([`Limit`]) |
 //! | synthetic recordings for tests and benchmarks | [`synth`] |
 //!
 //! **Rules** (DESIGN § Merger; the `trisort-verify` crate checks them from the two files
@@ -30,6 +31,7 @@ mod assemble;
 mod cells;
 pub mod cycles;
 mod graph;
+mod limits;
 mod paper;
 pub mod reduction;
 mod serialize;
@@ -43,6 +45,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 use trisort_format::{Baked, MatrixCell, Recording};
 
+pub use limits::Limit;
 pub use strategy::{Layout, Strategy};
 pub use trisort_format::{Bridge, Choice, Seeding};
 
@@ -192,6 +195,15 @@ pub enum MergeError {
     /// `segment` is zero.
     #[error("segment length must be at least one frame")]
     ZeroSegment,
+    /// A count exceeds what the merger's or the baked file's 32-bit offsets address.
+    #[error("{count} {limit} exceed the limit of {max} ({why}); {hint}",
+            max = .limit.max(), why = .limit.why(), hint = .limit.hint())]
+    TooLarge {
+        /// Which limit.
+        limit: Limit,
+        /// The count found (saturated at `u64::MAX`).
+        count: u64,
+    },
 }
 
 /// Merges recordings (contiguous frame ranges of one scene and path, any order) into a
@@ -248,18 +260,38 @@ pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, Mer
         .step_by(len as usize)
         .map(|s| s..(s + len).min(input.frames))
         .collect();
+    let vertices: Vec<u64> = graphs.iter().map(|g| g.nodes.len() as u64).collect();
+    limits::check_segments(&vertices, &segments)?;
     let combos: Vec<(Strategy, Layout)> = opts
         .strategy
         .candidates()
         .into_iter()
         .flat_map(|s| opts.layout.candidates().into_iter().map(move |l| (s, l)))
         .collect();
+    let best = best_combination(&cx, &segments, &combos, opts.seeding, first)?;
+    let recording_hashes: Vec<trisort_format::Hash> = input
+        .recordings
+        .par_iter()
+        .map(|r| r.content_hash())
+        .collect();
+    Ok(best.into_baked(first, recording_hashes, &graphs, opts))
+}
+
+/// Runs every combination of `combos` and keeps the best (see [`merge`]). Combinations run
+/// in `PRIORITY` order (the ones that usually win first). The first `LEADERS` run to the
+/// end; the others share a fixed bound derived from the leaders' best result and stop once
+/// their copies before joining exceed it (see `PRUNE_FACTOR`). The bound depends only on the
+/// leaders' results, never on timing, so the output is the same whatever the thread count.
+/// A combination whose counts exceed a 32-bit limit ([`Limit`]) is skipped; if every one
+/// does, the first one's error (in `PRIORITY` order) is returned.
+fn best_combination(
+    cx: &split::Context<'_>,
+    segments: &[Range<u32>],
+    combos: &[(Strategy, Layout)],
+    seeding: Seeding,
+    first: &Recording,
+) -> Result<assemble::Assembled, MergeError> {
     let triangles = &first.geometry.triangles;
-    // Combinations run in `PRIORITY` order (the ones that usually win first). The first
-    // `LEADERS` run to the end; the others share a fixed bound derived from the leaders'
-    // best result and stop once their copies before joining exceed it (see `PRUNE_FACTOR`).
-    // The bound depends only on the leaders' results, never on timing, so the output is the
-    // same whatever the thread count.
     let mut queue: Vec<usize> = (0..combos.len()).collect();
     queue.sort_by_key(|&k| {
         PRIORITY
@@ -267,7 +299,8 @@ pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, Mer
             .position(|p| *p == combos[k])
             .unwrap_or(PRIORITY.len())
     });
-    let run = |ks: &[usize], limit: u64| -> Vec<(usize, Option<assemble::Assembled>)> {
+    type Outcome = Result<Option<assemble::Assembled>, MergeError>;
+    let run = |ks: &[usize], limit: u64| -> Vec<(usize, Outcome)> {
         let next = AtomicUsize::new(0);
         (0..ks.len())
             .into_par_iter()
@@ -277,7 +310,7 @@ pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, Mer
                 let (s, l) = combos[k];
                 (
                     k,
-                    assemble::build(&cx, &segments, s, l, opts.seeding, triangles, limit),
+                    assemble::build(cx, segments, s, l, seeding, triangles, limit),
                 )
             })
             .collect()
@@ -285,28 +318,41 @@ pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, Mer
     let (leaders, rest) = queue.split_at(LEADERS.min(queue.len()));
     let mut results = run(leaders, u64::MAX);
     if !rest.is_empty() {
+        // No bound if no leader could be laid out.
         let lead = results
             .iter()
-            .filter_map(|(_, a)| a.as_ref().map(|a| a.copies.len() as u64))
+            .filter_map(|(_, a)| Some(a.as_ref().ok()?.as_ref()?.copies.len() as u64))
             .min()
-            .expect("leaders are never abandoned");
-        results.extend(run(
-            rest,
-            lead.saturating_mul(PRUNE_FACTOR.0) / PRUNE_FACTOR.1,
-        ));
+            .map_or(u64::MAX, |c| {
+                c.saturating_mul(PRUNE_FACTOR.0) / PRUNE_FACTOR.1
+            });
+        results.extend(run(rest, lead));
     }
-    let best = results
-        .into_iter()
-        .filter_map(|(k, a)| Some((k, a?)))
-        .min_by_key(|(k, a)| (a.copies.len(), a.draws_per_frame_max(), *k))
-        .map(|(_, a)| a)
-        .expect("leaders are never abandoned");
-    let recording_hashes: Vec<trisort_format::Hash> = input
-        .recordings
-        .par_iter()
-        .map(|r| r.content_hash())
-        .collect();
-    Ok(best.into_baked(first, recording_hashes, &graphs, opts))
+    // In `PRIORITY` order: the pool finishes them in any order.
+    results.sort_by_key(|(k, _)| queue.iter().position(|q| q == k));
+    let mut first_error = None;
+    let mut best: Option<(usize, assemble::Assembled)> = None;
+    for (k, outcome) in results {
+        match outcome {
+            Ok(Some(a)) => {
+                let key = |k: usize, a: &assemble::Assembled| {
+                    (a.copies.len(), a.draws_per_frame_max(), k)
+                };
+                if best.as_ref().is_none_or(|(bk, b)| key(k, &a) < key(*bk, b)) {
+                    best = Some((k, a));
+                }
+            }
+            Ok(None) => {}
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    match (best, first_error) {
+        (Some((_, a)), _) => Ok(a),
+        (None, Some(e)) => Err(e),
+        (None, None) => unreachable!("leaders are never abandoned"),
+    }
 }
 
 /// The non-empty cells of a baked file's matrix as `(first frame, last frame, triangles)`, in
