@@ -6,13 +6,16 @@
 //! [--segment N (0: one matrix)] [--auto] [--verify]`
 //!
 //! Options not given take the merge's defaults ([`MergeOptions::default`]). `--auto` also
-//! runs the library's own `auto` (every combination at once, as the CLI does).
+//! runs the library's own `auto` (every combination at once, as the CLI does). The last
+//! column, `digest`, hashes everything a bake holds but its statistics (copies, draws,
+//! windows, cells, removed edges): equal digests from two versions of the merger mean
+//! identical bakes up to `stats`.
 
 use std::path::PathBuf;
 use std::str::FromStr;
 use std::time::Instant;
 
-use trisort_format::{FileKind, Recording};
+use trisort_format::{Baked, FileKind, Recording};
 use trisort_merger::{merge, Choice, Layout, MergeOptions, Strategy};
 
 /// `all` (every value) or one value's name; exits with the parse error otherwise.
@@ -66,7 +69,7 @@ fn main() {
         recs.len(),
         t0.elapsed().as_secs_f64()
     );
-    println!("seeding  bridge  strategy layout  | index/|G| index  draws mean  max | drawn-not-vis unordered | seconds | valid");
+    println!("seeding  bridge  strategy layout  | index/|G| index  draws mean  max | drawn-not-vis unordered | seconds | valid | digest");
     let mut runs: Vec<MergeOptions> = Vec::new();
     for &s in &strategies {
         for &l in &layouts {
@@ -100,7 +103,7 @@ fn main() {
         };
         let s = &b.stats;
         println!(
-            "{:8} {:7} {:8} {:7} | {:9.3} {:6} {:10.1} {:4} | {:13.1} {:9} | {:7.2} | {}{}",
+            "{:8} {:7} {:8} {:7} | {:9.3} {:6} {:10.1} {:4} | {:13.1} {:9} | {:7.2} | {}{} | {}",
             b.merge.seeding,
             b.merge.bridge,
             b.merge.strategy,
@@ -117,7 +120,18 @@ fn main() {
                 " (auto)"
             } else {
                 ""
-            }
+            },
+            digest(&b)
         );
     }
+}
+
+/// The first 16 hex digits of the hash of a bake's content without its statistics.
+fn digest(b: &Baked) -> String {
+    let content = format!(
+        "{:?}{:?}{:?}{:?}{:?}",
+        b.copies, b.draws, b.frames, b.merge, b.removed_edges
+    );
+    let hash = trisort_format::hash_bytes(content.as_bytes());
+    hash.iter().take(8).map(|x| format!("{x:02x}")).collect()
 }
