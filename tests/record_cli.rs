@@ -41,15 +41,21 @@ fn car_concept_records_edges_and_interior_through_the_glass() {
     assert!(per_frame.iter().all(|f| f["edges"].as_u64().unwrap() > 0));
     assert!(per_frame.iter().all(|f| f["truncated"] == false));
     let rec = read(&dir.path().join("car.rec"));
-    // Interior parts are only visible through the glass (recorded at opacity 0).
-    let scene = trisort_scene::load(std::path::Path::new(&car)).unwrap();
-    let g = &scene.geometry;
+    // Interior parts are only visible through the glass (recorded at opacity 0). Ids are
+    // those of the recorded scene (split where triangles crossed): classify them with the
+    // recording's own geometry of G.
+    let g = &rec.geometry;
+    let local = |t: u32| {
+        rec.unique_visible
+            .binary_search(&t)
+            .expect("a triangle of G") as u32
+    };
     let interior = |t: u32| {
-        g.nodes[g.triangle_node(t) as usize]
+        g.nodes[g.triangle_node(local(t)) as usize]
             .name
             .starts_with("Interior")
     };
-    let glass = |t: u32| g.materials[g.triangle_material(t) as usize].transmission > 0.0;
+    let glass = |t: u32| g.materials[g.triangle_material(local(t)) as usize].transmission > 0.0;
     for f in &rec.frames {
         assert!(
             f.visible.iter().any(|&t| interior(t)),

@@ -79,7 +79,7 @@ enum Direction {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PeeledFrame {
     /// `width × height` pixels, RGBA8, sRGB-encoded, alpha 255: the resolved `Rgba16Float`
-    /// frame through [`quantize_rgba16f`], like the player's and the exact reference's frames.
+    /// frame through [`trisort_gpu::quantize_rgba16f`], like the player's and the exact reference's frames.
     pub rgba8: Vec<u8>,
     /// Layers peeled and composited (`depth`: 1, or 0 where nothing is drawn).
     pub layers: u32,
