@@ -1,7 +1,7 @@
 //! Test-only helpers shared by trisort's test suites; a dev-dependency of the workspace's
 //! crates, never a dependency, so the shipping libraries carry no test code.
 //!
-//! - [`gpu`] (feature `gpu`): a device, or a skip where there is none, unless
+//! - `gpu()` (feature `gpu`): a device, or a skip where there is none, unless
 //!   `TRISORT_REQUIRE_GPU=1` (CI) makes that a failure;
 //! - [`scene_path`]: a shared test scene, or a skip where it is missing, unless
 //!   `TRISORT_REQUIRE_SCENES=1` (CI) makes that a failure;

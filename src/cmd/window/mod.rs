@@ -1,5 +1,5 @@
 //! `trisort play BAKED --window`: a winit viewer that plays a baked file through the real
-//! [`Player`] into a window.
+//! [`trisort_player::Player`] into a window.
 //!
 //! Each frame, the player draws into an offscreen `Rgba16Float` target (multisampled at the
 //! chosen sample count and resolved, with a depth buffer in `depth` mode), exactly as the
