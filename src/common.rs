@@ -170,7 +170,15 @@ pub fn print_json(v: &serde_json::Value) {
 /// and exits with status 1. Work already finished is safe: recordings keep their finished
 /// frames in `OUT.partial/` (a rerun resumes) and every output file is written by rename.
 pub fn open_gpu() -> Result<trisort_gpu::Gpu> {
-    let gpu = trisort_gpu::Gpu::new()?;
+    open_gpu_with(trisort_gpu::GpuOptions::default())
+}
+
+/// [`open_gpu`] on the backend and with the limits of `options` (`--backend`, `--limits`).
+pub fn open_gpu_with(options: trisort_gpu::GpuOptions) -> Result<trisort_gpu::Gpu> {
+    let gpu = trisort_gpu::Gpu::with_options(
+        wgpu::InstanceFlags::from_build_config().with_env(),
+        options,
+    )?;
     let adapter = gpu.info.name.clone();
     gpu.device
         .on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {

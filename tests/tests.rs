@@ -17,4 +17,5 @@ mod record_cli;
 mod verify_cli;
 mod verify_forged;
 mod verify_images;
+mod webgl2_cli;
 mod window_cli;

@@ -14,11 +14,16 @@
 //! Reading never trusts the header for allocation: the payload length must match the file,
 //! the checksum is verified before decompressing, decompression stops at the declared size
 //! (which is capped), and postcard caps what it preallocates.
+//!
+//! Writing uses zstd's C library and exists only off wasm32; reading decompresses with zstd's C
+//! decoder natively and with the pure-Rust `ruzstd` on wasm32 ([`decode_pure`] reaches that path
+//! anywhere, so tests check that both decoders give the same bytes).
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use serde::de::DeserializeOwned;
+#[cfg(not(target_arch = "wasm32"))]
 use serde::Serialize;
 
 /// Current version of the container and of the types inside it. Files of another version are
@@ -125,7 +130,8 @@ pub enum FormatError {
     },
 }
 
-/// Encodes `value` into the container bytes.
+/// Encodes `value` into the container bytes (not on wasm32: it needs zstd's C library).
+#[cfg(not(target_arch = "wasm32"))]
 pub fn encode<T: Serialize>(kind: FileKind, value: &T) -> Vec<u8> {
     let raw =
         postcard::to_stdvec(value).expect("postcard serialization of trisort types cannot fail");
@@ -145,6 +151,25 @@ pub fn decode<T: DeserializeOwned>(
     kind: FileKind,
     bytes: &[u8],
     path: &Path,
+) -> Result<T, FormatError> {
+    decode_with(kind, bytes, path, cfg!(target_arch = "wasm32"))
+}
+
+/// [`decode`] with the pure-Rust `ruzstd` decompressor on every target (the path wasm32 builds
+/// always take); same checks, same result.
+pub fn decode_pure<T: DeserializeOwned>(
+    kind: FileKind,
+    bytes: &[u8],
+    path: &Path,
+) -> Result<T, FormatError> {
+    decode_with(kind, bytes, path, true)
+}
+
+fn decode_with<T: DeserializeOwned>(
+    kind: FileKind,
+    bytes: &[u8],
+    path: &Path,
+    pure: bool,
 ) -> Result<T, FormatError> {
     let p = || path.to_path_buf();
     if bytes.len() < 8 || &bytes[..8] != kind.magic() {
@@ -187,19 +212,8 @@ pub fn decode<T: DeserializeOwned>(
             reason: format!("declared size {raw_len} bytes exceeds the limit of {MAX_PAYLOAD}"),
         });
     }
-    // Grow the buffer as data arrives; never preallocate what the header claims.
-    let mut raw = Vec::new();
-    let decoder = zstd::Decoder::new(payload).map_err(|e| FormatError::Payload {
-        path: p(),
-        reason: e.to_string(),
-    })?;
-    decoder
-        .take(raw_len + 1)
-        .read_to_end(&mut raw)
-        .map_err(|e| FormatError::Payload {
-            path: p(),
-            reason: format!("decompression failed: {e}"),
-        })?;
+    let raw = decompress(payload, raw_len, pure)
+        .map_err(|reason| FormatError::Payload { path: p(), reason })?;
     if raw.len() as u64 != raw_len {
         return Err(FormatError::Payload {
             path: p(),
@@ -217,6 +231,29 @@ pub fn decode<T: DeserializeOwned>(
         });
     }
     Ok(value)
+}
+
+/// Decompresses `payload`, stopping one byte past `raw_len`. The buffer grows as data arrives:
+/// never preallocate what the header claims. `pure`: with ruzstd (always so on wasm32).
+fn decompress(payload: &[u8], raw_len: u64, pure: bool) -> Result<Vec<u8>, String> {
+    let mut raw = Vec::new();
+    let failed = |e: std::io::Error| format!("decompression failed: {e}");
+    #[cfg(not(target_arch = "wasm32"))]
+    if !pure {
+        let decoder = zstd::Decoder::new(payload).map_err(|e| e.to_string())?;
+        decoder
+            .take(raw_len + 1)
+            .read_to_end(&mut raw)
+            .map_err(failed)?;
+        return Ok(raw);
+    }
+    let _ = pure;
+    let decoder = ruzstd::decoding::StreamingDecoder::new(payload).map_err(|e| e.to_string())?;
+    decoder
+        .take(raw_len + 1)
+        .read_to_end(&mut raw)
+        .map_err(failed)?;
+    Ok(raw)
 }
 
 /// Reads and decodes a file of the given kind.
@@ -266,7 +303,8 @@ pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), FormatError> 
     result.map_err(io)
 }
 
-/// Encodes `value` and writes it atomically to `path`.
+/// Encodes `value` and writes it atomically to `path` (not on wasm32).
+#[cfg(not(target_arch = "wasm32"))]
 pub fn write_file_atomic<T: Serialize>(
     kind: FileKind,
     path: &Path,
@@ -349,6 +387,24 @@ mod tests {
             "old.baked: format version 1 is not supported (this trisort reads version 2); \
              record or merge it again with this trisort"
         );
+    }
+
+    #[test]
+    fn ruzstd_decodes_what_zstd_encodes() {
+        let bytes = encode(FileKind::Baked, &sample());
+        let path = Path::new("p.baked");
+        let native: Vec<(u32, String)> = decode(FileKind::Baked, &bytes, path).unwrap();
+        let pure: Vec<(u32, String)> = decode_pure(FileKind::Baked, &bytes, path).unwrap();
+        assert_eq!(native, pure);
+        assert_eq!(pure, sample());
+        // The raw payloads, byte for byte, including a multi-block one (> 128 KiB).
+        let big: Vec<u8> = (0..600_000u32)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+            .collect();
+        let packed = zstd::encode_all(&big[..], 3).unwrap();
+        let n = big.len() as u64;
+        assert_eq!(decompress(&packed, n, true).unwrap(), big);
+        assert_eq!(decompress(&packed, n, false).unwrap(), big);
     }
 
     #[test]

@@ -22,7 +22,9 @@ pub mod recording;
 
 pub use baked::{Baked, DrawIndexedIndirectArgs, FrameWindow, MatrixCell, MergeInfo, MergeStats};
 pub use camera::{world_transforms, Camera, FrameState, NodePose};
-pub use container::{read_file, write_file_atomic, FileKind, FormatError, FORMAT_VERSION};
+#[cfg(not(target_arch = "wasm32"))]
+pub use container::write_file_atomic;
+pub use container::{read_file, FileKind, FormatError, FORMAT_VERSION};
 pub use geometry::{AlphaMode, Geometry, Material, Node, Texture, Vertex};
 pub use mode::{Mode, ParseModeError};
 pub use options::{

@@ -64,7 +64,64 @@ pub fn device_info(info: &wgpu::AdapterInfo) -> trisort_format::DeviceInfo {
     }
 }
 
+/// The limits a device is opened with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LimitsChoice {
+    /// The adapter's own limits.
+    #[default]
+    Adapter,
+    /// WebGL2's ([`wgpu::Limits::downlevel_webgl2_defaults`], at the adapter's texture sizes):
+    /// no storage buffers, 16 KiB uniform bindings. The player then takes its WebGL2 path
+    /// (data-texture bindings, direct draws) on any adapter, so that path is testable here.
+    Webgl2,
+}
+
+impl std::str::FromStr for LimitsChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "default" => Ok(LimitsChoice::Adapter),
+            "webgl2" => Ok(LimitsChoice::Webgl2),
+            _ => Err(format!("unknown limits {s:?}: default or webgl2")),
+        }
+    }
+}
+
+/// Which backend to open a device on (`--backend`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BackendChoice {
+    /// wgpu's choice (`WGPU_BACKEND` where set).
+    #[default]
+    Auto,
+    /// Vulkan only.
+    Vulkan,
+    /// OpenGL / GLES only (EGL headless on Linux).
+    Gl,
+}
+
+impl std::str::FromStr for BackendChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(BackendChoice::Auto),
+            "vulkan" => Ok(BackendChoice::Vulkan),
+            "gl" => Ok(BackendChoice::Gl),
+            _ => Err(format!("unknown backend {s:?}: vulkan, gl or auto")),
+        }
+    }
+}
+
+/// How to open a device: backend and limits ([`Gpu::with_options`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuOptions {
+    /// The backend.
+    pub backend: BackendChoice,
+    /// The limits.
+    pub limits: LimitsChoice,
+}
+
 impl Gpu {
+    #[cfg(not(target_arch = "wasm32"))]
     /// Opens the default adapter headless (no surface) with the adapter's own limits and the
     /// [`wanted_features`] it supports. `WGPU_BACKEND` and `WGPU_ADAPTER_NAME` select as in
     /// wgpu.
@@ -72,17 +129,31 @@ impl Gpu {
         Gpu::with_flags(wgpu::InstanceFlags::from_build_config().with_env())
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// Like [`Gpu::new`], with the instance created with `flags` instead of wgpu's defaults
     /// (`WGPU_BACKEND` and `WGPU_ADAPTER_NAME` still select). Use it to switch wgpu's
     /// indirect-call validation ([`wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL`], on by
     /// default even in release builds) on or off: the flag is read when the device is created.
     pub fn with_flags(flags: wgpu::InstanceFlags) -> Result<Gpu, GpuError> {
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        desc.flags = flags;
-        let instance = wgpu::Instance::new(desc);
-        Gpu::open(&instance, None, "trisort")
+        Gpu::with_options(flags, GpuOptions::default())
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
+    /// [`Gpu::with_flags`] on the backend and with the limits of `options` (a backend other
+    /// than [`BackendChoice::Auto`] overrides `WGPU_BACKEND`).
+    pub fn with_options(flags: wgpu::InstanceFlags, options: GpuOptions) -> Result<Gpu, GpuError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.flags = flags;
+        match options.backend {
+            BackendChoice::Auto => {}
+            BackendChoice::Vulkan => desc.backends = wgpu::Backends::VULKAN,
+            BackendChoice::Gl => desc.backends = wgpu::Backends::GL,
+        }
+        let instance = wgpu::Instance::new(desc);
+        Gpu::open(&instance, None, "trisort", options.limits)
+    }
+
+    #[cfg(not(target_arch = "wasm32"))]
     /// A device on an adapter of `instance` that can present to `surface` (a window's, created
     /// from `instance`), with the adapter's own limits and the [`wanted_features`] it supports,
     /// chosen like [`Gpu::new`] otherwise.
@@ -90,14 +161,21 @@ impl Gpu {
         instance: &wgpu::Instance,
         surface: &wgpu::Surface<'_>,
     ) -> Result<Gpu, GpuError> {
-        Gpu::open(instance, Some(surface), "trisort window")
+        Gpu::open(
+            instance,
+            Some(surface),
+            "trisort window",
+            LimitsChoice::Adapter,
+        )
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// The one adapter and device request behind [`Gpu::with_flags`] and [`Gpu::for_surface`].
     fn open(
         instance: &wgpu::Instance,
         compatible_surface: Option<&wgpu::Surface<'_>>,
         label: &str,
+        limits: LimitsChoice,
     ) -> Result<Gpu, GpuError> {
         let adapter =
             pollster::block_on(
@@ -115,7 +193,12 @@ impl Gpu {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some(label),
             required_features: features,
-            required_limits: adapter.limits(),
+            required_limits: match limits {
+                LimitsChoice::Adapter => adapter.limits(),
+                LimitsChoice::Webgl2 => {
+                    wgpu::Limits::downlevel_webgl2_defaults().using_resolution(adapter.limits())
+                }
+            },
             ..Default::default()
         }))
         .map_err(|e| GpuError::Device {
@@ -143,6 +226,7 @@ impl Gpu {
         device_info(&self.info)
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// Reads back a buffer region synchronously (copies into a mappable staging buffer).
     pub fn read_buffer(&self, buffer: &wgpu::Buffer, offset: u64, size: u64) -> Vec<u8> {
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -157,6 +241,7 @@ impl Gpu {
         self.map_read(&staging)
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// Maps a `MAP_READ` buffer after the queue has finished with it, and returns its bytes.
     pub fn map_read(&self, staging: &wgpu::Buffer) -> Vec<u8> {
         let slice = staging.slice(..);
@@ -169,6 +254,7 @@ impl Gpu {
         out
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// Reads back a 2D RGBA8/BGRA8/R32 texture (4 bytes per texel, one sample, mip 0, layer 0)
     /// as tightly packed rows.
     pub fn read_texture_4bpp(&self, texture: &wgpu::Texture) -> Vec<u8> {

@@ -11,6 +11,7 @@
 //! [`compose`] concatenates.
 #![deny(missing_docs)]
 
+mod data_textures;
 pub mod device;
 pub mod pipeline;
 pub mod present;
@@ -18,13 +19,16 @@ pub mod readback;
 pub mod target;
 mod timer;
 
-pub use device::{device_info, wanted_features, Gpu, GpuError};
-pub use readback::{
-    f16_to_f32, halves, linear_to_srgb, map_read_all, poll_ready, quantize_rgba16f,
+pub use device::{
+    device_info, wanted_features, BackendChoice, Gpu, GpuError, GpuOptions, LimitsChoice,
 };
+#[cfg(not(target_arch = "wasm32"))]
+pub use readback::map_read_all;
+pub use readback::{f16_to_f32, halves, linear_to_srgb, poll_ready, quantize_rgba16f};
 pub use target::{clear_colour, FrameTarget, TargetConfig, BACKGROUND, COLOR_FORMAT, DEPTH_FORMAT};
 pub use timer::GpuTimer;
 pub mod scene_gpu;
+pub use scene_gpu::Bindings;
 
 /// The shared bindings, vertex layout, vertex transform and surface functions.
 pub const COMMON: &str = include_str!("wgsl/common.wgsl");
@@ -198,6 +202,14 @@ pub fn all() -> Vec<(&'static str, String)> {
     vec![
         ("smoke", smoke_shader()),
         ("player", compose(&[], PLAYER)),
+        (
+            "player textures",
+            compose_with(Bindings::Textures, &[], PLAYER),
+        ),
+        (
+            "smoke textures",
+            compose_with(Bindings::Textures, &[], &format!("{PLAIN}\n{SMOKE}")),
+        ),
         ("reference", reference_shader()),
         ("peel 1x", peel_shader(1)),
         ("peel 4x", peel_shader(4)),
@@ -213,18 +225,35 @@ pub fn all() -> Vec<(&'static str, String)> {
     ]
 }
 
-/// Composes a module: `enable` directives first (WGSL requires them before any declaration),
-/// then [`COMMON`], then `body`.
+/// Composes a module on the storage tier ([`Bindings::Storage`]): `enable` directives first
+/// (WGSL requires them before any declaration), then [`COMMON`], its binding prelude, then
+/// `body`.
 pub fn compose(enables: &[&str], body: &str) -> String {
+    compose_with(Bindings::Storage, enables, body)
+}
+
+/// [`compose`] with the binding prelude of `bindings` ([`STORAGE_BINDINGS`] or
+/// [`TEXTURE_BINDINGS`]): the same [`COMMON`] maths over either.
+pub fn compose_with(bindings: Bindings, enables: &[&str], body: &str) -> String {
     let mut s = String::new();
     for e in enables {
         s.push_str(&format!("enable {e};\n"));
     }
     s.push_str(COMMON);
     s.push('\n');
+    s.push_str(match bindings {
+        Bindings::Storage => STORAGE_BINDINGS,
+        Bindings::Textures => TEXTURE_BINDINGS,
+    });
+    s.push('\n');
     s.push_str(body);
     s
 }
+
+/// Binding prelude of [`Bindings::Storage`]: node matrices and materials in storage buffers.
+pub const STORAGE_BINDINGS: &str = include_str!("wgsl/storage.wgsl");
+/// Binding prelude of [`Bindings::Textures`]: node matrices and materials in data textures.
+pub const TEXTURE_BINDINGS: &str = include_str!("wgsl/textures.wgsl");
 
 /// Size in bytes of the `Frame` uniform of [`COMMON`].
 pub const FRAME_UNIFORM_SIZE: u64 = 64 + 16 + 16;

@@ -47,7 +47,7 @@ pub fn configure_surface(
     let configure = |config: &wgpu::SurfaceConfiguration| {
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         surface.configure(&gpu.device, config);
-        pollster::block_on(scope.pop())
+        poll_ready(scope.pop()).flatten()
     };
     if let Some(e) = configure(&config) {
         if config.view_formats.is_empty() {

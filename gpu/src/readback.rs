@@ -1,10 +1,13 @@
 //! Reading frames and buffers back from the GPU, and the one conversion from the linear
 //! `Rgba16Float` frame to 8-bit sRGB that the player and the exact reference share.
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::sync::mpsc;
 
+#[cfg(not(target_arch = "wasm32"))]
 use crate::GpuError;
 
+#[cfg(not(target_arch = "wasm32"))]
 /// Maps `MAP_READ` buffers after the queue is done with them and returns their bytes, waiting
 /// once for all of them.
 pub fn map_read_all(
@@ -40,11 +43,18 @@ pub fn map_read_all(
 
 /// Polls a future that native wgpu resolves immediately (error-scope pops), yielding between
 /// polls. A future still pending after a bounded number of polls gives `None`, which callers
-/// take to carry no error.
+/// take to carry no error. On wasm32 it polls once and never waits (a browser resolves the
+/// future only after control returns to it; errors not caught then reach the device's
+/// uncaptured-error handler).
 pub fn poll_ready<F: std::future::Future>(fut: F) -> Option<F::Output> {
     let mut fut = std::pin::pin!(fut);
     let mut cx = std::task::Context::from_waker(std::task::Waker::noop());
-    for _ in 0..1000 {
+    let polls = if cfg!(target_arch = "wasm32") {
+        1
+    } else {
+        1000
+    };
+    for _ in 0..polls {
         if let std::task::Poll::Ready(v) = fut.as_mut().poll(&mut cx) {
             return Some(v);
         }

@@ -77,9 +77,53 @@ fn align(x: u64, a: u64) -> u64 {
     x.div_ceil(a) * a
 }
 
-/// Creates the bind group layout of group 0.
+/// How group 0 carries node matrices and materials (bindings 1, 2 and 5): the binding prelude
+/// a shader is composed with ([`crate::compose_with`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Bindings {
+    /// Storage buffers read in the vertex stage (`wgsl/storage.wgsl`).
+    #[default]
+    Storage,
+    /// Rgba32Float data textures read with `textureLoad`, and a per-frame uniform naming the
+    /// frame's first node (`wgsl/textures.wgsl`): GLES 3.0 / WebGL2, which have no storage
+    /// buffers in the vertex stage.
+    Textures,
+}
+
+impl Bindings {
+    /// The tier a device's limits allow: [`Bindings::Storage`] where the vertex stage has the
+    /// two storage buffers it needs, else [`Bindings::Textures`].
+    pub fn for_limits(limits: &wgpu::Limits) -> Bindings {
+        if limits.max_storage_buffers_per_shader_stage >= 2 {
+            Bindings::Storage
+        } else {
+            Bindings::Textures
+        }
+    }
+
+    /// A short name (`storage`, `textures`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Bindings::Storage => "storage",
+            Bindings::Textures => "textures",
+        }
+    }
+}
+
+/// Texels per row of the data textures of [`Bindings::Textures`] (`DATA_WIDTH` in the WGSL).
+pub const DATA_WIDTH: u32 = 1024;
+
+/// Creates the bind group layout of group 0 on the storage tier.
 pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    bind_group_layout_for(device, Bindings::Storage)
+}
+
+/// Creates the bind group layout of group 0 for `bindings`.
+pub fn bind_group_layout_for(device: &wgpu::Device, bindings: Bindings) -> wgpu::BindGroupLayout {
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+    if bindings == Bindings::Textures {
+        return crate::data_textures::texture_tier_layout(device);
+    }
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("trisort scene"),
         entries: &[
@@ -203,7 +247,8 @@ pub fn begin_peel_pass<'e>(
 }
 
 impl SceneGpu {
-    /// Uploads the geometry, materials, textures and the uniforms of every frame.
+    /// Uploads the geometry, materials, textures and the uniforms of every frame, on the
+    /// storage tier ([`SceneGpu::with_bindings`] with [`Bindings::Storage`]).
     ///
     /// Textures share one array: each layer is as large as the largest texture, and a
     /// texture smaller than that fills the top-left corner (its uv scaled to fit), so one bind
@@ -214,6 +259,19 @@ impl SceneGpu {
         geometry: &Geometry,
         frames: &[FrameState],
         view: View,
+    ) -> SceneGpu {
+        SceneGpu::with_bindings(device, queue, geometry, frames, view, Bindings::Storage)
+    }
+
+    /// [`SceneGpu::new`] with node matrices and materials carried as `bindings` says; the
+    /// layout and bind group match shaders composed with [`crate::compose_with`] for it.
+    pub fn with_bindings(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+        bindings: Bindings,
     ) -> SceneGpu {
         let limits = device.limits();
         let vertex_bytes: &[u8] = if geometry.vertices.is_empty() {
@@ -226,7 +284,6 @@ impl SceneGpu {
             contents: vertex_bytes,
             usage: wgpu::BufferUsages::VERTEX,
         });
-
         let (texture_view, uv_scales) = upload_textures(device, queue, geometry);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("base colour"),
@@ -236,69 +293,53 @@ impl SceneGpu {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("materials"),
-            contents: bytemuck::cast_slice(&material_table(geometry, &uv_scales)),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let FrameData {
-            frame_bytes,
-            node_bytes,
-            frame_stride,
-            node_stride,
-            node_count,
-        } = frame_data(&limits, geometry, frames, view);
+        let materials = material_table(geometry, &uv_scales);
+        // The texture tier packs every frame's matrices contiguously (64 bytes a node).
+        let node_align = match bindings {
+            Bindings::Storage => limits.min_storage_buffer_offset_alignment as u64,
+            Bindings::Textures => 64,
+        };
+        let data = frame_data(&limits, geometry, frames, view, node_align);
         let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame uniforms"),
-            contents: &frame_bytes,
+            contents: &data.frame_bytes,
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let node_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("node matrices"),
-            contents: &node_bytes,
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let layout = bind_group_layout(device);
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("trisort scene"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &frame_buffer,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniform>() as u64),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &node_buffer,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(node_count * 64),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: materials.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&texture_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::Sampler(&sampler),
-                },
-            ],
-        });
+        let shared = SharedBindings {
+            frame: wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &frame_buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniform>() as u64),
+                }),
+            },
+            texture: wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(&texture_view),
+            },
+            sampler: wgpu::BindGroupEntry {
+                binding: 4,
+                resource: wgpu::BindingResource::Sampler(&sampler),
+            },
+        };
+        let (layout, bind_group, node_stride) = match bindings {
+            Bindings::Storage => storage_bind_group(device, shared, &data, &materials),
+            Bindings::Textures => crate::data_textures::bind_group(
+                device,
+                queue,
+                shared,
+                &data,
+                bytemuck::cast_slice(&materials),
+                frames.len(),
+            ),
+        };
         SceneGpu {
             vertices,
             vertex_count: geometry.vertices.len() as u32,
             layout,
             bind_group,
-            frame_stride,
+            frame_stride: data.frame_stride,
             node_stride,
             frames: frames.len() as u32,
         }
@@ -458,12 +499,62 @@ fn material_table(geometry: &Geometry, uv_scales: &[[f32; 2]]) -> Vec<MaterialGp
 
 /// Every frame's uniform and node matrices, each frame at its stride (the device's dynamic
 /// offset alignments).
-struct FrameData {
-    frame_bytes: Vec<u8>,
-    node_bytes: Vec<u8>,
-    frame_stride: u64,
-    node_stride: u64,
-    node_count: u64,
+pub(crate) struct FrameData {
+    pub(crate) frame_bytes: Vec<u8>,
+    pub(crate) node_bytes: Vec<u8>,
+    pub(crate) frame_stride: u64,
+    pub(crate) node_stride: u64,
+    pub(crate) node_count: u64,
+}
+
+/// Bind group entries both tiers share: the frame uniform (0), the base-colour texture array
+/// (3) and its sampler (4).
+pub(crate) struct SharedBindings<'a> {
+    pub(crate) frame: wgpu::BindGroupEntry<'a>,
+    pub(crate) texture: wgpu::BindGroupEntry<'a>,
+    pub(crate) sampler: wgpu::BindGroupEntry<'a>,
+}
+
+/// The storage tier's layout and bind group, and its node-matrix stride per frame.
+fn storage_bind_group(
+    device: &wgpu::Device,
+    shared: SharedBindings<'_>,
+    data: &FrameData,
+    materials: &[MaterialGpu],
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup, u64) {
+    let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("materials"),
+        contents: bytemuck::cast_slice(materials),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let node_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("node matrices"),
+        contents: &data.node_bytes,
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let layout = bind_group_layout(device);
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("trisort scene"),
+        layout: &layout,
+        entries: &[
+            shared.frame,
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &node_buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(data.node_count * 64),
+                }),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: materials.as_entire_binding(),
+            },
+            shared.texture,
+            shared.sampler,
+        ],
+    });
+    (layout, bind_group, data.node_stride)
 }
 
 /// Computes [`FrameData`]: camera-relative node matrices in f64, cast once.
@@ -472,16 +563,14 @@ fn frame_data(
     geometry: &Geometry,
     frames: &[FrameState],
     view: View,
+    node_align: u64,
 ) -> FrameData {
     let frame_stride = align(
         std::mem::size_of::<FrameUniform>() as u64,
         limits.min_uniform_buffer_offset_alignment as u64,
     );
     let node_count = geometry.nodes.len().max(1) as u64;
-    let node_stride = align(
-        node_count * 64,
-        limits.min_storage_buffer_offset_alignment as u64,
-    );
+    let node_stride = align(node_count * 64, node_align);
     let nframes = frames.len().max(1) as u64;
     let mut frame_bytes = vec![0u8; (frame_stride * nframes) as usize];
     let mut node_bytes = vec![0u8; (node_stride * nframes) as usize];

@@ -7,8 +7,10 @@
 use trisort_format::Mode;
 
 use crate::pipeline::texture_2d;
-use crate::readback::{halves, poll_ready, quantize_rgba16f};
-use crate::{Gpu, GpuError};
+use crate::readback::{halves, quantize_rgba16f};
+use crate::GpuError;
+#[cfg(not(target_arch = "wasm32"))]
+use crate::{readback::poll_ready, Gpu};
 
 /// The background every frame is drawn over: a dark grey, linear RGB.
 pub const BACKGROUND: [f32; 3] = [0.03, 0.03, 0.03];
@@ -250,6 +252,7 @@ impl FrameTarget {
         )
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// Runs `encode` in one command encoder, copies the resolved frame to the staging buffer,
     /// submits, waits and returns [`FrameTarget::rgba8`]. Errors on a wgpu validation error.
     /// Panics if the target was created without `readback`.

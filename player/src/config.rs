@@ -23,6 +23,24 @@ impl DrawPath {
             DrawPath::Direct
         }
     }
+
+    /// [`DrawPath::for_adapter`] for a device opened on `adapter`: the direct path also where
+    /// the device has WebGL2-class limits (the data-texture tier, [`trisort_gpu::Bindings`]),
+    /// as a browser's WebGL2 has no indirect execution, so the path is testable on any adapter.
+    pub fn for_device(adapter: &wgpu::Adapter, device: &wgpu::Device) -> DrawPath {
+        match trisort_gpu::Bindings::for_limits(&device.limits()) {
+            trisort_gpu::Bindings::Textures => DrawPath::Direct,
+            trisort_gpu::Bindings::Storage => DrawPath::for_adapter(adapter),
+        }
+    }
+
+    /// A short name (`multi-draw-indirect`, `direct`).
+    pub fn name(self) -> &'static str {
+        match self {
+            DrawPath::MultiDrawIndirect => "multi-draw-indirect",
+            DrawPath::Direct => "direct",
+        }
+    }
 }
 
 /// Everything [`crate::Player::new`] needs besides the file: the caller's target and how to

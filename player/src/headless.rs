@@ -115,7 +115,7 @@ impl<'g> HeadlessRenderer<'g> {
             glass_opacity: config.glass_opacity,
             draw_path: config
                 .draw_path
-                .unwrap_or_else(|| DrawPath::for_adapter(&gpu.adapter)),
+                .unwrap_or_else(|| DrawPath::for_device(&gpu.adapter, &gpu.device)),
             device: Some(gpu.device_info()),
         };
         let player = if config.force_u32 {

@@ -28,12 +28,14 @@ pub mod commands;
 pub mod config;
 pub mod draw_calls;
 mod error;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod headless;
 mod player;
 
 pub use config::{playback_warnings, DrawPath, PlayerConfig};
 pub use draw_calls::{Call, CallLog, DrawCalls};
 pub use error::PlayerError;
+#[cfg(not(target_arch = "wasm32"))]
 pub use headless::{render_frames, HeadlessConfig, HeadlessRenderer, RenderedFrame};
 pub use player::{blend_state, fragment_entry_point, open_baked, Player};
 pub use trisort_format::{Mode, ParseModeError};

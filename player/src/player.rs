@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use trisort_format::{Baked, DrawIndexedIndirectArgs, FileKind, FrameWindow};
-use trisort_gpu::scene_gpu::{vertex_layout, SceneGpu, View};
+use trisort_gpu::scene_gpu::{vertex_layout, Bindings, SceneGpu, View};
 use wgpu::util::DeviceExt;
 
 use crate::commands::{frame_commands, index_buffer, Order};
@@ -35,6 +35,7 @@ pub fn open_baked(path: &Path) -> Result<Baked, PlayerError> {
 /// order, and every frame's `DrawIndexedIndirectArgs` back to back in one indirect buffer.
 pub struct Player {
     scene: SceneGpu,
+    bindings: Bindings,
     pipeline: wgpu::RenderPipeline,
     index_buffer: wgpu::Buffer,
     index_format: wgpu::IndexFormat,
@@ -95,7 +96,15 @@ impl Player {
             samples: config.sample_count,
             glass_opacity: config.glass_opacity_for(baked),
         };
-        let scene = SceneGpu::new(device, queue, &baked.geometry, &baked.frame_states, view);
+        let bindings = Bindings::for_limits(&device.limits());
+        let scene = SceneGpu::with_bindings(
+            device,
+            queue,
+            &baked.geometry,
+            &baked.frame_states,
+            view,
+            bindings,
+        );
         let order = if config.mode.back_to_front() {
             Order::BackToFront
         } else {
@@ -126,13 +135,14 @@ impl Player {
             contents: command_bytes,
             usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
         });
-        let pipeline = create_pipeline(device, &scene.layout, &config);
+        let pipeline = create_pipeline(device, &scene.layout, &config, bindings);
 
         if let Some(Some(e)) = trisort_gpu::poll_ready(scope.pop()) {
             return Err(PlayerError::Wgpu(e.to_string()));
         }
         Ok(Player {
             scene,
+            bindings,
             pipeline,
             index_format: indices.format(),
             index_buffer,
@@ -232,6 +242,12 @@ impl Player {
         self.index_count
     }
 
+    /// How node matrices and materials are bound: [`Bindings::Storage`], or the data textures
+    /// of [`Bindings::Textures`] where the device's limits have no vertex storage (WebGL2).
+    pub fn bindings(&self) -> Bindings {
+        self.bindings
+    }
+
     /// The configuration it was created with.
     pub fn config(&self) -> &PlayerConfig {
         &self.config
@@ -290,8 +306,9 @@ fn create_pipeline(
     device: &wgpu::Device,
     scene_layout: &wgpu::BindGroupLayout,
     config: &PlayerConfig,
+    bindings: Bindings,
 ) -> wgpu::RenderPipeline {
-    let source = trisort_gpu::compose(&[], trisort_gpu::PLAYER);
+    let source = trisort_gpu::compose_with(bindings, &[], trisort_gpu::PLAYER);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("trisort player"),
         source: wgpu::ShaderSource::Wgsl(source.into()),

@@ -1,7 +1,8 @@
 //! The player's integration tests, one binary: the baked file as the player reads it
-//! (`baked_file`, no GPU) and what it draws (`play`).
+//! (`baked_file`, no GPU), what it draws (`play`) and its WebGL2 tier (`tiers`).
 
 mod support;
 
 mod baked_file;
 mod play;
+mod tiers;

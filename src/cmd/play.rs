@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde_json::json;
 use trisort_format::{Baked, FileKind};
-use trisort_gpu::Gpu;
+use trisort_gpu::{BackendChoice, Gpu, GpuOptions, LimitsChoice};
 use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
 use trisort_player::Mode;
 
@@ -52,6 +52,40 @@ pub struct PlayArgs {
     /// Print per-frame figures as JSON.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    device: DeviceArgs,
+}
+
+/// `--backend` and `--limits`: the device `play`, `verify` and `bench` open.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct DeviceArgs {
+    /// GPU backend: vulkan, gl (OpenGL/GLES; headless through EGL) or auto (wgpu's choice,
+    /// `WGPU_BACKEND` where set).
+    #[arg(long, default_value = "auto")]
+    pub backend: BackendChoice,
+    /// Device limits: default (the adapter's) or webgl2 (WebGL2's: the player takes its
+    /// GLES 3.0 / WebGL2 path, data-texture bindings and one draw per range, on any adapter).
+    #[arg(long, default_value = "default")]
+    pub limits: LimitsChoice,
+}
+
+impl DeviceArgs {
+    /// The options to open the device with.
+    pub fn options(self) -> GpuOptions {
+        GpuOptions {
+            backend: self.backend,
+            limits: self.limits,
+        }
+    }
+}
+
+/// What `play_frames` played with: the player's binding tier and draw path.
+#[derive(Clone, Copy, Debug)]
+pub struct PlayedPath {
+    /// `storage` or `textures` (`trisort_gpu::Bindings::name`).
+    pub bindings: &'static str,
+    /// `multi-draw-indirect` or `direct` (`trisort_player::DrawPath::name`).
+    pub draw_path: &'static str,
 }
 
 /// Writes a frame as PNG atomically.
@@ -78,7 +112,22 @@ pub fn play_frames(
     frames: std::ops::Range<u32>,
     out_dir: Option<&Path>,
 ) -> Result<Vec<RenderedFrame>> {
+    Ok(play_frames_on_path(gpu, baked, config, frames, out_dir)?.0)
+}
+
+/// [`play_frames`], also saying which binding tier and draw path played.
+pub fn play_frames_on_path(
+    gpu: &Gpu,
+    baked: &Baked,
+    config: &HeadlessConfig,
+    frames: std::ops::Range<u32>,
+    out_dir: Option<&Path>,
+) -> Result<(Vec<RenderedFrame>, PlayedPath)> {
     let renderer = HeadlessRenderer::new(gpu, baked, config)?;
+    let path = PlayedPath {
+        bindings: renderer.player().bindings().name(),
+        draw_path: renderer.player().config().draw_path.name(),
+    };
     for w in renderer.player().warnings() {
         eprintln!("trisort: warning: {w}");
     }
@@ -109,11 +158,14 @@ pub fn play_frames(
         });
     }
     bar.finish_and_clear();
-    Ok(out)
+    Ok((out, path))
 }
 
 pub fn run(a: PlayArgs) -> Result<ExitCode> {
     if a.window {
+        if a.device.options() != GpuOptions::default() {
+            anyhow::bail!("--backend and --limits apply to headless playback, not --window");
+        }
         return super::window::run(super::window::WindowArgs {
             baked: &a.baked,
             frames: a.frames,
@@ -144,14 +196,21 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
     if let Some(s) = a.samples {
         config.samples = s;
     }
-    let gpu = crate::common::open_gpu()?;
-    let frames = play_frames(&gpu, &baked, &config, range, a.out_dir.as_deref())?;
+    let gpu = crate::common::open_gpu_with(a.device.options())?;
+    let (frames, path) = play_frames_on_path(&gpu, &baked, &config, range, a.out_dir.as_deref())?;
     if a.json {
         let list: Vec<_> = frames
             .iter()
             .map(|f| json!({"frame": f.frame, "gpu_ms": f.gpu_ms}))
             .collect();
-        print_json(&json!({ "device": gpu.info.name, "mode": a.mode.name(), "frames": list }));
+        print_json(&json!({
+            "device": gpu.info.name,
+            "backend": format!("{:?}", gpu.info.backend),
+            "bindings": path.bindings,
+            "draw_path": path.draw_path,
+            "mode": a.mode.name(),
+            "frames": list,
+        }));
     } else {
         let ms: Vec<f64> = frames.iter().filter_map(|f| f.gpu_ms).collect();
         let timing = if ms.is_empty() {
@@ -164,10 +223,13 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
             )
         };
         println!(
-            "played {} frames ({} mode) on {}: {timing}",
+            "played {} frames ({} mode) on {} ({:?}; {} bindings, {} draws): {timing}",
             frames.len(),
             a.mode.name(),
-            gpu.info.name
+            gpu.info.name,
+            gpu.info.backend,
+            path.bindings,
+            path.draw_path
         );
         if let Some(d) = &a.out_dir {
             println!("wrote {}", d.display());

@@ -20,13 +20,14 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::{json, Value};
 use trisort_format::{Baked, Geometry, RecordSettings, Recording};
-use trisort_gpu::Gpu;
+use trisort_gpu::{Gpu, GpuOptions};
+use trisort_player::headless::HeadlessConfig;
 use trisort_player::Mode;
 use trisort_reference::compare::{difference_image, mask_image};
 use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
 
 use crate::cmd::merge::read_recordings;
-use crate::cmd::play::write_png;
+use crate::cmd::play::{play_frames_on_path, write_png};
 use crate::common::{load_scene, parse_range, parse_size, print_json, working_scene, FrameRange};
 
 /// Exit code of a verification that ran and found the baked file wrong.
@@ -75,6 +76,12 @@ pub struct VerifyArgs {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// `--backend` and `--limits`: other than `auto`/`default`, the frames are played on that
+    /// device (webgl2: the player's GLES 3.0 / WebGL2 path) and checked as captured frames
+    /// against the reference on the default device (the reference needs storage buffers and
+    /// depth-texture loads that GL lacks).
+    #[command(flatten)]
+    device: crate::cmd::play::DeviceArgs,
 }
 
 /// Image verification of a range of frames.
@@ -161,6 +168,47 @@ fn read_captured(dir: &Path, f: u32, size: (u32, u32)) -> Result<Vec<u8>> {
         );
     }
     Ok(image.into_raw())
+}
+
+/// A directory removed when dropped.
+struct TempDir(PathBuf);
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// `--backend`/`--limits` other than the defaults: plays `frames` on that device into a
+/// temporary directory, to be checked as captured frames.
+fn play_elsewhere(
+    a: &VerifyArgs,
+    baked: &Baked,
+    check: &ImageCheck,
+    frames: Range<u32>,
+) -> Result<TempDir> {
+    if a.frames_dir.is_some() {
+        bail!("--backend/--limits play the frames themselves: they cannot be combined with --frames-dir");
+    }
+    let player_gpu = crate::common::open_gpu_with(a.device.options())?;
+    let dir = TempDir(std::env::temp_dir().join(format!("trisort-played-{}", std::process::id())));
+    let config = HeadlessConfig {
+        size: check.size,
+        samples: check.samples,
+        mode: check.mode,
+        ..HeadlessConfig::recorded(baked)
+    };
+    let (_, path) = play_frames_on_path(&player_gpu, baked, &config, frames, Some(&dir.0))?;
+    if !a.json {
+        println!(
+            "played on: {} with {:?} limits ({} bindings, {} draws)",
+            player_gpu.describe(),
+            a.device.limits,
+            path.bindings,
+            path.draw_path
+        );
+    }
+    Ok(dir)
 }
 
 fn write_diff(dir: &Path, v: &VerifiedFrame, size: (u32, u32)) -> Result<()> {
@@ -261,7 +309,7 @@ fn image_check(
         size: a.size.unwrap_or((settings.width, settings.height)),
         samples: a.samples.unwrap_or(settings.samples.max(1)),
         max_error: a.max_error,
-        captured: a.frames_dir.is_some(),
+        captured: a.frames_dir.is_some() || a.device.options() != GpuOptions::default(),
         ..ImageCheck::recorded(baked, a.mode)
     };
     if check.samples != 1 && check.samples != 4 {
@@ -273,7 +321,15 @@ fn image_check(
     }
     let size = check.size;
     let geometry = &scene.geometry;
-    let captured = a.frames_dir.as_deref();
+    let elsewhere = if a.device.options() == GpuOptions::default() {
+        None
+    } else {
+        Some(play_elsewhere(a, baked, &check, range.clone())?)
+    };
+    let captured = a
+        .frames_dir
+        .as_deref()
+        .or(elsewhere.as_ref().map(|d| d.0.as_path()));
     let report = verify_images(&gpu, baked, geometry, check, recs, range, captured, |v| {
         if let Some(dir) = &a.diff_dir {
             if a.diff_all || !v.report.ok {

@@ -23,9 +23,10 @@ struct MaterialGpu {
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-// Camera-relative node matrices (view × world) of this frame, bound by dynamic offset.
-@group(0) @binding(1) var<storage, read> node_view: array<mat4x4<f32>>;
-@group(0) @binding(2) var<storage, read> materials: array<MaterialGpu>;
+// Bindings 1 and 2 (this frame's camera-relative node matrices, view × world, and the
+// materials) come from a binding prelude per tier: storage.wgsl (storage buffers) or
+// textures.wgsl (data textures, for GLES 3.0 / WebGL2). Both define `node_matrix(node)` and
+// `material_at(index)`, so everything below is the same maths on every tier.
 @group(0) @binding(3) var base_color_textures: texture_2d_array<f32>;
 @group(0) @binding(4) var base_color_sampler: sampler;
 
@@ -39,11 +40,11 @@ struct VertexIn {
 
 // The one vertex transform: local position → clip space.
 fn transform_position(position: vec3<f32>, node: u32) -> vec4<f32> {
-    return frame.proj * (node_view[node] * vec4<f32>(position, 1.0));
+    return frame.proj * (node_matrix(node) * vec4<f32>(position, 1.0));
 }
 
 fn transform_normal(normal: vec3<f32>, node: u32) -> vec3<f32> {
-    let m = node_view[node];
+    let m = node_matrix(node);
     return (m * vec4<f32>(normal, 0.0)).xyz;
 }
 
@@ -51,7 +52,7 @@ fn transform_normal(normal: vec3<f32>, node: u32) -> vec3<f32> {
 // opacity, opaque and mask materials alpha 1 (mask cut-off is tested on the texture alpha), blend
 // materials their alpha. Returns alpha < 0 when a MASK fragment is cut away.
 fn surface_base(material: u32, uv: vec2<f32>) -> vec4<f32> {
-    let m = materials[material];
+    let m = material_at(material);
     var color = m.base_color;
     if (m.params.w >= 0.0) {
         let layer = i32(m.params.w);
@@ -75,7 +76,7 @@ fn surface_base(material: u32, uv: vec2<f32>) -> vec4<f32> {
 
 // Whether a fragment is discarded for facing: single-sided materials drop back faces.
 fn culled(material: u32, front_facing: bool) -> bool {
-    return materials[material].params.z < 0.5 && !front_facing;
+    return material_at(material).params.z < 0.5 && !front_facing;
 }
 
 // Lit colour (linear, straight alpha): one directional light plus ambient, plus emissive.
@@ -86,6 +87,6 @@ fn shade(material: u32, base: vec4<f32>, view_normal: vec3<f32>, front_facing: b
     }
     let diffuse = max(dot(n, normalize(frame.light.xyz)), 0.0);
     let lit = base.rgb * (frame.light.w + (1.0 - frame.light.w) * diffuse)
-        + materials[material].emissive.rgb;
+        + material_at(material).emissive.rgb;
     return vec4<f32>(lit, base.a);
 }

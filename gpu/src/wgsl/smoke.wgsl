@@ -3,5 +3,5 @@
 
 @fragment
 fn fs_smoke(in: PlainVarying) -> @location(0) vec4<f32> {
-    return materials[in.material].base_color;
+    return material_at(in.material).base_color;
 }

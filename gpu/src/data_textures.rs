@@ -1,0 +1,149 @@
+//! Group 0 on the data-texture tier ([`crate::Bindings::Textures`], `wgsl/textures.wgsl`): node
+//! matrices of every frame and the materials as Rgba32Float texels, [`DATA_WIDTH`] a row, and a
+//! per-frame uniform with the frame's first node, bound by dynamic offset where the storage
+//! tier binds the frame's matrices. GLES 3.0 / WebGL2 read these in the vertex stage, where
+//! they have no storage buffers.
+
+use wgpu::util::DeviceExt;
+
+use crate::scene_gpu::{FrameData, SharedBindings, DATA_WIDTH};
+
+/// The bind group layout of group 0 on the texture tier.
+pub(crate) fn texture_tier_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+    let uniform = |binding, size: u64| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: vf,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: true,
+            min_binding_size: wgpu::BufferSize::new(size),
+        },
+        count: None,
+    };
+    let data = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: vf,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("trisort scene (data textures)"),
+        entries: &[
+            uniform(
+                0,
+                std::mem::size_of::<crate::scene_gpu::FrameUniform>() as u64,
+            ),
+            uniform(1, 16),
+            data(2),
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 4,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+            data(5),
+        ],
+    })
+}
+
+/// `bytes` (a whole number of 16-byte texels) as an Rgba32Float texture [`DATA_WIDTH`] texels
+/// wide, the last row padded with zeros.
+fn data_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    bytes: &[u8],
+) -> wgpu::TextureView {
+    let row = DATA_WIDTH as usize * 16;
+    let rows = bytes.len().div_ceil(row).max(1);
+    let mut padded = bytes.to_vec();
+    padded.resize(rows * row, 0);
+    let texture = device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: DATA_WIDTH,
+                height: rows as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &padded,
+    );
+    texture.create_view(&Default::default())
+}
+
+/// The texture tier's layout and bind group, and the stride of its per-frame node uniform
+/// (the frame uniform's).
+pub(crate) fn bind_group(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    shared: SharedBindings<'_>,
+    data: &FrameData,
+    material_bytes: &[u8],
+    frames: usize,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup, u64) {
+    debug_assert_eq!(data.node_stride, data.node_count * 64);
+    let stride = data.frame_stride as usize;
+    let mut base = vec![0u8; stride * frames.max(1)];
+    for f in 0..frames {
+        let first = (f as u64 * data.node_count) as u32;
+        base[f * stride..][..4].copy_from_slice(&first.to_le_bytes());
+    }
+    let base_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("first node of each frame"),
+        contents: &base,
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let materials = data_texture(device, queue, "material texels", material_bytes);
+    let nodes = data_texture(device, queue, "node matrix texels", &data.node_bytes);
+    let layout = texture_tier_layout(device);
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("trisort scene (data textures)"),
+        layout: &layout,
+        entries: &[
+            shared.frame,
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &base_buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(16),
+                }),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&materials),
+            },
+            shared.texture,
+            shared.sampler,
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: wgpu::BindingResource::TextureView(&nodes),
+            },
+        ],
+    });
+    (layout, bind_group, data.frame_stride)
+}
