@@ -10,6 +10,7 @@ use crate::scene_gpu::{FrameData, SharedBindings, DATA_WIDTH};
 
 /// The bind group layout of group 0 on the texture tier.
 pub(crate) fn texture_tier_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let base_colour = crate::scene_gpu::base_colour_entries();
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let uniform = |binding, size: u64| wgpu::BindGroupLayoutEntry {
         binding,
@@ -40,22 +41,8 @@ pub(crate) fn texture_tier_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
             ),
             uniform(1, 16),
             data(2),
-            wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                    view_dimension: wgpu::TextureViewDimension::D2Array,
-                    multisampled: false,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 4,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            },
+            base_colour[0],
+            base_colour[1],
             data(5),
         ],
     })
@@ -125,14 +112,7 @@ pub(crate) fn bind_group(
         layout: &layout,
         entries: &[
             shared.frame,
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &base_buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(16),
-                }),
-            },
+            crate::scene_gpu::sized_buffer_entry(1, &base_buffer, 16),
             wgpu::BindGroupEntry {
                 binding: 2,
                 resource: wgpu::BindingResource::TextureView(&materials),

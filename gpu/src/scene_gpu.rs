@@ -120,6 +120,7 @@ pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 
 /// Creates the bind group layout of group 0 for `bindings`.
 pub fn bind_group_layout_for(device: &wgpu::Device, bindings: Bindings) -> wgpu::BindGroupLayout {
+    let base_colour = base_colour_entries();
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     if bindings == Bindings::Textures {
         return crate::data_textures::texture_tier_layout(device);
@@ -159,24 +160,50 @@ pub fn bind_group_layout_for(device: &wgpu::Device, bindings: Bindings) -> wgpu:
                 },
                 count: None,
             },
-            wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                    view_dimension: wgpu::TextureViewDimension::D2Array,
-                    multisampled: false,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 4,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            },
+            base_colour[0],
+            base_colour[1],
         ],
     })
+}
+
+/// A bind-group entry that binds the first `size` bytes of `buffer` (a dynamic offset moves
+/// the window per frame).
+pub(crate) fn sized_buffer_entry(
+    binding: u32,
+    buffer: &wgpu::Buffer,
+    size: u64,
+) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(size),
+        }),
+    }
+}
+
+/// Bindings 3 and 4 of every tier's scene group: the base-colour texture array and its
+/// filtering sampler, read by the fragment stage.
+pub(crate) fn base_colour_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
+    [
+        wgpu::BindGroupLayoutEntry {
+            binding: 3,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            count: None,
+        },
+        wgpu::BindGroupLayoutEntry {
+            binding: 4,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        },
+    ]
 }
 
 /// Group 1, bindings 0-2, of a peel pass (`peel.wgsl`'s `fs_peel`, `peeling.wgsl`'s
@@ -538,14 +565,7 @@ fn storage_bind_group(
         layout: &layout,
         entries: &[
             shared.frame,
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &node_buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(data.node_count * 64),
-                }),
-            },
+            sized_buffer_entry(1, &node_buffer, data.node_count * 64),
             wgpu::BindGroupEntry {
                 binding: 2,
                 resource: materials.as_entire_binding(),

@@ -8,7 +8,7 @@ use trisort_intersect::{
 
 use crate::common::{
     check, frame, geometry, grid, irregular_pair, node, one_node, pose, quad, t_junctions, tri,
-    x_quads, Expect,
+    x_quads, Expect, X_QUAD_A, X_QUAD_B,
 };
 
 /// Both triangles of each crossing pair cut (the default cuts one): these cases check the
@@ -22,6 +22,16 @@ fn both_sides() -> SplitOptions {
 
 fn split(g: &Geometry) -> SplitScene {
     split_intersections(g, &[], &both_sides())
+}
+
+/// One node holding triangle `a` (material 0) and triangle `b` (material 1), and the split of
+/// both sides.
+fn two_triangles(a: [[f32; 3]; 3], b: [[f32; 3]; 3]) -> (Geometry, SplitScene) {
+    let mut g = one_node();
+    tri(&mut g, a, 0, 0);
+    tri(&mut g, b, 0, 1);
+    let out = split(&g);
+    (g, out)
 }
 
 /// Exact where the cut points are representable in f32.
@@ -92,20 +102,10 @@ fn irregular_crossing_interpolates_at_rounded_cut_points() {
 
 #[test]
 fn a_pierced_triangle_is_split_with_the_piercing_one() {
-    let mut g = one_node();
-    tri(
-        &mut g,
+    let (g, out) = two_triangles(
         [[-2.0, 0.0, 2.0], [2.0, 0.0, 2.0], [0.0, 0.0, -2.0]],
-        0,
-        0,
-    );
-    tri(
-        &mut g,
         [[-0.2, -0.5, 0.0], [0.2, -0.5, 0.0], [0.0, 0.5, 0.1]],
-        0,
-        1,
     );
-    let out = split(&g);
     assert_eq!(out.report.pairs_split, 1);
     assert_eq!(out.report.triangles_split, 2);
     check(&g, &[], &out, &ROUNDED);
@@ -114,20 +114,10 @@ fn a_pierced_triangle_is_split_with_the_piercing_one() {
 
 #[test]
 fn coplanar_overlap_is_a_tie_and_left_alone() {
-    let mut g = one_node();
-    tri(
-        &mut g,
+    let (g, out) = two_triangles(
         [[-1.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 0.0, -1.0]],
-        0,
-        0,
-    );
-    tri(
-        &mut g,
         [[-0.5, 0.0, 2.0], [0.5, 0.0, 2.0], [0.0, 0.0, -0.5]],
-        0,
-        1,
     );
-    let out = split(&g);
     assert_untouched(&g, &out);
     assert_eq!(out.report.pairs_below_precision, 0);
 }
@@ -162,20 +152,8 @@ fn two_nodes(frames: &[trisort_format::FrameState]) -> (Geometry, SplitScene) {
         node("a", Some(0), DMat4::from_translation(DVec3::X)),
         node("b", Some(0), DMat4::from_translation(DVec3::X)),
     ]);
-    let a = [
-        [-1.0, -1.0, -1.0],
-        [1.0, -1.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [-1.0, 1.0, -1.0],
-    ];
-    let b = [
-        [-1.0, -1.0, 1.0],
-        [1.0, -1.0, -1.0],
-        [1.0, 1.0, -1.0],
-        [-1.0, 1.0, 1.0],
-    ];
-    quad(&mut g, a, 1, 0);
-    quad(&mut g, b, 2, 1);
+    quad(&mut g, X_QUAD_A, 1, 0);
+    quad(&mut g, X_QUAD_B, 2, 1);
     let out = split_intersections(&g, frames, &both_sides());
     (g, out)
 }

@@ -49,8 +49,15 @@ fn normal_at(p: [f32; 3]) -> [f32; 3] {
 
 /// Adds a triangle with three vertices of its own (uv and normal varying with the position).
 pub fn tri(g: &mut Geometry, corners: [[f32; 3]; 3], node: u32, material: u32) {
+    let base = push_corners(g, &corners, node, material);
+    g.triangles.push([base, base + 1, base + 2]);
+}
+
+/// Appends a vertex per corner (uv and normal varying with the position); returns the first
+/// one's index.
+fn push_corners(g: &mut Geometry, corners: &[[f32; 3]], node: u32, material: u32) -> u32 {
     let base = g.vertices.len() as u32;
-    for position in corners {
+    for &position in corners {
         g.vertices.push(Vertex {
             position,
             normal: normal_at(position),
@@ -59,21 +66,12 @@ pub fn tri(g: &mut Geometry, corners: [[f32; 3]; 3], node: u32, material: u32) {
             node,
         });
     }
-    g.triangles.push([base, base + 1, base + 2]);
+    base
 }
 
 /// Adds a quad with four shared vertices: triangles (0, 1, 2) and (0, 2, 3).
 pub fn quad(g: &mut Geometry, corners: [[f32; 3]; 4], node: u32, material: u32) {
-    let base = g.vertices.len() as u32;
-    for position in corners {
-        g.vertices.push(Vertex {
-            position,
-            normal: normal_at(position),
-            uv: uv_at(position),
-            material,
-            node,
-        });
-    }
+    let base = push_corners(g, &corners, node, material);
     g.triangles.push([base, base + 1, base + 2]);
     g.triangles.push([base, base + 2, base + 3]);
 }
@@ -81,21 +79,25 @@ pub fn quad(g: &mut Geometry, corners: [[f32; 3]; 4], node: u32, material: u32) 
 /// Two 2 × 2 quads crossing like an X seen from +Y: one in the plane z = x, one in z = −x,
 /// mapped by `f`. Their intersection is the line x = z = 0, through edge midpoints.
 pub fn x_quads(g: &mut Geometry, node: u32, f: impl Fn([f32; 3]) -> [f32; 3]) {
-    let a = [
-        [-1.0, -1.0, -1.0],
-        [1.0, -1.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [-1.0, 1.0, -1.0],
-    ];
-    let b = [
-        [-1.0, -1.0, 1.0],
-        [1.0, -1.0, -1.0],
-        [1.0, 1.0, -1.0],
-        [-1.0, 1.0, 1.0],
-    ];
-    quad(g, a.map(&f), node, 0);
-    quad(g, b.map(&f), node, 1);
+    quad(g, X_QUAD_A.map(&f), node, 0);
+    quad(g, X_QUAD_B.map(&f), node, 1);
 }
+
+/// The quad of [`x_quads`] in the plane z = x.
+pub const X_QUAD_A: [[f32; 3]; 4] = [
+    [-1.0, -1.0, -1.0],
+    [1.0, -1.0, 1.0],
+    [1.0, 1.0, 1.0],
+    [-1.0, 1.0, -1.0],
+];
+
+/// The quad of [`x_quads`] in the plane z = −x.
+pub const X_QUAD_B: [[f32; 3]; 4] = [
+    [-1.0, -1.0, 1.0],
+    [1.0, -1.0, -1.0],
+    [1.0, 1.0, -1.0],
+    [-1.0, 1.0, 1.0],
+];
 
 /// Two triangles crossing at an angle with intersection points that f32 cannot represent.
 pub fn irregular_pair(g: &mut Geometry, node: u32, f: impl Fn([f32; 3]) -> [f32; 3]) {

@@ -228,16 +228,9 @@ fn a_64_layer_transparent_stack() {
     );
 }
 
-/// Two opaque quads crossing along x = 0 (z = −2 ± 0.5x), recorded as they are
-/// (`--keep-intersections`): on one side A is in front, on the other B. The frame's graph has
-/// a cycle; the merger removes a minimum-weight set of
-/// edges, which are the only unordered samples (no more than the lighter direction's
-/// weight), the file records them, and the rules pass with them removed. Against the exact
-/// reference, the loss is confined to the unordered mask: no pixel without an unordered
-/// sample differs.
-#[test]
-fn an_interpenetrating_pair_is_unordered_only_where_it_crosses() {
-    let dir = tempfile::tempdir().unwrap();
+/// Two opaque quads crossing along x = 0 (z = −2 ± 0.5x), as a GLB, and a two-key path
+/// looking at them head-on, then from above.
+fn crossing_quads() -> (Vec<u8>, String) {
     let tilted = |slope: f32| -> Vec<[[f32; 3]; 3]> {
         let p = |x: f32, y: f32| [x, y, -2.0 + slope * x];
         vec![
@@ -254,6 +247,20 @@ fn an_interpenetrating_pair_is_unordered_only_where_it_crosses() {
         Some((0.1, 10.0)),
         &[(EYE0, AHEAD), ([0.0, 0.6, 0.2], [0.0, 0.0, -2.0])],
     );
+    (scene, path)
+}
+
+/// Two opaque quads crossing along x = 0 (z = −2 ± 0.5x), recorded as they are
+/// (`--keep-intersections`): on one side A is in front, on the other B. The frame's graph has
+/// a cycle; the merger removes a minimum-weight set of
+/// edges, which are the only unordered samples (no more than the lighter direction's
+/// weight), the file records them, and the rules pass with them removed. Against the exact
+/// reference, the loss is confined to the unordered mask: no pixel without an unordered
+/// sample differs.
+#[test]
+fn an_interpenetrating_pair_is_unordered_only_where_it_crosses() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, path) = crossing_quads();
     let Some(b) = bake_with(
         dir.path(),
         "cross",
@@ -300,22 +307,7 @@ fn an_interpenetrating_pair_is_unordered_only_where_it_crosses() {
 #[test]
 fn an_interpenetrating_pair_is_split_and_sorted_exactly() {
     let dir = tempfile::tempdir().unwrap();
-    let tilted = |slope: f32| -> Vec<[[f32; 3]; 3]> {
-        let p = |x: f32, y: f32| [x, y, -2.0 + slope * x];
-        vec![
-            [p(-1.0, -1.0), p(1.0, -1.0), p(1.0, 1.0)],
-            [p(-1.0, -1.0), p(1.0, 1.0), p(-1.0, 1.0)],
-        ]
-    };
-    let scene = glb(
-        &[part(0, tilted(0.5)), part(1, tilted(-0.5))],
-        &[Mat([0.9, 0.2, 0.2, 1.0]), Mat([0.2, 0.2, 0.9, 1.0])],
-    );
-    let path = path_toml(
-        60.0,
-        Some((0.1, 10.0)),
-        &[(EYE0, AHEAD), ([0.0, 0.6, 0.2], [0.0, 0.0, -2.0])],
-    );
+    let (scene, path) = crossing_quads();
     let Some(b) = bake(dir.path(), "split", &scene, &path, 32, 4) else {
         return;
     };
