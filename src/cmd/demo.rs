@@ -80,7 +80,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         trisort_reference::ImageCheck::recorded(&baked, trisort_player::Mode::Blend),
         std::slice::from_ref(&rec),
         0..baked.frames.len() as u32,
-        None,
+        crate::cmd::verify::Frames::Play,
         |_| Ok(()),
     )?;
     let images_s = t_images.elapsed().as_secs_f64();

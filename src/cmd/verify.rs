@@ -21,13 +21,13 @@ use clap::Args;
 use serde_json::{json, Value};
 use trisort_format::{Baked, Geometry, RecordSettings, Recording};
 use trisort_gpu::{Gpu, GpuOptions};
-use trisort_player::headless::HeadlessConfig;
+use trisort_player::headless::{HeadlessConfig, HeadlessRenderer};
 use trisort_player::Mode;
 use trisort_reference::compare::{difference_image, mask_image};
 use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
 
 use crate::cmd::merge::read_recordings;
-use crate::cmd::play::{play_frames_on_path, write_png};
+use crate::cmd::play::write_png;
 use crate::common::{load_scene, parse_range, parse_size, print_json, working_scene, FrameRange};
 
 /// Exit code of a verification that ran and found the baked file wrong.
@@ -121,7 +121,7 @@ pub fn verify_images(
     check: ImageCheck,
     recordings: &[Recording],
     frames: Range<u32>,
-    captured: Option<&Path>,
+    captured: Frames<'_>,
     mut each: impl FnMut(&VerifiedFrame) -> Result<()>,
 ) -> Result<ImageReport> {
     let verifier = ImageVerifier::new(gpu, baked, geometry, check, recordings)?;
@@ -132,8 +132,9 @@ pub fn verify_images(
     };
     for f in frames {
         let v = match captured {
-            Some(dir) => verifier.verify_captured(f, read_captured(dir, f, check.size)?),
-            None => verifier.verify(f),
+            Frames::Play => verifier.verify(f),
+            Frames::Dir(dir) => verifier.verify_captured(f, read_captured(dir, f, check.size)?),
+            Frames::Elsewhere(player) => verifier.verify_captured(f, player.render(f)?.rgba8),
         }
         .with_context(|| format!("verifying frame {f}"))?;
         each(&v)?;
@@ -170,45 +171,54 @@ fn read_captured(dir: &Path, f: u32, size: (u32, u32)) -> Result<Vec<u8>> {
     Ok(image.into_raw())
 }
 
-/// A directory removed when dropped.
-struct TempDir(PathBuf);
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
+/// Where the checked frames come from.
+#[derive(Clone, Copy)]
+pub enum Frames<'a> {
+    /// Played here by the player on the verifying device.
+    Play,
+    /// Drawn elsewhere: PNGs in a directory (`--frames-dir`).
+    Dir(&'a Path),
+    /// Played on another device (`--backend`/`--limits`), one frame at a time as it is
+    /// checked.
+    Elsewhere(&'a HeadlessRenderer<'a>),
 }
 
-/// `--backend`/`--limits` other than the defaults: plays `frames` on that device into a
-/// temporary directory, to be checked as captured frames.
-fn play_elsewhere(
-    a: &VerifyArgs,
-    baked: &Baked,
-    check: &ImageCheck,
-    frames: Range<u32>,
-) -> Result<TempDir> {
+/// `--backend`/`--limits` other than the defaults: the device the frames are played on before
+/// they are checked as captured frames.
+fn elsewhere_device(a: &VerifyArgs) -> Result<Gpu> {
     if a.frames_dir.is_some() {
         bail!("--backend/--limits play the frames themselves: they cannot be combined with --frames-dir");
     }
-    let player_gpu = crate::common::open_gpu_with(a.device.options())?;
-    let dir = TempDir(std::env::temp_dir().join(format!("trisort-played-{}", std::process::id())));
+    crate::common::open_gpu_with(a.device.options())
+}
+
+/// The player on the `--backend`/`--limits` device, saying where it plays.
+fn elsewhere_player<'g>(
+    a: &VerifyArgs,
+    gpu: &'g Gpu,
+    baked: &Baked,
+    check: &ImageCheck,
+) -> Result<HeadlessRenderer<'g>> {
     let config = HeadlessConfig {
         size: check.size,
         samples: check.samples,
         mode: check.mode,
         ..HeadlessConfig::recorded(baked)
     };
-    let (_, path) = play_frames_on_path(&player_gpu, baked, &config, frames, Some(&dir.0))?;
+    let player = HeadlessRenderer::new(gpu, baked, &config)?;
+    for w in player.player().warnings() {
+        eprintln!("trisort: warning: {w}");
+    }
     if !a.json {
         println!(
             "played on: {} with {:?} limits ({} bindings, {} draws)",
-            player_gpu.describe(),
+            gpu.describe(),
             a.device.limits,
-            path.bindings,
-            path.draw_path
+            player.player().bindings().name(),
+            player.player().config().draw_path.name()
         );
     }
-    Ok(dir)
+    Ok(player)
 }
 
 fn write_diff(dir: &Path, v: &VerifiedFrame, size: (u32, u32)) -> Result<()> {
@@ -321,15 +331,20 @@ fn image_check(
     }
     let size = check.size;
     let geometry = &scene.geometry;
-    let elsewhere = if a.device.options() == GpuOptions::default() {
+    let elsewhere_gpu = if a.device.options() == GpuOptions::default() {
         None
     } else {
-        Some(play_elsewhere(a, baked, &check, range.clone())?)
+        Some(elsewhere_device(a)?)
     };
-    let captured = a
-        .frames_dir
-        .as_deref()
-        .or(elsewhere.as_ref().map(|d| d.0.as_path()));
+    let elsewhere = elsewhere_gpu
+        .as_ref()
+        .map(|g| elsewhere_player(a, g, baked, &check))
+        .transpose()?;
+    let captured = match (a.frames_dir.as_deref(), &elsewhere) {
+        (Some(dir), _) => Frames::Dir(dir),
+        (None, Some(player)) => Frames::Elsewhere(player),
+        (None, None) => Frames::Play,
+    };
     let report = verify_images(&gpu, baked, geometry, check, recs, range, captured, |v| {
         if let Some(dir) = &a.diff_dir {
             if a.diff_all || !v.report.ok {
