@@ -16,7 +16,6 @@ pub mod baked;
 pub mod camera;
 pub mod container;
 pub mod geometry;
-pub mod mode;
 pub mod options;
 pub mod recording;
 
@@ -26,9 +25,9 @@ pub use camera::{world_transforms, Camera, FrameState, NodePose};
 pub use container::write_file_atomic;
 pub use container::{read_file, FileKind, FormatError, FORMAT_VERSION};
 pub use geometry::{AlphaMode, Geometry, Material, Node, Texture, Vertex};
-pub use mode::{Mode, ParseModeError};
 pub use options::{
-    Bridge, Choice, Choosable, Layout, OptionValue, ParseOptionError, Seeding, Strategy,
+    Bridge, Choice, Choosable, DeviceBackend, DeviceLimits, Layout, Mode, OptionValue,
+    ParseOptionError, Seeding, Strategy,
 };
 pub use recording::{
     DeviceInfo, Edge, FrameRecord, Phase, RecordSettings, Recording, SettingsError,

@@ -209,6 +209,53 @@ option_enum! {
     }
 }
 
+option_enum! {
+    /// How a baked frame is composited (see the player's crate documentation for the
+    /// equations): `play`, `verify` and `bench --mode`.
+    pub enum Mode: "mode" {
+        /// Back to front, *over*, no depth test.
+        #[default]
+        Blend = "blend", "Back to front, over, no depth test";
+        /// Front to back with the depth test (`Less`, depth writes) and *over*.
+        Depth = "depth", "Front to back with the depth test";
+        /// Front to back, *under* on a target cleared to alpha 0, no depth test.
+        Saturate = "saturate", "Front to back, under, no depth test";
+    }
+}
+
+impl Mode {
+    /// Whether the mode plays the stored order reversed (back to front).
+    pub fn back_to_front(self) -> bool {
+        self == Mode::Blend
+    }
+}
+
+option_enum! {
+    /// Which GPU backend a device is opened on (`--backend`).
+    pub enum DeviceBackend: "backend" {
+        /// wgpu's choice (`WGPU_BACKEND` where set).
+        #[default]
+        Auto = "auto", "wgpu's choice (WGPU_BACKEND where set)";
+        /// Vulkan only.
+        Vulkan = "vulkan", "Vulkan only";
+        /// OpenGL / GLES only (EGL headless on Linux).
+        Gl = "gl", "OpenGL/GLES only (headless through EGL)";
+    }
+}
+
+option_enum! {
+    /// The limits a device is opened with (`--limits`).
+    pub enum DeviceLimits: "limits" {
+        /// The adapter's own limits.
+        #[default]
+        Adapter = "default", "The adapter's own limits";
+        /// WebGL2's (`wgpu::Limits::downlevel_webgl2_defaults`, at the adapter's texture
+        /// sizes): no storage buffers, 16 KiB uniform bindings. The player then takes its
+        /// WebGL2 path (data-texture bindings, direct draws) on any adapter.
+        Webgl2 = "webgl2", "WebGL2's limits: the player's GLES 3.0 / WebGL2 path";
+    }
+}
+
 /// An option whose values the merger can also try all of ([`Choice::Auto`]): [`Strategy`]
 /// and [`Layout`].
 pub trait Choosable: OptionValue {

@@ -64,60 +64,15 @@ pub fn device_info(info: &wgpu::AdapterInfo) -> trisort_format::DeviceInfo {
     }
 }
 
-/// The limits a device is opened with.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LimitsChoice {
-    /// The adapter's own limits.
-    #[default]
-    Adapter,
-    /// WebGL2's ([`wgpu::Limits::downlevel_webgl2_defaults`], at the adapter's texture sizes):
-    /// no storage buffers, 16 KiB uniform bindings. The player then takes its WebGL2 path
-    /// (data-texture bindings, direct draws) on any adapter, so that path is testable here.
-    Webgl2,
-}
-
-impl std::str::FromStr for LimitsChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "default" => Ok(LimitsChoice::Adapter),
-            "webgl2" => Ok(LimitsChoice::Webgl2),
-            _ => Err(format!("unknown limits {s:?}: default or webgl2")),
-        }
-    }
-}
-
-/// Which backend to open a device on (`--backend`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum BackendChoice {
-    /// wgpu's choice (`WGPU_BACKEND` where set).
-    #[default]
-    Auto,
-    /// Vulkan only.
-    Vulkan,
-    /// OpenGL / GLES only (EGL headless on Linux).
-    Gl,
-}
-
-impl std::str::FromStr for BackendChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(BackendChoice::Auto),
-            "vulkan" => Ok(BackendChoice::Vulkan),
-            "gl" => Ok(BackendChoice::Gl),
-            _ => Err(format!("unknown backend {s:?}: vulkan, gl or auto")),
-        }
-    }
-}
+pub use trisort_format::{DeviceBackend, DeviceLimits};
 
 /// How to open a device: backend and limits ([`Gpu::with_options`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct GpuOptions {
     /// The backend.
-    pub backend: BackendChoice,
+    pub backend: DeviceBackend,
     /// The limits.
-    pub limits: LimitsChoice,
+    pub limits: DeviceLimits,
 }
 
 impl Gpu {
@@ -140,14 +95,14 @@ impl Gpu {
 
     #[cfg(not(target_arch = "wasm32"))]
     /// [`Gpu::with_flags`] on the backend and with the limits of `options` (a backend other
-    /// than [`BackendChoice::Auto`] overrides `WGPU_BACKEND`).
+    /// than [`DeviceBackend::Auto`] overrides `WGPU_BACKEND`).
     pub fn with_options(flags: wgpu::InstanceFlags, options: GpuOptions) -> Result<Gpu, GpuError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         desc.flags = flags;
         match options.backend {
-            BackendChoice::Auto => {}
-            BackendChoice::Vulkan => desc.backends = wgpu::Backends::VULKAN,
-            BackendChoice::Gl => desc.backends = wgpu::Backends::GL,
+            DeviceBackend::Auto => {}
+            DeviceBackend::Vulkan => desc.backends = wgpu::Backends::VULKAN,
+            DeviceBackend::Gl => desc.backends = wgpu::Backends::GL,
         }
         let instance = wgpu::Instance::new(desc);
         Gpu::open(&instance, None, "trisort", options.limits)
@@ -165,7 +120,7 @@ impl Gpu {
             instance,
             Some(surface),
             "trisort window",
-            LimitsChoice::Adapter,
+            DeviceLimits::Adapter,
         )
     }
 
@@ -175,7 +130,7 @@ impl Gpu {
         instance: &wgpu::Instance,
         compatible_surface: Option<&wgpu::Surface<'_>>,
         label: &str,
-        limits: LimitsChoice,
+        limits: DeviceLimits,
     ) -> Result<Gpu, GpuError> {
         let adapter =
             pollster::block_on(
@@ -194,8 +149,8 @@ impl Gpu {
             label: Some(label),
             required_features: features,
             required_limits: match limits {
-                LimitsChoice::Adapter => adapter.limits(),
-                LimitsChoice::Webgl2 => {
+                DeviceLimits::Adapter => adapter.limits(),
+                DeviceLimits::Webgl2 => {
                     wgpu::Limits::downlevel_webgl2_defaults().using_resolution(adapter.limits())
                 }
             },

@@ -20,7 +20,7 @@ pub mod target;
 mod timer;
 
 pub use device::{
-    device_info, wanted_features, BackendChoice, Gpu, GpuError, GpuOptions, LimitsChoice,
+    device_info, wanted_features, DeviceBackend, DeviceLimits, Gpu, GpuError, GpuOptions,
 };
 #[cfg(not(target_arch = "wasm32"))]
 pub use readback::map_read_all;

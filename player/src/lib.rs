@@ -38,7 +38,7 @@ pub use error::PlayerError;
 #[cfg(not(target_arch = "wasm32"))]
 pub use headless::{render_frames, HeadlessConfig, HeadlessRenderer, RenderedFrame};
 pub use player::{blend_state, fragment_entry_point, open_baked, Player};
-pub use trisort_format::{Mode, ParseModeError};
+pub use trisort_format::{Mode, ParseOptionError};
 /// The background every frame is drawn over (re-exported from the GPU crate for hosts).
 pub use trisort_gpu::BACKGROUND;
 

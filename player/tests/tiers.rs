@@ -4,7 +4,7 @@
 //! pure-Rust decoder the wasm32 build uses is the bake written.
 
 use trisort_format::{Baked, FileKind};
-use trisort_gpu::{BackendChoice, Bindings, Gpu, GpuOptions, LimitsChoice};
+use trisort_gpu::{Bindings, DeviceBackend, DeviceLimits, Gpu, GpuOptions};
 use trisort_player::{DrawPath, HeadlessConfig, HeadlessRenderer, Mode};
 
 use crate::support::*;
@@ -51,7 +51,7 @@ fn all_frames(gpu: &Gpu, baked: &Baked) -> (Bindings, DrawPath, Vec<Vec<u8>>) {
     (bindings, draw_path, out)
 }
 
-fn options(backend: BackendChoice, limits: LimitsChoice) -> GpuOptions {
+fn options(backend: DeviceBackend, limits: DeviceLimits) -> GpuOptions {
     GpuOptions { backend, limits }
 }
 
@@ -60,7 +60,7 @@ fn webgl2_limits_pick_data_textures_and_direct_draws_and_the_same_bytes() {
     let Some(full) = open(GpuOptions::default()) else {
         return;
     };
-    let Some(web) = open(options(BackendChoice::Auto, LimitsChoice::Webgl2)) else {
+    let Some(web) = open(options(DeviceBackend::Auto, DeviceLimits::Webgl2)) else {
         return;
     };
     assert_eq!(web.device.limits().max_storage_buffers_per_shader_stage, 0);
@@ -85,10 +85,10 @@ fn webgl2_limits_pick_data_textures_and_direct_draws_and_the_same_bytes() {
 
 #[test]
 fn gl_draws_the_same_bytes_on_both_tiers() {
-    let Some(gl) = open(options(BackendChoice::Gl, LimitsChoice::Adapter)) else {
+    let Some(gl) = open(options(DeviceBackend::Gl, DeviceLimits::Adapter)) else {
         return;
     };
-    let Some(web) = open(options(BackendChoice::Gl, LimitsChoice::Webgl2)) else {
+    let Some(web) = open(options(DeviceBackend::Gl, DeviceLimits::Webgl2)) else {
         return;
     };
     assert_eq!(web.info.backend, wgpu::Backend::Gl);

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde_json::json;
 use trisort_format::{Baked, FileKind};
-use trisort_gpu::{BackendChoice, Gpu, GpuOptions, LimitsChoice};
+use trisort_gpu::{DeviceBackend, DeviceLimits, Gpu, GpuOptions};
 use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
 use trisort_player::Mode;
 
@@ -62,11 +62,11 @@ pub struct DeviceArgs {
     /// GPU backend: vulkan, gl (OpenGL/GLES; headless through EGL) or auto (wgpu's choice,
     /// `WGPU_BACKEND` where set).
     #[arg(long, default_value = "auto")]
-    pub backend: BackendChoice,
+    pub backend: DeviceBackend,
     /// Device limits: default (the adapter's) or webgl2 (WebGL2's: the player takes its
     /// GLES 3.0 / WebGL2 path, data-texture bindings and one draw per range, on any adapter).
     #[arg(long, default_value = "default")]
-    pub limits: LimitsChoice,
+    pub limits: DeviceLimits,
 }
 
 impl DeviceArgs {
