@@ -254,12 +254,11 @@ impl FrameTarget {
 
     #[cfg(not(target_arch = "wasm32"))]
     /// Runs `encode` in one command encoder, copies the resolved frame to the staging buffer,
-    /// submits, waits and returns [`FrameTarget::rgba8`]. Errors on a wgpu validation error.
-    /// Panics if the target was created without `readback`.
-    pub fn read_rgba8(
+    /// submits, waits and returns the resolved texels as tightly packed rows. Errors on a wgpu
+    /// validation error. Panics if the target was created without `readback`.
+    pub fn read(
         &self,
         gpu: &Gpu,
-        mode: Mode,
         encode: impl FnOnce(&mut wgpu::CommandEncoder),
     ) -> Result<Vec<u8>, GpuError> {
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -274,7 +273,22 @@ impl FrameTarget {
             .staging
             .as_ref()
             .expect("FrameTarget created without readback");
-        Ok(self.rgba8(&gpu.map_read(staging), mode))
+        Ok(self.unpad(&gpu.map_read(staging)))
+    }
+
+    /// [`FrameTarget::read`] of an `Rgba16Float` frame as 8-bit sRGB RGBA (see
+    /// [`FrameTarget::rgba8`]).
+    pub fn read_rgba8(
+        &self,
+        gpu: &Gpu,
+        mode: Mode,
+        encode: impl FnOnce(&mut wgpu::CommandEncoder),
+    ) -> Result<Vec<u8>, GpuError> {
+        let texels = self.read(gpu, encode)?;
+        Ok(quantize_rgba16f(
+            &halves(&texels),
+            (mode == Mode::Saturate).then_some(BACKGROUND),
+        ))
     }
 
     /// The staging buffer's mapped bytes as tightly packed rows (drops the row padding).

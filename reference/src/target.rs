@@ -43,22 +43,13 @@ impl Target {
         clear: wgpu::Color,
         draw: impl FnOnce(&mut wgpu::RenderPass<'_>) -> Result<(), ReferenceError>,
     ) -> Result<Vec<u8>, ReferenceError> {
-        let device = &gpu.device;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("reference frame"),
-        });
-        {
-            let mut pass = self.0.begin_pass(&mut enc, clear, None);
-            draw(&mut pass)?;
-        }
-        self.0.copy_to_staging(&mut enc);
-        gpu.queue.submit([enc.finish()]);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(ReferenceError::Wgpu(e.to_string()));
-        }
-        let staging = self.0.staging().expect("created with readback");
-        Ok(self.0.unpad(&gpu.map_read(staging)))
+        let mut drawn = Ok(());
+        let texels = self.0.read(gpu, |enc| {
+            let mut pass = self.0.begin_pass(enc, clear, None);
+            drawn = draw(&mut pass);
+        })?;
+        drawn?;
+        Ok(texels)
     }
 }
 
