@@ -14,6 +14,7 @@ mod extremes_no_lost_work;
 mod long_paths;
 mod merge_car;
 mod record_cli;
+mod self_check_cli;
 mod verify_cli;
 mod verify_forged;
 mod verify_images;

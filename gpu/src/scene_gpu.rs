@@ -71,6 +71,11 @@ pub struct SceneGpu {
     frame_stride: u64,
     node_stride: u64,
     frames: u32,
+    /// The frame uniforms (binding 0), rewritten by [`SceneGpu::set_subpixel_offset`].
+    frame_buffer: wgpu::Buffer,
+    /// Per frame: the uniform as uploaded with no offset, and its projection in f64.
+    uniforms: Vec<(FrameUniform, glam::DMat4)>,
+    view: View,
 }
 
 fn align(x: u64, a: u64) -> u64 {
@@ -330,7 +335,7 @@ impl SceneGpu {
         let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame uniforms"),
             contents: &data.frame_bytes,
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let shared = SharedBindings {
             frame: wgpu::BindGroupEntry {
@@ -369,6 +374,33 @@ impl SceneGpu {
             frame_stride: data.frame_stride,
             node_stride,
             frames: frames.len() as u32,
+            uniforms: frames
+                .iter()
+                .map(|state| (frame_uniform(state, view), projection(state, view)))
+                .collect(),
+            frame_buffer,
+            view,
+        }
+    }
+
+    /// Shifts every frame's projection by `offset` pixels (x right, y down) at this scene's
+    /// view size, or back to the recorded projection with `[0.0, 0.0]`: the image moves by
+    /// `offset`, as if the sample pattern moved by `-offset`. A test aid that stands for
+    /// another rasterizer's vertex snapping (`play --subpixel-offset`), and the recorder's
+    /// jittered patterns (`record --robust N`). Applied in f64 before the one cast, so the
+    /// zero offset rasterizes exactly what [`SceneGpu::new`] uploads. Takes effect for
+    /// commands submitted after it.
+    pub fn set_subpixel_offset(&self, queue: &wgpu::Queue, offset: [f64; 2]) {
+        for (f, (u, proj)) in self.uniforms.iter().enumerate() {
+            let mut u = *u;
+            u.proj = (subpixel_shift(offset, self.view) * *proj)
+                .as_mat4()
+                .to_cols_array_2d();
+            queue.write_buffer(
+                &self.frame_buffer,
+                f as u64 * self.frame_stride,
+                bytemuck::bytes_of(&u),
+            );
         }
     }
 
@@ -387,10 +419,26 @@ impl SceneGpu {
     }
 }
 
+/// A frame's projection in f64 at a view's aspect ratio.
+fn projection(state: &FrameState, view: View) -> glam::DMat4 {
+    let aspect = view.width as f64 / view.height as f64;
+    state.camera.projection(aspect)
+}
+
+/// The clip-space translation that moves the image by `offset` pixels (x right, y down) at
+/// `view`'s size: x_clip += 2·dx/width · w_clip, y_clip −= 2·dy/height · w_clip (NDC y points
+/// up, pixel rows down).
+pub fn subpixel_shift(offset: [f64; 2], view: View) -> glam::DMat4 {
+    glam::DMat4::from_translation(glam::DVec3::new(
+        2.0 * offset[0] / view.width.max(1) as f64,
+        -2.0 * offset[1] / view.height.max(1) as f64,
+        0.0,
+    ))
+}
+
 /// The `Frame` uniform for one frame at a view.
 pub fn frame_uniform(state: &FrameState, view: View) -> FrameUniform {
-    let aspect = view.width as f64 / view.height as f64;
-    let proj = state.camera.projection(aspect).as_mat4();
+    let proj = projection(state, view).as_mat4();
     FrameUniform {
         proj: proj.to_cols_array_2d(),
         light: LIGHT,

@@ -134,6 +134,11 @@ impl<'g> HeadlessRenderer<'g> {
         })
     }
 
+    /// Shifts every frame's projection by `offset` pixels ([`Player::set_subpixel_offset`]).
+    pub fn set_subpixel_offset(&self, offset: [f64; 2]) {
+        self.player.set_subpixel_offset(&self.gpu.queue, offset);
+    }
+
     /// The player.
     pub fn player(&self) -> &Player {
         &self.player

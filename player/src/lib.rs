@@ -31,12 +31,16 @@ mod error;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod headless;
 mod player;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod self_check;
 
 pub use config::{playback_warnings, DrawPath, PlayerConfig};
 pub use draw_calls::{Call, CallLog, DrawCalls};
 pub use error::PlayerError;
 #[cfg(not(target_arch = "wasm32"))]
 pub use headless::{render_frames, HeadlessConfig, HeadlessRenderer, RenderedFrame};
+#[cfg(not(target_arch = "wasm32"))]
+pub use self_check::{SelfCheck, SelfCheckFrame};
 pub use player::{blend_state, fragment_entry_point, open_baked, Player};
 pub use trisort_format::{Mode, ParseOptionError};
 /// The background every frame is drawn over (re-exported from the GPU crate for hosts).

@@ -248,6 +248,15 @@ impl Player {
         self.bindings
     }
 
+    /// Shifts the projection of every frame by `offset` pixels (x right, y down) at the
+    /// configured size; `[0.0, 0.0]` restores the recorded projection. A test aid standing for
+    /// another GPU's vertex snapping (`play --subpixel-offset`): frames drawn after it move by
+    /// a fraction of a pixel, which the sorted order was not recorded for
+    /// ([`trisort_gpu::scene_gpu::SceneGpu::set_subpixel_offset`]).
+    pub fn set_subpixel_offset(&self, queue: &wgpu::Queue, offset: [f64; 2]) {
+        self.scene.set_subpixel_offset(queue, offset);
+    }
+
     /// The configuration it was created with.
     pub fn config(&self) -> &PlayerConfig {
         &self.config

@@ -5,4 +5,5 @@ mod support;
 
 mod baked_file;
 mod play;
+mod self_check;
 mod tiers;

@@ -312,6 +312,14 @@ impl<'g> Peeler<'g> {
         })
     }
 
+    /// Shifts every frame's projection by `offset` pixels (x right, y down): later layers
+    /// are peeled at the sample pattern moved by `-offset` (`record --robust N`'s jittered
+    /// patterns, and the reference of `play --subpixel-offset`). `[0.0, 0.0]` restores the
+    /// recorded pattern.
+    pub fn set_subpixel_offset(&self, offset: [f64; 2]) {
+        self.scene.set_subpixel_offset(&self.gpu.queue, offset);
+    }
+
     /// Number of samples in one layer.
     pub fn slots(&self) -> usize {
         self.view.width as usize * self.view.height as usize * self.view.samples as usize

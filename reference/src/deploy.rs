@@ -47,6 +47,11 @@ impl<'g> Srgb8Player<'g> {
         })
     }
 
+    /// Shifts every frame's projection by `offset` pixels ([`Player::set_subpixel_offset`]).
+    pub fn set_subpixel_offset(&self, offset: [f64; 2]) {
+        self.player.set_subpixel_offset(&self.gpu.queue, offset);
+    }
+
     /// Renders frame `frame`: 8-bit sRGB RGBA with alpha 255. In `saturate` mode the target
     /// holds premultiplied colour and coverage; the background goes under it on the CPU
     /// (decoded, `rgb + (1 − a)·background`, encoded and rounded once more).

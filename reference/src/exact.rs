@@ -351,6 +351,14 @@ impl<'g> ExactReference<'g> {
         })
     }
 
+    /// Shifts every frame's projection by `offset` pixels (x right, y down), in the peel and
+    /// in the compositing pass alike: the exact reference of a player shifted the same way
+    /// ([`trisort_player::Player::set_subpixel_offset`]). `[0.0, 0.0]` restores it.
+    pub fn set_subpixel_offset(&self, offset: [f64; 2]) {
+        self.peeler.set_subpixel_offset(offset);
+        self.scene.set_subpixel_offset(&self.gpu.queue, offset);
+    }
+
     /// The configuration.
     pub fn config(&self) -> &ReferenceConfig {
         &self.config

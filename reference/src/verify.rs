@@ -51,6 +51,10 @@ pub struct ImageCheck {
     /// no sRGB figure here, and the recorded pattern is the recorded size and sample count
     /// whatever the device that drew them.
     pub captured: bool,
+    /// Shift of the projection in pixels (x right, y down) applied to the player and to the
+    /// exact reference alike (`verify --subpixel-offset`, a test aid standing for another
+    /// GPU's vertex snapping); anything but zero is off the recorded pattern.
+    pub subpixel_offset: [f64; 2],
 }
 
 impl ImageCheck {
@@ -63,6 +67,7 @@ impl ImageCheck {
             max_error: None,
             srgb8: true,
             captured: false,
+            subpixel_offset: [0.0, 0.0],
         }
     }
 }
@@ -181,6 +186,7 @@ impl<'g> ImageVerifier<'g> {
         let s = &truth.settings;
         let at_pattern = check.size == (s.width, s.height)
             && check.samples == s.samples.max(1)
+            && check.subpixel_offset == [0.0, 0.0]
             && (check.captured || gpu.device_info() == *truth.device);
         let player = if check.captured {
             None
@@ -221,14 +227,30 @@ impl<'g> ImageVerifier<'g> {
         } else {
             None
         };
-        Ok(ImageVerifier {
+        let verifier = ImageVerifier {
             check,
             at_pattern,
             player,
             reference,
             srgb8,
             unordered: truth.unordered,
-        })
+        };
+        if check.subpixel_offset != [0.0, 0.0] {
+            verifier.shift(check.subpixel_offset);
+        }
+        Ok(verifier)
+    }
+
+    /// Shifts the projection of the player, the sRGB player and the exact reference by
+    /// `offset` pixels ([`ImageCheck::subpixel_offset`]).
+    fn shift(&self, offset: [f64; 2]) {
+        if let Some(p) = &self.player {
+            p.set_subpixel_offset(offset);
+        }
+        if let Some(p) = &self.srgb8 {
+            p.set_subpixel_offset(offset);
+        }
+        self.reference.set_subpixel_offset(offset);
     }
 
     /// Whether frames are checked at the recorded pattern (size, samples and, for frames

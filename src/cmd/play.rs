@@ -9,7 +9,7 @@ use serde_json::json;
 use trisort_format::{Baked, FileKind};
 use trisort_gpu::{DeviceBackend, DeviceLimits, Gpu, GpuOptions};
 use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
-use trisort_player::Mode;
+use trisort_player::{Mode, SelfCheck};
 
 use crate::common::{parse_range, parse_size, print_json, progress_bar, FrameRange};
 
@@ -52,8 +52,49 @@ pub struct PlayArgs {
     /// Print per-frame figures as JSON.
     #[arg(long)]
     json: bool,
+    /// Shift the projection by X,Y pixels (x right, y down; decimals or fractions such as
+    /// `1/16,0`): a test aid standing for another GPU's vertex snapping. The bake's order was
+    /// recorded for the unshifted sample pattern.
+    #[arg(long, value_name = "X,Y", value_parser = parse_subpixel_offset, allow_hyphen_values = true)]
+    subpixel_offset: Option<[f64; 2]>,
+    /// Also check every played frame for holes on this device: its depth-mode frame against a
+    /// z-buffer of the baked file's own triangles (any differing pixel is a triangle of the
+    /// file that the frame leaves out but that is the nearest surface here). Exit 3 when a
+    /// frame has a hole; `--json` adds per frame `holes`.
+    #[arg(long)]
+    self_check: bool,
     #[command(flatten)]
     device: DeviceArgs,
+}
+
+/// Parses `--subpixel-offset X,Y`: two finite numbers of pixels, each a decimal or a fraction
+/// `a/b`, at most 16 pixels.
+pub fn parse_subpixel_offset(s: &str) -> Result<[f64; 2], String> {
+    let bad = || format!("bad offset {s:?}: expected X,Y in pixels, e.g. 0.0625,0 or 1/16,0");
+    let number = |x: &str| -> Result<f64, String> {
+        let x = x.trim();
+        let v = match x.split_once('/') {
+            Some((a, b)) => {
+                let (a, b) = (
+                    a.trim().parse::<f64>().map_err(|_| bad())?,
+                    b.trim().parse::<f64>().map_err(|_| bad())?,
+                );
+                if b == 0.0 {
+                    return Err(bad());
+                }
+                a / b
+            }
+            None => x.parse::<f64>().map_err(|_| bad())?,
+        };
+        if !v.is_finite() || v.abs() > 16.0 {
+            return Err(format!(
+                "offset {s}: each component must be a finite number of pixels in [-16, 16]"
+            ));
+        }
+        Ok(v)
+    };
+    let (x, y) = s.split_once(',').ok_or_else(bad)?;
+    Ok([number(x)?, number(y)?])
 }
 
 /// `--backend` and `--limits`: the device `play`, `verify` and `bench` open.
@@ -112,18 +153,21 @@ pub fn play_frames(
     frames: std::ops::Range<u32>,
     out_dir: Option<&Path>,
 ) -> Result<Vec<RenderedFrame>> {
-    Ok(play_frames_on_path(gpu, baked, config, frames, out_dir)?.0)
+    Ok(play_frames_on_path(gpu, baked, config, frames, out_dir, [0.0, 0.0])?.0)
 }
 
-/// [`play_frames`], also saying which binding tier and draw path played.
+/// [`play_frames`] with the projection shifted by `offset` pixels, also saying which binding
+/// tier and draw path played.
 pub fn play_frames_on_path(
     gpu: &Gpu,
     baked: &Baked,
     config: &HeadlessConfig,
     frames: std::ops::Range<u32>,
     out_dir: Option<&Path>,
+    offset: [f64; 2],
 ) -> Result<(Vec<RenderedFrame>, PlayedPath)> {
     let renderer = HeadlessRenderer::new(gpu, baked, config)?;
+    renderer.set_subpixel_offset(offset);
     let path = PlayedPath {
         bindings: renderer.player().bindings().name(),
         draw_path: renderer.player().config().draw_path.name(),
@@ -166,6 +210,11 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
         if a.device.options() != GpuOptions::default() {
             anyhow::bail!("--backend and --limits apply to headless playback, not --window");
         }
+        if a.subpixel_offset.is_some() || a.self_check {
+            anyhow::bail!(
+                "--subpixel-offset and --self-check apply to headless playback, not --window"
+            );
+        }
         return super::window::run(super::window::WindowArgs {
             baked: &a.baked,
             frames: a.frames,
@@ -197,20 +246,62 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
         config.samples = s;
     }
     let gpu = crate::common::open_gpu_with(a.device.options())?;
-    let (frames, path) = play_frames_on_path(&gpu, &baked, &config, range, a.out_dir.as_deref())?;
+    let offset = a.subpixel_offset.unwrap_or([0.0, 0.0]);
+    if offset != [0.0, 0.0] {
+        eprintln!(
+            "trisort: warning: projection shifted by ({}, {}) px: the sorted order was recorded for the unshifted sample pattern",
+            offset[0], offset[1]
+        );
+    }
+    let (frames, path) = play_frames_on_path(
+        &gpu,
+        &baked,
+        &config,
+        range.clone(),
+        a.out_dir.as_deref(),
+        offset,
+    )?;
+    let checks = if a.self_check {
+        let check = SelfCheck::new(&gpu, &baked, config.size, config.samples)?;
+        check.set_subpixel_offset(offset);
+        let bar = progress_bar(range.len() as u64, "self-check");
+        let mut out = Vec::with_capacity(range.len());
+        for f in range {
+            out.push(check.check(f)?);
+            bar.inc(1);
+        }
+        bar.finish_and_clear();
+        Some(out)
+    } else {
+        None
+    };
+    let holes: u64 = checks.iter().flatten().map(|c| c.holes).sum();
     if a.json {
         let list: Vec<_> = frames
             .iter()
-            .map(|f| json!({"frame": f.frame, "gpu_ms": f.gpu_ms}))
+            .enumerate()
+            .map(|(k, f)| {
+                let mut v = json!({"frame": f.frame, "gpu_ms": f.gpu_ms});
+                if let Some(c) = checks.as_ref().map(|c| c[k]) {
+                    v["holes"] = json!(c.holes);
+                    v["holes_max_channel_diff"] = json!(c.max_channel_diff);
+                }
+                v
+            })
             .collect();
-        print_json(&json!({
+        let mut v = json!({
             "device": gpu.info.name,
             "backend": format!("{:?}", gpu.info.backend),
             "bindings": path.bindings,
             "draw_path": path.draw_path,
             "mode": a.mode.name(),
+            "subpixel_offset": offset,
             "frames": list,
-        }));
+        });
+        if checks.is_some() {
+            v["self_check"] = json!({"ok": holes == 0, "holes": holes});
+        }
+        print_json(&v);
     } else {
         let ms: Vec<f64> = frames.iter().filter_map(|f| f.gpu_ms).collect();
         let timing = if ms.is_empty() {
@@ -234,6 +325,27 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
         if let Some(d) = &a.out_dir {
             println!("wrote {}", d.display());
         }
+        if let Some(checks) = &checks {
+            let bad: Vec<_> = checks.iter().filter(|c| c.holes > 0).collect();
+            println!(
+                "self-check ({}x{}, {}x MSAA, depth mode, against a z-buffer of the file's own triangles): {} holes in {} of {} frames",
+                config.size.0,
+                config.size.1,
+                config.samples,
+                holes,
+                bad.len(),
+                checks.len()
+            );
+            for c in bad.iter().take(20) {
+                println!(
+                    "  frame {}: {} hole pixels (max {}/255)",
+                    c.frame, c.holes, c.max_channel_diff
+                );
+            }
+        }
+    }
+    if holes > 0 {
+        return Ok(ExitCode::from(super::verify::VERIFY_FAILED));
     }
     Ok(ExitCode::SUCCESS)
 }

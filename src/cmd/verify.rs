@@ -73,6 +73,11 @@ pub struct VerifyArgs {
     /// the checked size. Needs `--scene`.
     #[arg(long, value_name = "DIR", requires = "scene")]
     frames_dir: Option<PathBuf>,
+    /// Shift the projection of the player and of the exact reference by X,Y pixels (x right,
+    /// y down; decimals or fractions such as `1/16,0`): a test aid standing for another GPU's
+    /// vertex snapping. Off the recorded pattern: measured, failing only above --max-error.
+    #[arg(long, value_name = "X,Y", value_parser = crate::cmd::play::parse_subpixel_offset, allow_hyphen_values = true)]
+    subpixel_offset: Option<[f64; 2]>,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -206,6 +211,7 @@ fn elsewhere_player<'g>(
         ..HeadlessConfig::recorded(baked)
     };
     let player = HeadlessRenderer::new(gpu, baked, &config)?;
+    player.set_subpixel_offset(check.subpixel_offset);
     for w in player.player().warnings() {
         eprintln!("trisort: warning: {w}");
     }
@@ -320,6 +326,7 @@ fn image_check(
         samples: a.samples.unwrap_or(settings.samples.max(1)),
         max_error: a.max_error,
         captured: a.frames_dir.is_some() || a.device.options() != GpuOptions::default(),
+        subpixel_offset: a.subpixel_offset.unwrap_or([0.0, 0.0]),
         ..ImageCheck::recorded(baked, a.mode)
     };
     if check.samples != 1 && check.samples != 4 {
@@ -398,6 +405,7 @@ fn json_report(
         out["at_recorded_pattern"] = json!(report.at_recorded_pattern);
         out["max_error"] = json!(check.max_error);
         out["captured"] = json!(check.captured);
+        out["subpixel_offset"] = json!(check.subpixel_offset);
         out["unordered_from_recording"] = json!(graph.is_some());
     }
     out
