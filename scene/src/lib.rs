@@ -203,7 +203,7 @@ pub mod gltf_import;
 pub use demo_car::{demo_car, DEFAULT_TRIANGLES, DOOR_NODE, DOOR_WINDOW_NODE};
 pub use error::SceneError;
 pub use export::{export_glb, ExportError};
-pub use gltf_import::{load, load_slice};
+pub use gltf_import::{load, load_slice, load_with_sources, TriangleSource};
 
 #[cfg(test)]
 mod tests {

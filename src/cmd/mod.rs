@@ -3,6 +3,7 @@
 mod bake;
 mod bench;
 mod demo;
+mod export_order;
 mod inspect;
 pub mod merge;
 mod play;
@@ -46,6 +47,8 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Bake and play the built-in procedural car and print its figures.
     Demo(demo::DemoArgs),
+    /// Write the order-only export of a baked file: each sorted triangle's glTF source.
+    ExportOrder(export_order::ExportOrderArgs),
 }
 
 /// Recording options shared by `record` and `bake`.
@@ -120,5 +123,6 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Verify(a) => verify::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::ExportOrder(a) => export_order::run(a),
     }
 }

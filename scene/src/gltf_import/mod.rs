@@ -90,6 +90,42 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 /// scene (its stem) and the errors, and its folder resolves relative URIs. Same semantics as
 /// [`load`].
 pub fn load_slice(bytes: &[u8], file: &Path) -> Result<Scene, SceneError> {
+    load_slice_with_sources(bytes, file).map(|(scene, _)| scene)
+}
+
+/// Where an imported triangle comes from in the glTF file: the triangle of
+/// [`Geometry::triangles`] with the same index is triangle `triangle` of primitive
+/// `primitive` of mesh `mesh`, instanced by node `node`. All four are indices of the file
+/// (`node` is the file's node index, not the reordered [`Geometry::nodes`] index); `triangle`
+/// counts the primitive's triangles in index order (for strips and fans, in the order the
+/// glTF specification derives them), before any winding flip.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TriangleSource {
+    /// Mesh index in the file.
+    pub mesh: u32,
+    /// Primitive index within the mesh.
+    pub primitive: u32,
+    /// Triangle index within the primitive.
+    pub triangle: u32,
+    /// Node index in the file (the mesh instance).
+    pub node: u32,
+}
+
+/// [`load`], and the source of every triangle of the scene's geometry (same length as
+/// [`Geometry::triangles`], same order).
+pub fn load_with_sources(path: &Path) -> Result<(Scene, Vec<TriangleSource>), SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    load_slice_with_sources(&bytes, path)
+}
+
+/// [`load_slice`], and the source of every triangle (see [`load_with_sources`]).
+pub fn load_slice_with_sources(
+    bytes: &[u8],
+    file: &Path,
+) -> Result<(Scene, Vec<TriangleSource>), SceneError> {
     let (doc, bin) = container::parse(bytes, file)?;
     let mut importer = Importer {
         file: file.to_path_buf(),
@@ -97,6 +133,7 @@ pub fn load_slice(bytes: &[u8], file: &Path) -> Result<Scene, SceneError> {
         doc: &doc,
         buffers: Vec::new(),
         notes: Vec::new(),
+        sources: Vec::new(),
     };
     importer.load_buffers(bin)?;
     importer.run()
@@ -129,6 +166,8 @@ struct Importer<'d> {
     buffers: Vec<Vec<u8>>,
     /// Warnings and notes for [`Scene::notes`].
     notes: Vec<String>,
+    /// Per imported triangle, where it comes from.
+    sources: Vec<TriangleSource>,
 }
 
 impl<'d> Importer<'d> {
@@ -142,7 +181,7 @@ impl<'d> Importer<'d> {
     /// Imports the document in this order, which is also the order of its errors and notes:
     /// nodes, materials (with their images), the geometry of the scene, animations, cameras,
     /// ignored extensions.
-    fn run(mut self) -> Result<Scene, SceneError> {
+    fn run(mut self) -> Result<(Scene, Vec<TriangleSource>), SceneError> {
         let file_nodes: Vec<gltf::Node> = self.doc.nodes().collect();
         let (tree, nodes) = self.node_tree(&file_nodes)?;
         let materials = self.materials()?;
@@ -164,7 +203,8 @@ impl<'d> Importer<'d> {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        Ok(Scene {
+        debug_assert_eq!(self.sources.len(), geometry.triangles.len());
+        let scene = Scene {
             name,
             geometry,
             animations,
@@ -172,7 +212,8 @@ impl<'d> Importer<'d> {
             stats,
             notes: self.notes,
             hash_cache: Default::default(),
-        })
+        };
+        Ok((scene, self.sources))
     }
 }
 

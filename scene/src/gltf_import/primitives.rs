@@ -74,6 +74,15 @@ impl Importer<'_> {
                     continue;
                 };
                 zero_area_triangles += data.zero_area;
+                self.sources
+                    .extend((0..data.triangles.len() as u32).map(|triangle| {
+                        super::TriangleSource {
+                            mesh: mesh.index() as u32,
+                            primitive: prim.index() as u32,
+                            triangle,
+                            node: n as u32,
+                        }
+                    }));
                 instance(&mut geometry, data, new_node, flip).map_err(|problem| {
                     SceneError::Unsupported {
                         file: self.file.clone(),

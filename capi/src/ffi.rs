@@ -1,0 +1,960 @@
+//! The `extern "C"` functions of `include/trisort.h`.
+//!
+//! Conventions (also in the header):
+//! - Every function returns a [`TrisortStatus`] (except [`trisort_abi_version`],
+//!   [`trisort_last_error`] and the `close` functions). On failure, [`trisort_last_error`]
+//!   copies a message naming the file and the problem (per thread, until the next call).
+//! - No panic crosses the boundary: each entry point runs under `catch_unwind` and reports one
+//!   as [`TrisortStatus::Panic`].
+//! - Handles are opened and closed by the library (`trisort_open_*` / `trisort_close`). The
+//!   host never frees library memory: arrays are copied into host buffers. Each copy function
+//!   takes `out`, its capacity `cap` in elements and `len`: it stores the element count in
+//!   `*len` (when `len` is not null); with `out` null it only reports it, with `cap` too small
+//!   it returns [`TrisortStatus::BufferTooSmall`] and copies nothing.
+//! - Matrices are 16 floats, column major.
+
+use std::cell::RefCell;
+use std::ffi::{c_char, CStr};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+
+use glam::DMat4;
+use trisort_format::{container, AlphaMode, Baked, FileKind};
+
+use crate::order::{Order, OrderRange, OrderSource};
+
+/// The ABI version of this library: bumped whenever a function, a struct or an enum of the
+/// header changes incompatibly. Hosts compare [`trisort_abi_version`] with the header's
+/// `TRISORT_ABI_VERSION`.
+pub const TRISORT_ABI_VERSION: u32 = 1;
+
+/// The result of a call.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrisortStatus {
+    /// Success.
+    Ok = 0,
+    /// A required pointer argument was null.
+    NullArgument = 1,
+    /// A file could not be read or written.
+    Io = 2,
+    /// A file is not a valid trisort file of a supported version.
+    Format = 3,
+    /// A frame, texture or other index is out of range.
+    OutOfRange = 4,
+    /// The caller's buffer is smaller than the data (see `len`).
+    BufferTooSmall = 5,
+    /// The request cannot be met for this file (e.g. u16 indices for more than 65,536
+    /// vertices, or a scene that is not the baked file's).
+    Unsupported = 6,
+    /// An internal error (a panic, caught): please report it.
+    Panic = 7,
+}
+
+/// A baked file opened by [`trisort_open_path`] or [`trisort_open_bytes`].
+pub struct TrisortBaked {
+    baked: Baked,
+}
+
+/// An ORDER file opened by [`trisort_order_open_path`] or [`trisort_order_open_bytes`].
+pub struct TrisortOrder {
+    order: Order,
+}
+
+/// Figures of a baked file.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TrisortInfo {
+    /// Frames.
+    pub frame_count: u32,
+    /// Recorded image width (the bake is exact at this size and sample count).
+    pub width: u32,
+    /// Recorded image height.
+    pub height: u32,
+    /// Recorded MSAA sample count (1 or 4).
+    pub samples: u32,
+    /// Vertices of G.
+    pub vertex_count: u32,
+    /// Triangles of G (the vertex streams' triangles).
+    pub triangle_count: u32,
+    /// Triangles of the sorted index buffer (3 indices each).
+    pub index_triangle_count: u32,
+    /// Draw ranges over all frames.
+    pub draw_count: u32,
+    /// Nodes.
+    pub node_count: u32,
+    /// Materials.
+    pub material_count: u32,
+    /// Textures.
+    pub texture_count: u32,
+    /// Opacity transmissive (glass) materials are drawn with.
+    pub glass_opacity: f32,
+    /// Whether u16 indices suffice (at most 65,536 vertices).
+    pub fits_u16: bool,
+    /// Whether the file plays only with the depth test ([`TrisortMode::Depth`]).
+    pub depth_only: bool,
+    /// Whether intersecting triangles were split before recording.
+    pub split_intersections: bool,
+    /// The mode the file plays best in: [`TrisortMode::Depth`] when `depth_only`, else
+    /// [`TrisortMode::Blend`].
+    pub recommended_mode: TrisortMode,
+}
+
+/// How frames are drawn (the player's `--mode`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TrisortMode {
+    /// Back to front (reversed order), straight-alpha *over*, no depth test.
+    #[default]
+    Blend = 0,
+    /// Front to back, depth test `LESS` with depth writes, *over*.
+    Depth = 1,
+    /// Front to back, premultiplied *under* on a target cleared to alpha 0, no depth test.
+    Saturate = 2,
+}
+
+/// One draw: `count` indices starting at index `first` of the index buffer (for
+/// `glDrawElements(GL_TRIANGLES, count, type, first * index_size)`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TrisortRange {
+    /// First index.
+    pub first: u32,
+    /// Number of indices (a multiple of 3).
+    pub count: u32,
+}
+
+/// One indexed indirect draw, laid out as Vulkan's `VkDrawIndexedIndirectCommand` and
+/// OpenGL's `DrawElementsIndirectCommand` read it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TrisortDrawIndexedIndirectArgs {
+    /// Number of indices.
+    pub index_count: u32,
+    /// Number of instances (1).
+    pub instance_count: u32,
+    /// First index.
+    pub first_index: u32,
+    /// Added to each index (0).
+    pub base_vertex: i32,
+    /// First instance (0).
+    pub first_instance: u32,
+}
+
+/// One vertex of G, 40 bytes, as trisort's own pipelines read it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TrisortVertex {
+    /// Position in the local space of `node`.
+    pub position: [f32; 3],
+    /// Unit normal in the local space of `node` (zero when unknown).
+    pub normal: [f32; 3],
+    /// Base-colour texture coordinate.
+    pub uv: [f32; 2],
+    /// Material index.
+    pub material: u32,
+    /// Node index: the node matrix that moves this vertex.
+    pub node: u32,
+}
+
+/// A material (the subset trisort draws).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TrisortMaterial {
+    /// Linear RGBA base colour factor.
+    pub base_color: [f32; 4],
+    /// Linear RGB emissive colour.
+    pub emissive: [f32; 3],
+    /// Alpha cutoff (for [`TrisortAlphaMode::Mask`]).
+    pub alpha_cutoff: f32,
+    /// `KHR_materials_transmission` factor; > 0 marks glass, drawn at the info's
+    /// `glass_opacity`.
+    pub transmission: f32,
+    /// Base-colour texture index, or -1 for none.
+    pub base_color_texture: i32,
+    /// Alpha mode.
+    pub alpha_mode: TrisortAlphaMode,
+    /// Whether back faces are drawn (single-sided materials discard them).
+    pub double_sided: bool,
+}
+
+/// glTF alpha mode.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TrisortAlphaMode {
+    /// Opaque: alpha 1.
+    #[default]
+    Opaque = 0,
+    /// Cut out below the cutoff, else opaque.
+    Mask = 1,
+    /// Blended with its base-colour alpha.
+    Blend = 2,
+}
+
+/// Clip-space depth convention of a projection matrix.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrisortDepthRange {
+    /// Depth in [0, 1] (Vulkan, Direct3D, Metal, WebGPU: what trisort renders with).
+    ZeroToOne = 0,
+    /// Depth in [-1, 1] (OpenGL and OpenGL ES defaults).
+    MinusOneToOne = 1,
+}
+
+/// Figures of an ORDER file.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TrisortOrderInfo {
+    /// Frames.
+    pub frame_count: u32,
+    /// Ranges over all frames.
+    pub range_count: u32,
+    /// Index-buffer triangles.
+    pub triangle_count: u32,
+    /// Whether the bake split intersecting triangles (several consecutive entries can then
+    /// name one source triangle: see docs/FORMAT.md § ORDER).
+    pub split: bool,
+}
+
+/// What went wrong, for the status code and the thread's last error.
+struct Failure(TrisortStatus, String);
+
+impl From<trisort_format::FormatError> for Failure {
+    fn from(e: trisort_format::FormatError) -> Self {
+        let status = match e {
+            trisort_format::FormatError::Io { .. } => TrisortStatus::Io,
+            _ => TrisortStatus::Format,
+        };
+        Failure(status, e.to_string())
+    }
+}
+
+impl From<crate::OrderError> for Failure {
+    fn from(e: crate::OrderError) -> Self {
+        use crate::OrderError as E;
+        let status = match &e {
+            E::Io { .. } | E::Format(trisort_format::FormatError::Io { .. }) => TrisortStatus::Io,
+            E::Malformed { .. } | E::Format(_) | E::Scene(_) => TrisortStatus::Format,
+            E::WrongScene { .. } => TrisortStatus::Unsupported,
+        };
+        Failure(status, e.to_string())
+    }
+}
+
+thread_local! {
+    static LAST_ERROR: RefCell<String> = const { RefCell::new(String::new()) };
+}
+
+fn set_error(message: String) {
+    LAST_ERROR.with(|e| *e.borrow_mut() = message);
+}
+
+/// Runs `f` with panics caught, recording its failure as the thread's last error.
+fn guard(f: impl FnOnce() -> Result<(), Failure>) -> TrisortStatus {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(Ok(())) => {
+            set_error(String::new());
+            TrisortStatus::Ok
+        }
+        Ok(Err(Failure(status, message))) => {
+            set_error(message);
+            status
+        }
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            set_error(format!("trisort: internal error (panic): {what}"));
+            TrisortStatus::Panic
+        }
+    }
+}
+
+fn null(what: &str) -> Failure {
+    Failure(TrisortStatus::NullArgument, format!("{what} is null"))
+}
+
+/// `*ptr` as a reference, or a null-argument failure.
+///
+/// # Safety
+/// `ptr` is null or valid for reads for the call.
+unsafe fn handle<'a, T>(ptr: *const T, what: &str) -> Result<&'a T, Failure> {
+    ptr.as_ref().ok_or_else(|| null(what))
+}
+
+/// A C string as a path.
+///
+/// # Safety
+/// `s` is null or a NUL-terminated string.
+unsafe fn c_path(s: *const c_char, what: &str) -> Result<PathBuf, Failure> {
+    if s.is_null() {
+        return Err(null(what));
+    }
+    let s = CStr::from_ptr(s).to_str().map_err(|_| {
+        Failure(
+            TrisortStatus::Unsupported,
+            format!("{what} is not valid UTF-8"),
+        )
+    })?;
+    Ok(PathBuf::from(s))
+}
+
+/// Copies `src` to the host's buffer under the conventions of the module documentation.
+///
+/// # Safety
+/// `out` is null or valid for `cap` writes of `T`; `len` is null or valid for one write.
+unsafe fn copy_out<T: Copy>(
+    src: &[T],
+    out: *mut T,
+    cap: usize,
+    len: *mut usize,
+) -> Result<(), Failure> {
+    if !len.is_null() {
+        *len = src.len();
+    }
+    if out.is_null() {
+        if len.is_null() {
+            return Err(null("both out and len are"));
+        }
+        return Ok(());
+    }
+    if cap < src.len() {
+        return Err(Failure(
+            TrisortStatus::BufferTooSmall,
+            format!("buffer holds {cap} elements, {} needed", src.len()),
+        ));
+    }
+    std::ptr::copy_nonoverlapping(src.as_ptr(), out, src.len());
+    Ok(())
+}
+
+/// Stores `value` in `*out`.
+///
+/// # Safety
+/// `out` is null or valid for one write.
+unsafe fn store<T>(out: *mut T, value: T, what: &str) -> Result<(), Failure> {
+    if out.is_null() {
+        return Err(null(what));
+    }
+    out.write(value);
+    Ok(())
+}
+
+fn frame_index(baked: &Baked, frame: u32) -> Result<usize, Failure> {
+    if (frame as usize) < baked.frames.len() {
+        Ok(frame as usize)
+    } else {
+        Err(Failure(
+            TrisortStatus::OutOfRange,
+            format!(
+                "frame {frame} is out of range ({} frames)",
+                baked.frames.len()
+            ),
+        ))
+    }
+}
+
+fn open_baked(bytes: &[u8], path: &Path) -> Result<Box<TrisortBaked>, Failure> {
+    let baked: Baked = container::decode(FileKind::Baked, bytes, path)?;
+    baked.check_structure().map_err(|problem| {
+        Failure(
+            TrisortStatus::Format,
+            format!("{}: inconsistent baked file: {problem}", path.display()),
+        )
+    })?;
+    Ok(Box::new(TrisortBaked { baked }))
+}
+
+/// The library's ABI version ([`TRISORT_ABI_VERSION`] of the library actually linked).
+#[no_mangle]
+pub extern "C" fn trisort_abi_version() -> u32 {
+    TRISORT_ABI_VERSION
+}
+
+/// Copies the calling thread's last error message (UTF-8, empty after a success) into `buf`,
+/// truncated to `cap - 1` bytes and NUL-terminated (nothing is written when `buf` is null or
+/// `cap` is 0). Returns the message's full length in bytes, without the NUL.
+///
+/// # Safety
+/// `buf` is null or valid for `cap` byte writes.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_last_error(buf: *mut c_char, cap: usize) -> usize {
+    catch_unwind(|| {
+        LAST_ERROR.with(|e| {
+            let e = e.borrow();
+            if !buf.is_null() && cap > 0 {
+                let n = e.len().min(cap - 1);
+                std::ptr::copy_nonoverlapping(e.as_ptr(), buf.cast::<u8>(), n);
+                *buf.add(n) = 0;
+            }
+            e.len()
+        })
+    })
+    .unwrap_or(0)
+}
+
+/// Opens the baked file at `path` (NUL-terminated UTF-8) and stores its handle in `*out`.
+/// The file is read, checked (magic, version, checksum, structure) and kept in memory.
+///
+/// # Safety
+/// `path` is a NUL-terminated string; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_open_path(
+    path: *const c_char,
+    out: *mut *mut TrisortBaked,
+) -> TrisortStatus {
+    guard(|| {
+        let path = c_path(path, "path")?;
+        let bytes = std::fs::read(&path).map_err(|source| {
+            Failure(TrisortStatus::Io, format!("{}: {source}", path.display()))
+        })?;
+        let h = open_baked(&bytes, &path)?;
+        store(out, Box::into_raw(h), "out")
+    })
+}
+
+/// Opens a baked file from `len` bytes at `data` (copied; the host may free them after the
+/// call) and stores its handle in `*out`.
+///
+/// # Safety
+/// `data` is valid for `len` byte reads; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_open_bytes(
+    data: *const u8,
+    len: usize,
+    out: *mut *mut TrisortBaked,
+) -> TrisortStatus {
+    guard(|| {
+        if data.is_null() {
+            return Err(null("data"));
+        }
+        let bytes = std::slice::from_raw_parts(data, len);
+        let h = open_baked(bytes, Path::new("<bytes>"))?;
+        store(out, Box::into_raw(h), "out")
+    })
+}
+
+/// Closes a handle from `trisort_open_*` (null is ignored). The handle is invalid afterwards.
+///
+/// # Safety
+/// `h` is null or a handle not closed before.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_close(h: *mut TrisortBaked) {
+    if !h.is_null() {
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(h))));
+    }
+}
+
+/// Stores the file's figures in `*out`.
+///
+/// # Safety
+/// `h` is an open handle; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_info(
+    h: *const TrisortBaked,
+    out: *mut TrisortInfo,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let g = &b.geometry;
+        let info = TrisortInfo {
+            frame_count: b.frames.len() as u32,
+            width: b.settings.width,
+            height: b.settings.height,
+            samples: b.settings.samples,
+            vertex_count: g.vertices.len() as u32,
+            triangle_count: g.triangles.len() as u32,
+            index_triangle_count: b.copies.len() as u32,
+            draw_count: b.draws.len() as u32,
+            node_count: g.nodes.len() as u32,
+            material_count: g.materials.len() as u32,
+            texture_count: g.textures.len() as u32,
+            glass_opacity: b.settings.glass_opacity,
+            fits_u16: b.fits_u16(),
+            depth_only: b.merge.depth_only,
+            split_intersections: b.settings.split_intersections,
+            recommended_mode: if b.merge.depth_only {
+                TrisortMode::Depth
+            } else {
+                TrisortMode::Blend
+            },
+        };
+        store(out, info, "out")
+    })
+}
+
+/// The index buffer's triangles (G-local triangle ids) in front-to-back order, or reversed.
+fn ordered_copies(b: &Baked, back_to_front: bool) -> Vec<u32> {
+    let mut copies = b.copies.clone();
+    if back_to_front {
+        copies.reverse();
+    }
+    copies
+}
+
+/// Copies the sorted index buffer as u32 indices into the vertex streams: front to back, or
+/// reversed (`back_to_front`, what [`TrisortMode::Blend`] draws; use the same flag for the
+/// frame ranges). `len` counts indices.
+///
+/// # Safety
+/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_indices_u32(
+    h: *const TrisortBaked,
+    back_to_front: bool,
+    out: *mut u32,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let idx: Vec<u32> = ordered_copies(b, back_to_front)
+            .iter()
+            .flat_map(|&c| b.geometry.triangles[c as usize])
+            .collect();
+        copy_out(&idx, out, cap, len)
+    })
+}
+
+/// [`trisort_indices_u32`] as u16 indices; [`TrisortStatus::Unsupported`] when the file has
+/// more than 65,536 vertices (see the info's `fits_u16`).
+///
+/// # Safety
+/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_indices_u16(
+    h: *const TrisortBaked,
+    back_to_front: bool,
+    out: *mut u16,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        if !b.fits_u16() {
+            return Err(Failure(
+                TrisortStatus::Unsupported,
+                format!(
+                    "{} vertices do not fit u16 indices: use trisort_indices_u32",
+                    b.geometry.vertices.len()
+                ),
+            ));
+        }
+        let idx: Vec<u16> = ordered_copies(b, back_to_front)
+            .iter()
+            .flat_map(|&c| b.geometry.triangles[c as usize].map(|v| v as u16))
+            .collect();
+        copy_out(&idx, out, cap, len)
+    })
+}
+
+/// Frame `frame`'s draws in drawing order over the index buffer of the same `back_to_front`.
+fn frame_ranges(b: &Baked, frame: usize, back_to_front: bool) -> Vec<TrisortRange> {
+    let n = b.copies.len() as u32 * 3;
+    let mut out: Vec<TrisortRange> = b
+        .frame_draws(frame)
+        .iter()
+        .map(|d| TrisortRange {
+            first: if back_to_front {
+                n - d.first_index - d.index_count
+            } else {
+                d.first_index
+            },
+            count: d.index_count,
+        })
+        .collect();
+    if back_to_front {
+        out.reverse();
+    }
+    out
+}
+
+/// Copies frame `frame`'s draw ranges, in drawing order, over the index buffer of the same
+/// `back_to_front` ([`trisort_indices_u32`]). `len` counts ranges.
+///
+/// # Safety
+/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_frame_ranges(
+    h: *const TrisortBaked,
+    frame: u32,
+    back_to_front: bool,
+    out: *mut TrisortRange,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let f = frame_index(b, frame)?;
+        copy_out(&frame_ranges(b, f, back_to_front), out, cap, len)
+    })
+}
+
+/// Copies frame `frame`'s draws as indirect-draw arguments (the same draws as
+/// [`trisort_frame_ranges`], ready for `glMultiDrawElementsIndirect`/`vkCmdDrawIndexedIndirect`).
+///
+/// # Safety
+/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_frame_draws(
+    h: *const TrisortBaked,
+    frame: u32,
+    back_to_front: bool,
+    out: *mut TrisortDrawIndexedIndirectArgs,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let f = frame_index(b, frame)?;
+        let draws: Vec<TrisortDrawIndexedIndirectArgs> = frame_ranges(b, f, back_to_front)
+            .iter()
+            .map(|r| TrisortDrawIndexedIndirectArgs {
+                index_count: r.count,
+                instance_count: 1,
+                first_index: r.first,
+                base_vertex: 0,
+                first_instance: 0,
+            })
+            .collect();
+        copy_out(&draws, out, cap, len)
+    })
+}
+
+/// Copies the vertex streams of G, interleaved (40 bytes per vertex).
+///
+/// # Safety
+/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_vertices(
+    h: *const TrisortBaked,
+    out: *mut TrisortVertex,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let v: Vec<TrisortVertex> = b
+            .geometry
+            .vertices
+            .iter()
+            .map(|v| TrisortVertex {
+                position: v.position,
+                normal: v.normal,
+                uv: v.uv,
+                material: v.material,
+                node: v.node,
+            })
+            .collect();
+        copy_out(&v, out, cap, len)
+    })
+}
+
+fn write_matrix(m: DMat4, out: *mut f32) -> Result<(), Failure> {
+    if out.is_null() {
+        return Err(null("out"));
+    }
+    let cols = m.as_mat4().to_cols_array();
+    // SAFETY: the caller promised 16 writable floats.
+    unsafe { std::ptr::copy_nonoverlapping(cols.as_ptr(), out, 16) };
+    Ok(())
+}
+
+/// Writes frame `frame`'s camera view matrix (world to view; right handed, looking down −Z)
+/// to `out[0..16]`.
+///
+/// # Safety
+/// `h` is an open handle; `out` is valid for 16 float writes.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_frame_view(
+    h: *const TrisortBaked,
+    frame: u32,
+    out: *mut f32,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let f = frame_index(b, frame)?;
+        write_matrix(b.frame_states[f].camera.view_matrix(), out)
+    })
+}
+
+/// Writes frame `frame`'s projection matrix for an image of `aspect` (width / height) in the
+/// clip-depth convention `depth` to `out[0..16]`. Built in f64 and rounded once, as trisort's
+/// own pipelines do.
+///
+/// # Safety
+/// `h` is an open handle; `out` is valid for 16 float writes.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_frame_projection(
+    h: *const TrisortBaked,
+    frame: u32,
+    aspect: f64,
+    depth: TrisortDepthRange,
+    out: *mut f32,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let f = frame_index(b, frame)?;
+        if !(aspect.is_finite() && aspect > 0.0) {
+            return Err(Failure(
+                TrisortStatus::OutOfRange,
+                format!("aspect {aspect} is not a positive number"),
+            ));
+        }
+        let p = b.frame_states[f].camera.projection(aspect);
+        let p = match depth {
+            TrisortDepthRange::ZeroToOne => p,
+            // z' = 2z − w maps [0, w] onto [−w, w].
+            TrisortDepthRange::MinusOneToOne => {
+                DMat4::from_cols_array(&[
+                    1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, -1.0, 1.0,
+                ]) * p
+            }
+        };
+        write_matrix(p, out)
+    })
+}
+
+/// Copies frame `frame`'s node matrices, 16 floats per node: with `view_relative` the
+/// camera-relative view × world matrices trisort's pipelines use (computed in f64, rounded
+/// once: precise far from the origin), else the world matrices. `cap` and `len` count floats.
+///
+/// # Safety
+/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_frame_node_matrices(
+    h: *const TrisortBaked,
+    frame: u32,
+    view_relative: bool,
+    out: *mut f32,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let f = frame_index(b, frame)?;
+        let state = &b.frame_states[f];
+        let view = if view_relative {
+            state.camera.view_matrix()
+        } else {
+            DMat4::IDENTITY
+        };
+        let floats: Vec<f32> = trisort_format::world_transforms(&b.geometry.nodes, &state.poses)
+            .into_iter()
+            .flat_map(|w| (view * w).as_mat4().to_cols_array())
+            .collect();
+        copy_out(&floats, out, cap, len)
+    })
+}
+
+/// Copies the materials.
+///
+/// # Safety
+/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_materials(
+    h: *const TrisortBaked,
+    out: *mut TrisortMaterial,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let m: Vec<TrisortMaterial> = b
+            .geometry
+            .materials
+            .iter()
+            .map(|m| TrisortMaterial {
+                base_color: m.base_color,
+                emissive: m.emissive,
+                alpha_cutoff: m.alpha_cutoff,
+                transmission: m.transmission,
+                base_color_texture: m.base_color_texture.map_or(-1, |t| t as i32),
+                alpha_mode: match m.alpha_mode {
+                    AlphaMode::Opaque => TrisortAlphaMode::Opaque,
+                    AlphaMode::Mask => TrisortAlphaMode::Mask,
+                    AlphaMode::Blend => TrisortAlphaMode::Blend,
+                },
+                double_sided: m.double_sided,
+            })
+            .collect();
+        copy_out(&m, out, cap, len)
+    })
+}
+
+/// Stores texture `texture`'s size in `*width` and `*height` (either may be null) and copies
+/// its texels (RGBA8, sRGB, rows top to bottom; `cap` and `len` count bytes).
+///
+/// # Safety
+/// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
+/// `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_texture(
+    h: *const TrisortBaked,
+    texture: u32,
+    width: *mut u32,
+    height: *mut u32,
+    out: *mut u8,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        let t = b.geometry.textures.get(texture as usize).ok_or_else(|| {
+            Failure(
+                TrisortStatus::OutOfRange,
+                format!(
+                    "texture {texture} is out of range ({} textures)",
+                    b.geometry.textures.len()
+                ),
+            )
+        })?;
+        if !width.is_null() {
+            *width = t.width;
+        }
+        if !height.is_null() {
+            *height = t.height;
+        }
+        copy_out(&t.rgba8, out, cap, len)
+    })
+}
+
+/// Builds the order-only export of the baked file at `baked_path`, whose scene is the glTF
+/// file `scene_path`, and writes it to `out_path` (atomically). The same as
+/// `trisort export-order BAKED --scene SCENE -o OUT`.
+///
+/// # Safety
+/// The three paths are NUL-terminated strings.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_export_order(
+    baked_path: *const c_char,
+    scene_path: *const c_char,
+    out_path: *const c_char,
+) -> TrisortStatus {
+    guard(|| {
+        let baked_path = c_path(baked_path, "baked_path")?;
+        let scene_path = c_path(scene_path, "scene_path")?;
+        let out_path = c_path(out_path, "out_path")?;
+        let baked: Baked = trisort_format::read_file(FileKind::Baked, &baked_path)?;
+        let order = Order::from_baked(&baked, &baked_path, &scene_path)?;
+        order.write(&out_path)?;
+        Ok(())
+    })
+}
+
+fn open_order(bytes: &[u8], path: &Path) -> Result<*mut TrisortOrder, Failure> {
+    let order = Order::decode(bytes, path)?;
+    Ok(Box::into_raw(Box::new(TrisortOrder { order })))
+}
+
+/// Opens the ORDER file at `path` and stores its handle in `*out`.
+///
+/// # Safety
+/// `path` is a NUL-terminated string; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_order_open_path(
+    path: *const c_char,
+    out: *mut *mut TrisortOrder,
+) -> TrisortStatus {
+    guard(|| {
+        let path = c_path(path, "path")?;
+        let bytes = std::fs::read(&path).map_err(|source| {
+            Failure(TrisortStatus::Io, format!("{}: {source}", path.display()))
+        })?;
+        store(out, open_order(&bytes, &path)?, "out")
+    })
+}
+
+/// Opens an ORDER file from `len` bytes at `data` (copied) and stores its handle in `*out`.
+///
+/// # Safety
+/// `data` is valid for `len` byte reads; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_order_open_bytes(
+    data: *const u8,
+    len: usize,
+    out: *mut *mut TrisortOrder,
+) -> TrisortStatus {
+    guard(|| {
+        if data.is_null() {
+            return Err(null("data"));
+        }
+        let bytes = std::slice::from_raw_parts(data, len);
+        store(out, open_order(bytes, Path::new("<bytes>"))?, "out")
+    })
+}
+
+/// Closes a handle from `trisort_order_open_*` (null is ignored).
+///
+/// # Safety
+/// `h` is null or a handle not closed before.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_order_close(h: *mut TrisortOrder) {
+    if !h.is_null() {
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(h))));
+    }
+}
+
+/// Stores the ORDER file's figures in `*out`.
+///
+/// # Safety
+/// `h` is an open order handle; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_order_info(
+    h: *const TrisortOrder,
+    out: *mut TrisortOrderInfo,
+) -> TrisortStatus {
+    guard(|| {
+        let o = &handle(h, "handle")?.order;
+        let info = TrisortOrderInfo {
+            frame_count: o.frames.len() as u32,
+            range_count: o.ranges.len() as u32,
+            triangle_count: o.triangles.len() as u32,
+            split: o.split,
+        };
+        store(out, info, "out")
+    })
+}
+
+/// Copies frame `frame`'s ranges (first triangle, triangle count), front to back.
+///
+/// # Safety
+/// `h` is an open order handle; `out`, `cap`, `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_order_frame_ranges(
+    h: *const TrisortOrder,
+    frame: u32,
+    out: *mut OrderRange,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let o = &handle(h, "handle")?.order;
+        if frame as usize >= o.frames.len() {
+            return Err(Failure(
+                TrisortStatus::OutOfRange,
+                format!("frame {frame} is out of range ({} frames)", o.frames.len()),
+            ));
+        }
+        copy_out(o.frame_ranges(frame as usize), out, cap, len)
+    })
+}
+
+/// Copies every index-buffer triangle's source, front to back.
+///
+/// # Safety
+/// `h` is an open order handle; `out`, `cap`, `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_order_triangles(
+    h: *const TrisortOrder,
+    out: *mut OrderSource,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let o = &handle(h, "handle")?.order;
+        copy_out(&o.triangles, out, cap, len)
+    })
+}

@@ -1,0 +1,4 @@
+//! trisort-capi's tests: one binary, a module per subject.
+
+mod api;
+mod header;

@@ -1,0 +1,114 @@
+//! docs/FORMAT.md's independent reader (docs/format_reader.py, Python, written from the
+//! specification alone) parses a fresh bake and an ORDER file; its counts must equal
+//! `inspect --json`'s and `export-order --json`'s.
+
+use std::path::Path;
+use std::process::Command;
+
+use crate::support::{args, gpu_tempdir, run, run_json, scene};
+
+/// A Python 3 with the `zstandard` module (Debian's python3-zstandard lives under
+/// /usr/bin/python3), or `None` to skip; CI (scripts/ensure-c-host.sh installs it) requires one.
+fn python() -> Option<&'static str> {
+    let found = ["python3", "/usr/bin/python3"].into_iter().find(|p| {
+        Command::new(p)
+            .args(["-c", "import zstandard"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "no python3 with zstandard: run scripts/ensure-c-host.sh"
+        );
+        eprintln!("skipping: no python3 with the zstandard module");
+    }
+    found
+}
+
+fn read(python: &str, file: &Path) -> serde_json::Value {
+    let reader = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/format_reader.py");
+    let out = Command::new(python).arg(reader).arg(file).output().unwrap();
+    assert!(
+        out.status.success(),
+        "format_reader.py {} failed:\n{}",
+        file.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
+    let Some(python) = python() else { return };
+    let Some(dir) = gpu_tempdir() else { return };
+    let d = dir.path();
+    run(
+        d,
+        &args("bake demo:10000 --path orbit:frames=5,degrees=90 --size 64x64 --samples 4 -o car.baked"),
+        true,
+    );
+    let ours = read(python, &d.join("car.baked"));
+    let inspect = run_json(d, &["inspect", "car.baked"]);
+    for key in [
+        "frames",
+        "index_triangles",
+        "unique_visible",
+        "draws_per_frame_max",
+        "unordered_samples",
+        "strategy",
+        "layout",
+        "split_intersections",
+    ] {
+        assert_eq!(ours[key], inspect[key], "{key}");
+    }
+    assert_eq!(ours["stats_index_triangles"], inspect["index_triangles"]);
+    assert_eq!(ours["triangles"], ours["unique_visible"]);
+    assert_eq!(ours["textures"], 1, "the demo car's licence plate");
+    assert_eq!(
+        (ours["width"].as_u64(), ours["samples"].as_u64()),
+        (Some(64), Some(4))
+    );
+
+    // A damaged file is refused with the file named, not misread.
+    let mut bytes = std::fs::read(d.join("car.baked")).unwrap();
+    bytes.truncate(bytes.len() - 1);
+    std::fs::write(d.join("cut.baked"), &bytes).unwrap();
+    let reader = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/format_reader.py");
+    let out = Command::new(python)
+        .arg(&reader)
+        .arg(d.join("cut.baked"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cut.baked"));
+}
+
+#[test]
+fn the_independent_reader_parses_an_order_file() {
+    let Some(python) = python() else { return };
+    let Some(truck) = scene("CesiumMilkTruck") else {
+        return;
+    };
+    let Some(dir) = gpu_tempdir() else { return };
+    let d = dir.path();
+    let mut bake =
+        args("bake --path gltf --fps 4 --size 48x48 --samples 1 --keep-intersections -o t.baked");
+    bake.insert(1, &truck);
+    run(d, &bake, true);
+    let v = run_json(
+        d,
+        &[
+            "export-order",
+            "t.baked",
+            "--scene",
+            &truck,
+            "-o",
+            "t.order",
+        ],
+    );
+    let ours = read(python, &d.join("t.order"));
+    for key in ["frames", "ranges", "triangles", "split"] {
+        assert_eq!(ours[key], v[key], "{key}");
+    }
+}
