@@ -131,6 +131,15 @@ pub struct FrameRange {
     end: Option<u32>,
 }
 
+impl From<Range<u32>> for FrameRange {
+    fn from(r: Range<u32>) -> FrameRange {
+        FrameRange {
+            start: Some(r.start),
+            end: Some(r.end),
+        }
+    }
+}
+
 impl FrameRange {
     /// The concrete range for a path of `n` frames; an error if it is empty or past the end.
     pub fn resolve(&self, n: u32) -> Result<Range<u32>> {

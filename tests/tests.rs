@@ -18,6 +18,7 @@ mod long_paths;
 mod merge_car;
 mod record_cli;
 mod self_check_cli;
+mod shard_cli;
 mod verify_cli;
 mod verify_forged;
 mod verify_images;

@@ -62,73 +62,32 @@ pub(crate) struct Input<'a> {
     pub frames: u32,
 }
 
-/// Checks that the recordings are contiguous frame ranges of one scene, path and setting,
-/// all with graphs, together covering every frame of the path.
-pub(crate) fn check_recordings(recordings: &[Recording]) -> Result<Input<'_>, MergeError> {
-    let first = recordings.first().ok_or(MergeError::NoRecordings)?;
+/// Checks that the recordings are contiguous frame ranges of one scene, path, setting and
+/// (unless `allow_mixed_devices`) device, all with graphs, together covering every frame of
+/// the path.
+pub(crate) fn check_recordings(
+    recordings: &[Recording],
+    allow_mixed_devices: bool,
+) -> Result<Input<'_>, MergeError> {
     for (k, r) in recordings.iter().enumerate() {
         r.check_structure()
             .map_err(|why| MergeError::Invalid { recording: k, why })?;
-        let differs = |what: &'static str| Err(MergeError::Mismatch { recording: k, what });
         if r.phase != Phase::Graphs {
             return Err(MergeError::NotGraphs { recording: k });
         }
-        if r.scene_hash != first.scene_hash {
-            return differs("scene hash");
-        }
-        if r.path_hash != first.path_hash {
-            return differs("path hash");
-        }
-        if r.settings != first.settings {
-            return differs("recording settings");
-        }
-        if r.unique_visible != first.unique_visible {
-            return differs("unique visible set G");
-        }
-        if r.frame_states != first.frame_states {
-            return differs("frame states");
-        }
-        if r.frames.is_empty() {
-            return Err(MergeError::NoFrames { recording: k });
-        }
         if r.geometry.triangles.len() != r.unique_visible.len() {
-            return differs("geometry (not one triangle per member of G)");
-        }
-    }
-    let mut order: Vec<usize> = (0..recordings.len()).collect();
-    order.sort_by_key(|&k| (recordings[k].frame_range().start, k));
-    let mut next = 0u32;
-    for &k in &order {
-        let r = &recordings[k];
-        let range = r.frame_range();
-        if range.start != next {
-            return Err(MergeError::NotContiguous {
+            return Err(MergeError::Mismatch {
                 recording: k,
-                expected: next,
-                found: range,
+                what: "geometry (not one triangle per member of G)",
             });
         }
-        for (n, fr) in r.frames.iter().enumerate() {
-            if fr.frame != range.start + n as u32 {
-                return Err(MergeError::BadFrame {
-                    recording: k,
-                    frame: fr.frame,
-                    why: "frames are not consecutive".into(),
-                });
-            }
-        }
-        next = range.end;
     }
-    let total = first.frame_states.len() as u32;
-    if next != total {
-        return Err(MergeError::MissingFrames {
-            covered: next,
-            total,
-        });
-    }
+    crate::shards::first_difference(recordings, allow_mixed_devices)?;
+    let order = crate::shards::frame_order(recordings)?;
+    let first = &recordings[0];
     Ok(Input {
         recordings: order.iter().map(|&k| &recordings[k]).collect(),
-        frames: total,
+        frames: first.frame_states.len() as u32,
     })
 }
 

@@ -35,6 +35,7 @@ mod limits;
 mod paper;
 pub mod reduction;
 mod serialize;
+pub mod shards;
 mod split;
 pub mod strategy;
 pub mod synth;
@@ -46,6 +47,7 @@ use rayon::prelude::*;
 use trisort_format::{Baked, MatrixCell, Recording};
 
 pub use limits::Limit;
+pub use shards::{device_differences, differences, join, settings_differences, Difference};
 pub use strategy::{Layout, Strategy};
 pub use trisort_format::{Bridge, Choice, Seeding};
 
@@ -148,6 +150,15 @@ pub enum MergeError {
         /// What differs.
         what: &'static str,
     },
+    /// A recording differs from recording 0 in what makes it part of another bake (see
+    /// [`differences`]): device, driver, settings, scene, path, phase or G.
+    #[error("recording {recording} differs from recording 0: {differences}")]
+    Differs {
+        /// Index of the recording.
+        recording: usize,
+        /// Every difference found, with both values, `; `-separated.
+        differences: String,
+    },
     /// A recording holds no frame.
     #[error("recording {recording} holds no frame")]
     NoFrames {
@@ -220,13 +231,32 @@ pub enum MergeError {
 ///
 /// Errors when the recordings are not frame ranges of one path recorded with graphs (see
 /// [`MergeError`]). Frames the recorder marked truncated are merged as recorded (their graph
-/// is incomplete); the validator fails on them. The device is taken from the first
-/// recording (in frame order).
+/// is incomplete); the validator fails on them. Recordings made on different devices (adapter,
+/// driver or backend) are refused ([`MergeError::Differs`]): their graphs come from different
+/// rasterizers, so the bake would be exact on neither; see [`merge_mixed_devices`].
 pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, MergeError> {
+    merge_checked(recordings, opts, false)
+}
+
+/// [`merge`], accepting recordings made on different devices (everything else must still
+/// agree). The baked file then names every device with its frames, each field of its
+/// `device` starting `mixed: ` (`merge --allow-mixed-devices`).
+pub fn merge_mixed_devices(
+    recordings: &[Recording],
+    opts: &MergeOptions,
+) -> Result<Baked, MergeError> {
+    merge_checked(recordings, opts, true)
+}
+
+fn merge_checked(
+    recordings: &[Recording],
+    opts: &MergeOptions,
+    allow_mixed_devices: bool,
+) -> Result<Baked, MergeError> {
     if opts.segment == Some(0) {
         return Err(MergeError::ZeroSegment);
     }
-    let input = graph::check_recordings(recordings)?;
+    let input = graph::check_recordings(recordings, allow_mixed_devices)?;
     let index_of = |r: &Recording| {
         recordings
             .iter()
@@ -274,7 +304,9 @@ pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, Mer
         .par_iter()
         .map(|r| r.content_hash())
         .collect();
-    Ok(best.into_baked(first, recording_hashes, &graphs, opts))
+    let mut baked = best.into_baked(first, recording_hashes, &graphs, opts);
+    baked.device = shards::device_of(&input.recordings);
+    Ok(baked)
 }
 
 /// Runs every combination of `combos` and keeps the best (see [`merge`]). Combinations run

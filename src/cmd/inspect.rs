@@ -103,6 +103,9 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         "heuristic_unordered_samples": s.heuristic_unordered_samples,
         "frames": baked.frames.len(),
         "split_intersections": baked.settings.split_intersections,
+        // The recording device; `mixed: …` (each device with its frames) when the recordings
+        // were merged with `merge --allow-mixed-devices`.
+        "device": baked.device.adapter, "driver": baked.device.driver,
         // The edges the merger removed to break depth-order cycles, front → back, as scene
         // ids of the recorded scene (the file stores G-local ids): the samples they weigh are
         // the unordered ones.

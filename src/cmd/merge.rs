@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
 use trisort_format::{Baked, Bridge, Choice, FileKind, Layout, Recording, Seeding, Strategy};
@@ -79,6 +79,17 @@ pub struct MergeArgs {
     output: PathBuf,
     #[command(flatten)]
     opts: MergeOpts,
+    /// Merge recordings made on different devices (adapter, driver or backend), which are
+    /// refused otherwise: the bake is then exact on none of them. Warns, and the baked file's
+    /// device names every device with its frames (`mixed: …`).
+    #[arg(long)]
+    allow_mixed_devices: bool,
+    /// Join the recordings (frame ranges of one path, e.g. one per shard) into the one
+    /// recording a single machine would have written, write it to REC, and bake from it: the
+    /// baked file and REC are then byte for byte those of a one-machine `bake` (whose
+    /// recording is `BAKED.rec`).
+    #[arg(long, value_name = "REC", conflicts_with = "allow_mixed_devices")]
+    join: Option<PathBuf>,
     /// Print the figures as JSON.
     #[arg(long)]
     json: bool,
@@ -125,6 +136,73 @@ pub fn read_recording(file: &std::path::Path) -> Result<Recording> {
     Ok(rec)
 }
 
+/// A merger error, which names recordings by index, with the file of each index.
+pub fn name_files(e: &str, files: &[impl AsRef<std::path::Path>]) -> String {
+    format!(
+        "{e} (recordings: {})",
+        files
+            .iter()
+            .enumerate()
+            .map(|(i, n)| format!("{i} = {}", n.as_ref().display()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+}
+
+/// Checks that `recs` (read from `files`) are parts of one bake ([`trisort_merger::differences`]
+/// against the first): an error naming the file and every difference, except that with
+/// `allow_mixed_devices` a different device only gives a warning (returned, and printed on
+/// stderr).
+pub fn check_compatible(
+    recs: &[Recording],
+    files: &[PathBuf],
+    allow_mixed_devices: bool,
+) -> Result<Vec<String>> {
+    let mut warnings = Vec::new();
+    for (k, r) in recs.iter().enumerate().skip(1) {
+        let (device, other): (Vec<_>, Vec<_>) = trisort_merger::differences(&recs[0], r)
+            .into_iter()
+            .partition(|d| d.device);
+        let list = |v: &[trisort_merger::Difference]| {
+            v.iter()
+                .map(|d| d.what.clone())
+                .collect::<Vec<_>>()
+                .join("; ")
+        };
+        if !other.is_empty() {
+            bail!(
+                "{} is not part of the same bake as {}: {}",
+                files[k].display(),
+                files[0].display(),
+                list(&other)
+            );
+        }
+        if !device.is_empty() {
+            if !allow_mixed_devices {
+                bail!(
+                    "{} was recorded on another device than {}: {}; a bake of both is exact \
+                     on neither (re-record it on one kind of device, or merge anyway with \
+                     --allow-mixed-devices)",
+                    files[k].display(),
+                    files[0].display(),
+                    list(&device)
+                );
+            }
+            let w = format!(
+                "{} was recorded on another device than {}: {}; merged anyway \
+                 (--allow-mixed-devices): the bake is exact on neither, and its device says \
+                 \"mixed: …\"",
+                files[k].display(),
+                files[0].display(),
+                list(&device)
+            );
+            eprintln!("trisort: warning: {w}");
+            warnings.push(w);
+        }
+    }
+    Ok(warnings)
+}
+
 /// Merges and writes atomically.
 pub fn merge_to_file(
     recs: &[Recording],
@@ -132,32 +210,53 @@ pub fn merge_to_file(
     output: &std::path::Path,
     names: &[String],
 ) -> Result<Baked> {
-    let baked = trisort_merger::merge(recs, opts).map_err(|e| {
-        // Errors name recordings by index; say which file that is.
-        anyhow::anyhow!(
-            "{e} (recordings: {})",
-            names
-                .iter()
-                .enumerate()
-                .map(|(i, n)| format!("{i} = {n}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    })?;
+    merge_to_file_with(recs, opts, output, names, false)
+}
+
+/// [`merge_to_file`], merging recordings of different devices when `allow_mixed_devices`.
+fn merge_to_file_with(
+    recs: &[Recording],
+    opts: &MergeOptions,
+    output: &std::path::Path,
+    names: &[String],
+    allow_mixed_devices: bool,
+) -> Result<Baked> {
+    let merged = if allow_mixed_devices {
+        trisort_merger::merge_mixed_devices(recs, opts)
+    } else {
+        trisort_merger::merge(recs, opts)
+    };
+    // Errors name recordings by index; say which file that is.
+    let baked = merged.map_err(|e| anyhow::anyhow!("{}", name_files(&e.to_string(), names)))?;
     trisort_format::write_file_atomic(FileKind::Baked, output, &baked)
         .with_context(|| format!("writing {}", output.display()))?;
     Ok(baked)
 }
 
 pub fn run(a: MergeArgs) -> Result<ExitCode> {
-    let recs = read_recordings(&a.recordings)?;
-    let names: Vec<String> = a
+    let mut recs = read_recordings(&a.recordings)?;
+    check_compatible(&recs, &a.recordings, a.allow_mixed_devices)?;
+    let mut names: Vec<String> = a
         .recordings
         .iter()
         .map(|p| p.display().to_string())
         .collect();
     let t0 = std::time::Instant::now();
-    let baked = merge_to_file(&recs, &a.opts.options(), &a.output, &names)?;
+    if let Some(join) = &a.join {
+        let joined = trisort_merger::join(&recs)
+            .map_err(|e| anyhow::anyhow!("{}", name_files(&e.to_string(), &a.recordings)))?;
+        trisort_format::write_file_atomic(FileKind::Recording, join, &joined)
+            .with_context(|| format!("writing {}", join.display()))?;
+        recs = vec![joined];
+        names = vec![join.display().to_string()];
+    }
+    let baked = merge_to_file_with(
+        &recs,
+        &a.opts.options(),
+        &a.output,
+        &names,
+        a.allow_mixed_devices,
+    )?;
     let seconds = t0.elapsed().as_secs_f64();
     if a.json {
         print_json(&baked_json(&baked, seconds));
