@@ -156,3 +156,70 @@ fn a_bad_subpixel_offset_is_refused() {
         assert!(err.contains("offset"), "{bad}: {err}");
     }
 }
+
+/// Sum of per-frame `holes` of `play BAKED --self-check --subpixel-offset OFFSET --json`, and
+/// whether it exited 0.
+fn self_check_holes(dir: &std::path::Path, baked: &str, offset: &str) -> (u64, bool) {
+    let out = trisort(dir)
+        .args([
+            "play",
+            baked,
+            "--self-check",
+            "--subpixel-offset",
+            offset,
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!("{e}: {}", String::from_utf8_lossy(&out.stderr));
+    });
+    let holes = v["frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["holes"].as_u64().unwrap())
+        .sum();
+    (holes, out.status.success())
+}
+
+#[test]
+fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
+    let Some(dir) = gpu_tempdir() else { return };
+    let d = dir.path();
+    let bake =
+        format!("bake {SCENE} --path orbit:frames=2,degrees=40 --size 64x64 --samples 4");
+    let plain = run_json(d, &[args(&bake), vec!["-o", "plain.baked"]].concat());
+    let robust = run_json(
+        d,
+        &[
+            args(&bake),
+            args("-o robust.baked --conservative --robust 2 --robust-tolerance 0.125"),
+        ]
+        .concat(),
+    );
+    assert_eq!(
+        robust["robust"],
+        serde_json::json!({"patterns": 2, "tolerance": 0.125, "conservative": true}),
+        "{robust}"
+    );
+    assert_eq!(plain["robust"]["patterns"], 1);
+    let tris = |v: &serde_json::Value| v["source_triangles"].as_u64().unwrap();
+    assert!(tris(&robust) > tris(&plain), "{robust}\n{plain}");
+    // Still a valid bake, exact at its recorded pattern.
+    run(
+        d,
+        &args("verify robust.baked --recording robust.baked.rec"),
+        true,
+    );
+    run(
+        d,
+        &args("verify robust.baked --recording robust.baked.rec --scene demo:10000 --mode depth"),
+        true,
+    );
+    // Moved by 1/8 px (the tolerance), the plain bake shows holes, the conservative one none.
+    let (plain_holes, plain_ok) = self_check_holes(d, "plain.baked", "1/8,0");
+    assert!(plain_holes > 0 && !plain_ok, "{plain_holes}");
+    let (robust_holes, robust_ok) = self_check_holes(d, "robust.baked", "1/8,0");
+    assert_eq!((robust_holes, robust_ok), (0, true));
+}

@@ -30,8 +30,9 @@ use serde::Serialize;
 /// refused ([`FormatError::Version`]), never guessed at.
 ///
 /// History: 1, the first; 2, [`crate::MergeInfo`] stores its options as enums
-/// ([`crate::options`]) instead of strings.
-pub const FORMAT_VERSION: u32 = 2;
+/// ([`crate::options`]) instead of strings; 3, [`crate::RecordSettings`] stores how robust
+/// the recording is ([`crate::Robust`]).
+pub const FORMAT_VERSION: u32 = 3;
 
 /// Decompressed payloads larger than this are refused (16 GiB).
 pub const MAX_PAYLOAD: u64 = 16 << 30;
@@ -377,14 +378,14 @@ mod tests {
         assert!(matches!(
             err,
             FormatError::Version {
-                found: 1,
-                supported: 2,
+                found: 2,
+                supported: 3,
                 ..
             }
         ));
         assert_eq!(
             err.to_string(),
-            "old.baked: format version 1 is not supported (this trisort reads version 2); \
+            "old.baked: format version 2 is not supported (this trisort reads version 3); \
              record or merge it again with this trisort"
         );
     }

@@ -30,7 +30,7 @@ pub use options::{
     ParseOptionError, Seeding, Strategy,
 };
 pub use recording::{
-    DeviceInfo, Edge, FrameRecord, Phase, RecordSettings, Recording, SettingsError,
+    DeviceInfo, Edge, FrameRecord, Phase, RecordSettings, Recording, Robust, SettingsError,
 };
 
 /// The version of the trisort tool that wrote a file (stored in every file).

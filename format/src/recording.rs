@@ -29,6 +29,86 @@ pub struct RecordSettings {
     /// [`RecordSettings::DEFAULT_SPLIT_INTERSECTIONS`]; `record --keep-intersections` turns
     /// it off.
     pub split_intersections: bool,
+    /// Robust recording (`record --robust N`, `--conservative`): visibility and edges gathered
+    /// beyond the recorded sample pattern, so that another rasterizer's snapping or a modest
+    /// resize opens no hole. Default [`Robust::DEFAULT`].
+    pub robust: Robust,
+}
+
+/// How far beyond the recorded sample pattern a recording looks (`record --robust N`,
+/// `--conservative`, `--robust-tolerance PX`).
+///
+/// A triangle belongs to V_f when it wins a sample of the recorded pattern. On another
+/// rasterizer (4 to 8 bits of sub-pixel precision, other tie rules), or with the pattern
+/// moved by a fraction of a pixel, a triangle that won no sample can win one; if the frame
+/// does not draw it, what lies behind shows through (a hole). Robust recording widens V_f (and
+/// E_f, so the extra triangles are ordered) towards "wins a sample under some placement of
+/// the samples within `tolerance` pixels":
+/// - `patterns` N: the union over N sample patterns, the recorded one and N − 1 moved by
+///   offsets within ±`tolerance` ([`Robust::offsets`]), for phase 1 (visibility) and phase 2
+///   (covered sets, edges, ties; edge weights add up over the patterns);
+/// - `conservative`: phase 1 also keeps every triangle whose footprint, dilated by
+///   `tolerance` in x and y, reaches a sample at a depth (its nearest over the dilation) not
+///   behind the nearest opaque surface that covers the sample's whole ±`tolerance` box
+///   (that surface's farthest depth over the box) (`recorder`'s conservative pass).
+///
+/// The recorded pattern stays one of the patterns, so a robust bake is still exact at it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Robust {
+    /// Sample patterns unioned (1: the recorded one only).
+    pub patterns: u32,
+    /// Tolerance in pixels: the jitter of the extra patterns and the conservative dilation.
+    pub tolerance: f32,
+    /// Conservative visibility (dilated coverage against eroded opaque occluders).
+    pub conservative: bool,
+}
+
+impl Robust {
+    /// The most patterns [`RecordSettings::validate`] accepts.
+    pub const MAX_PATTERNS: u32 = 64;
+    /// Recorded pattern only.
+    pub const OFF: Robust = Robust {
+        patterns: 1,
+        tolerance: 0.125,
+        conservative: false,
+    };
+    /// The default of `record`.
+    pub const DEFAULT: Robust = Robust::OFF;
+
+    /// Whether anything beyond the recorded pattern is gathered.
+    pub fn is_on(&self) -> bool {
+        self.patterns > 1 || self.conservative
+    }
+
+    /// The pattern offsets in pixels (x right, y down), the recorded pattern's `[0, 0]` first,
+    /// then `patterns − 1` points of the (2, 3) Halton sequence scaled to ±`tolerance`:
+    /// deterministic, spread over the square without clumping.
+    pub fn offsets(&self) -> Vec<[f64; 2]> {
+        fn halton(mut i: u32, base: u32) -> f64 {
+            let (mut f, mut r) = (1.0, 0.0);
+            while i > 0 {
+                f /= base as f64;
+                r += f * (i % base) as f64;
+                i /= base;
+            }
+            r
+        }
+        let t = self.tolerance as f64;
+        let mut out = vec![[0.0, 0.0]];
+        for k in 1..self.patterns.max(1) {
+            out.push([
+                (2.0 * halton(k, 2) - 1.0) * t,
+                (2.0 * halton(k, 3) - 1.0) * t,
+            ]);
+        }
+        out
+    }
+}
+
+impl Default for Robust {
+    fn default() -> Self {
+        Robust::DEFAULT
+    }
 }
 
 impl RecordSettings {
@@ -77,6 +157,13 @@ impl RecordSettings {
         if s.max_layers == 0 {
             return Err(SettingsError::MaxLayers);
         }
+        let r = &s.robust;
+        if r.patterns == 0 || r.patterns > Robust::MAX_PATTERNS {
+            return Err(SettingsError::Patterns(r.patterns));
+        }
+        if !(r.tolerance >= 0.0 && r.tolerance <= 4.0) {
+            return Err(SettingsError::Tolerance(r.tolerance));
+        }
         Ok(())
     }
 }
@@ -91,6 +178,7 @@ impl Default for RecordSettings {
             glass_opacity: Self::DEFAULT_GLASS_OPACITY,
             max_layers: Self::DEFAULT_MAX_LAYERS,
             split_intersections: Self::DEFAULT_SPLIT_INTERSECTIONS,
+            robust: Robust::DEFAULT,
         }
     }
 }
@@ -113,6 +201,12 @@ pub enum SettingsError {
     /// No layer allowed.
     #[error("max layers must be at least 1")]
     MaxLayers,
+    /// Robust patterns outside 1..=[`Robust::MAX_PATTERNS`].
+    #[error("--robust {0}: the number of sample patterns must be 1..={max}", max = Robust::MAX_PATTERNS)]
+    Patterns(u32),
+    /// Robust tolerance outside [0, 4] pixels.
+    #[error("robust tolerance {0} px must be in [0, 4]")]
+    Tolerance(f32),
 }
 
 /// The device a recording was made on.

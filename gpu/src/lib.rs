@@ -173,6 +173,23 @@ pub fn peeling_shader(samples: u32) -> String {
     compose(&["primitive_index"], &format!("{PLAYER}\n{body}"))
 }
 
+/// The recorder's conservative visibility passes (`vs_erode`/`fs_erode`,
+/// `vs_dilate`/`fs_mark`); compose with [`conservative_shader`].
+pub const CONSERVATIVE: &str = include_str!("wgsl/conservative.wgsl");
+
+/// The complete conservative visibility shader for a sample count: [`COMMON`] and
+/// [`CONSERVATIVE`] with its occluder-depth texture type and per-sample load filled in.
+pub fn conservative_shader(samples: u32) -> String {
+    let (_, depth, at) = sample_types(samples.max(1));
+    compose(
+        &[],
+        &CONSERVATIVE.replace("OCCLUDER_TYPE", depth).replace(
+            "LOAD_OCCLUDER",
+            &format!("textureLoad(occluder, coord, {at})"),
+        ),
+    )
+}
+
 /// The coverage test's entry point (`fs_coverage`); compose with [`coverage_shader`].
 pub const COVERAGE: &str = include_str!("wgsl/coverage.wgsl");
 
@@ -220,6 +237,8 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("peeling 4x", peeling_shader(4)),
         ("oit", oit_shader(32)),
         ("coverage", coverage_shader()),
+        ("conservative 1x", conservative_shader(1)),
+        ("conservative 4x", conservative_shader(4)),
         ("blit", blit_shader(false, true, BACKGROUND)),
         ("blit saturate linear", blit_shader(true, false, BACKGROUND)),
     ]

@@ -15,6 +15,7 @@
 #![deny(missing_docs)]
 
 pub mod bench;
+mod conservative;
 #[cfg(test)]
 mod coverage_test;
 pub mod partial;
@@ -23,12 +24,15 @@ mod peeler;
 use std::collections::HashMap;
 use std::ops::Range;
 
+#[cfg(doc)]
+use trisort_format::Robust;
 use trisort_format::{
     Edge, FrameRecord, FrameState, Geometry, Hash, Phase, RecordSettings, Recording,
 };
 use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
 
+pub use conservative::Conservative;
 use partial::{Graph, Visibility};
 pub use peeler::{Layer, Peeler};
 
@@ -114,30 +118,48 @@ fn view_of(s: &RecordSettings) -> View {
 }
 
 /// Phase 1 of one frame: the visible set, layers used, and whether `max_layers` truncated it.
+/// With robust settings, the union over the sample patterns of [`Robust::offsets`] (layers
+/// add up) and the conservative pass's triangles.
 fn visibility_frame(
     peeler: &Peeler,
+    conservative: Option<&Conservative>,
     frame: u32,
     s: &RecordSettings,
 ) -> Result<Visibility, RecordError> {
     let slots = peeler.slots();
-    let mut transmittance = vec![1.0f32; slots];
     let mut visible = vec![];
     let residual = 1.0 - s.saturation;
-    let (layers, truncated) = peeler.peel(frame, s.max_layers, |_, layer, done| {
-        for i in 0..slots {
-            let id = layer.ids[i];
-            if id == 0 || done[i] != 0 {
-                continue;
-            }
-            // Reached before saturation: visible (its own opacity does not matter).
-            visible.push(id - 1);
-            transmittance[i] *= 1.0 - layer.alpha[i];
-            if transmittance[i] <= residual {
-                done[i] = 1;
-            }
+    let (mut layers, mut truncated) = (0, false);
+    let offsets = s.robust.offsets();
+    for &offset in &offsets {
+        if offsets.len() > 1 {
+            peeler.set_subpixel_offset(offset);
         }
-        Ok(true)
-    })?;
+        let mut transmittance = vec![1.0f32; slots];
+        let (l, t) = peeler.peel(frame, s.max_layers, |_, layer, done| {
+            for i in 0..slots {
+                let id = layer.ids[i];
+                if id == 0 || done[i] != 0 {
+                    continue;
+                }
+                // Reached before saturation: visible (its own opacity does not matter).
+                visible.push(id - 1);
+                transmittance[i] *= 1.0 - layer.alpha[i];
+                if transmittance[i] <= residual {
+                    done[i] = 1;
+                }
+            }
+            Ok(true)
+        })?;
+        layers += l;
+        truncated |= t;
+    }
+    if offsets.len() > 1 {
+        peeler.set_subpixel_offset([0.0, 0.0]);
+    }
+    if let Some(c) = conservative {
+        visible.extend(c.visible(frame)?);
+    }
     visible.sort_unstable();
     visible.dedup();
     Ok((visible, layers, truncated))
@@ -151,31 +173,44 @@ fn graph_frame(
     s: &RecordSettings,
 ) -> Result<Graph, RecordError> {
     let slots = peeler.slots();
-    let mut last_id = vec![0u32; slots];
-    let mut last_depth = vec![0f32; slots];
     let mut covered = vec![false; g.len()];
     let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
     let mut ties: HashMap<(u32, u32), u32> = HashMap::new();
-    let (layers, truncated) = peeler.peel(frame, s.max_layers, |_, layer, _| {
-        for i in 0..slots {
-            let id = layer.ids[i];
-            if id == 0 {
-                continue;
-            }
-            covered[(id - 1) as usize] = true;
-            let prev = last_id[i];
-            if prev != 0 {
-                let key = (g[(prev - 1) as usize], g[(id - 1) as usize]);
-                *edges.entry(key).or_default() += 1;
-                if layer.depth[i] == last_depth[i] {
-                    *ties.entry(key).or_default() += 1;
-                }
-            }
-            last_id[i] = id;
-            last_depth[i] = layer.depth[i];
+    let (mut layers, mut truncated) = (0, false);
+    // Robust settings: the union over the sample patterns (edge weights add up).
+    let offsets = s.robust.offsets();
+    for &offset in &offsets {
+        if offsets.len() > 1 {
+            peeler.set_subpixel_offset(offset);
         }
-        Ok(true)
-    })?;
+        let mut last_id = vec![0u32; slots];
+        let mut last_depth = vec![0f32; slots];
+        let (l, t) = peeler.peel(frame, s.max_layers, |_, layer, _| {
+            for i in 0..slots {
+                let id = layer.ids[i];
+                if id == 0 {
+                    continue;
+                }
+                covered[(id - 1) as usize] = true;
+                let prev = last_id[i];
+                if prev != 0 {
+                    let key = (g[(prev - 1) as usize], g[(id - 1) as usize]);
+                    *edges.entry(key).or_default() += 1;
+                    if layer.depth[i] == last_depth[i] {
+                        *ties.entry(key).or_default() += 1;
+                    }
+                }
+                last_id[i] = id;
+                last_depth[i] = layer.depth[i];
+            }
+            Ok(true)
+        })?;
+        layers += l;
+        truncated |= t;
+    }
+    if offsets.len() > 1 {
+        peeler.set_subpixel_offset([0.0, 0.0]);
+    }
     let covered: Vec<u32> = covered
         .iter()
         .enumerate()
@@ -230,8 +265,19 @@ pub fn record(
         let mut done = total - todo.len() as u32;
         if !todo.is_empty() {
             let peeler = Peeler::new(gpu, job.geometry, &all_ids, job.frames, view)?;
+            let conservative = if s.robust.conservative {
+                Some(Conservative::new(
+                    gpu,
+                    job.geometry,
+                    job.frames,
+                    view,
+                    s.robust.tolerance,
+                )?)
+            } else {
+                None
+            };
             for f in todo {
-                let v = visibility_frame(&peeler, f, &s)?;
+                let v = visibility_frame(&peeler, conservative.as_ref(), f, &s)?;
                 if let Some(p) = partial {
                     p.store_visibility(f, &v)?;
                 }

@@ -118,7 +118,7 @@ fn job_key(job: &RecordJob) -> trisort_format::Hash {
     ] {
         h.update(&x.to_le_bytes());
     }
-    h.update(format!("{:?} {:?}", job.phase, job.range).as_bytes());
+    h.update(format!("{:?} {:?} {:?}", job.phase, job.range, s.robust).as_bytes());
     if let Some(g) = &job.known_visible {
         h.update(b"G");
         h.update(bytemuck::cast_slice(g));

@@ -81,6 +81,19 @@ pub struct RecordOpts {
     /// by leaving some samples unordered.
     #[arg(long)]
     pub keep_intersections: bool,
+    /// Robust recording: union visibility and edges over N sample patterns, the recorded one
+    /// and N − 1 moved by up to --robust-tolerance pixels, so another rasterizer's snapping
+    /// or a modest resize opens fewer holes (costs N times the peel).
+    #[arg(long, value_name = "N", default_value_t = RecordSettings::default().robust.patterns)]
+    pub robust: u32,
+    /// Robust recording: also keep every triangle whose footprint grown by --robust-tolerance
+    /// pixels reaches a sample not behind the nearest opaque surface covering the sample's
+    /// whole tolerance box (two extra passes per frame; edges come from the --robust patterns).
+    #[arg(long)]
+    pub conservative: bool,
+    /// Tolerance in pixels of --robust's jittered patterns and of --conservative.
+    #[arg(long, value_name = "PX", default_value_t = RecordSettings::default().robust.tolerance)]
+    pub robust_tolerance: f32,
 }
 
 impl RecordOpts {
@@ -95,6 +108,9 @@ impl RecordOpts {
             frames: None,
             fps,
             keep_intersections: !settings.split_intersections,
+            robust: settings.robust.patterns,
+            conservative: settings.robust.conservative,
+            robust_tolerance: settings.robust.tolerance,
         }
     }
 
@@ -108,6 +124,11 @@ impl RecordOpts {
             glass_opacity: self.glass_opacity,
             max_layers: self.max_layers,
             split_intersections: !self.keep_intersections,
+            robust: trisort_format::Robust {
+                patterns: self.robust,
+                tolerance: self.robust_tolerance,
+                conservative: self.conservative,
+            },
         }
     }
 }
