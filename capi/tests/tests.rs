@@ -1,4 +1,5 @@
 //! trisort-capi's tests: one binary, a module per subject.
 
 mod api;
+mod baked;
 mod header;
