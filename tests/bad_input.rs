@@ -511,7 +511,11 @@ fn mismatched_recordings_are_not_merged() {
             "covers frames 6..12, but frame 0 comes next",
         ),
         (&["a.rec", "moved.rec"], "moved.rec", "path hash"),
-        (&["a.rec", "wide.rec"], "wide.rec", "recording settings"),
+        (
+            &["a.rec", "wide.rec"],
+            "wide.rec",
+            "size \"1x1\" vs \"2x1\"",
+        ),
         (&["a.rec", "phase1.rec"], "phase1.rec", "no graphs"),
     ];
     for (inputs, file, problem) in cases {

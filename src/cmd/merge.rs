@@ -235,6 +235,15 @@ fn merge_to_file_with(
 
 pub fn run(a: MergeArgs) -> Result<ExitCode> {
     let mut recs = read_recordings(&a.recordings)?;
+    for (r, f) in recs.iter().zip(&a.recordings) {
+        if r.phase != trisort_format::Phase::Graphs {
+            bail!(
+                "{}: a recording with no graphs (phase 1 only); record phase 2 first \
+                 (record --phase graphs)",
+                f.display()
+            );
+        }
+    }
     check_compatible(&recs, &a.recordings, a.allow_mixed_devices)?;
     let mut names: Vec<String> = a
         .recordings
