@@ -454,7 +454,7 @@ pub fn frame_uniform(state: &FrameState, view: View) -> FrameUniform {
 /// Uploads the base-colour textures into one array (each layer as large as the largest
 /// texture, clamped to the device's limit; smaller textures fill the top-left corner) and
 /// returns its view and each texture's uv scale. A scene without textures gets one white
-/// texel.
+/// texel. On GL the array has two layers at least (see the comment inside).
 fn upload_textures(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -467,7 +467,16 @@ fn upload_textures(
         .fold((1u32, 1u32), |(w, h), t| (w.max(t.width), h.max(t.height)));
     let max_dim = limits.max_texture_dimension_2d;
     let (tw, th) = (tw.min(max_dim), th.min(max_dim));
-    let layers = geometry.textures.len().max(1) as u32;
+    // wgpu's GL backend picks the GL texture target when the texture is made, from its
+    // layer count alone: one layer becomes TEXTURE_2D, which a `texture_2d_array` binding
+    // (sampler2DArray) then samples as an incomplete texture, black. Two layers at least on
+    // GL make it TEXTURE_2D_ARRAY; the spare layer is never addressed.
+    let min_layers = if device.adapter_info().backend == wgpu::Backend::Gl {
+        2
+    } else {
+        1
+    };
+    let layers = geometry.textures.len().max(min_layers) as u32;
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("base colour textures"),
         size: wgpu::Extent3d {
