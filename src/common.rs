@@ -209,13 +209,30 @@ pub fn open_gpu_with(options: trisort_gpu::GpuOptions) -> Result<trisort_gpu::Gp
 /// `settings.split_intersections`, its triangles that pass through each other within a rigid
 /// group are split along their intersection (`trisort_intersect::working_geometry`), which
 /// changes the scene's triangles and hash. Says on stderr what was split; returns the report.
+///
+/// `frames` come from `frames_from` (a path, a recording or a baked file, for the message):
+/// their poses must name nodes of the scene (`spec`), or the scene is not the one they were
+/// made over, and this is an error naming both rather than an out-of-range node.
 pub fn working_scene(
     scene: &mut Scene,
+    spec: &str,
     frames: &[trisort_format::FrameState],
+    frames_from: &str,
     settings: &trisort_format::RecordSettings,
-) -> Option<trisort_intersect::SplitReport> {
+) -> Result<Option<trisort_intersect::SplitReport>> {
+    let nodes = scene.geometry.nodes.len();
+    for (f, s) in frames.iter().enumerate() {
+        if let Err(why) = trisort_format::camera::check_frame_state(f, s, Some(nodes)) {
+            bail!(
+                "scene {spec} ({nodes} nodes) is not the scene {frames_from} was made over: {why}; \
+                 give the same scene file, or for demo the same demo:TRIANGLES"
+            );
+        }
+    }
     let t0 = std::time::Instant::now();
-    let split = trisort_intersect::working_geometry(&scene.geometry, frames, settings)?;
+    let Some(split) = trisort_intersect::working_geometry(&scene.geometry, frames, settings) else {
+        return Ok(None);
+    };
     let r = split.report;
     if r.pairs_split > 0 || r.pairs_skipped_sliver > 0 {
         eprintln!(
@@ -228,5 +245,5 @@ pub fn working_scene(
         );
     }
     *scene.geometry_mut() = split.geometry;
-    Some(r)
+    Ok(Some(r))
 }

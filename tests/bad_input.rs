@@ -616,3 +616,72 @@ fn bad_scene_files_fail_before_recording() {
         );
     }
 }
+
+/// A one-node glTF scene (one triangle, its buffer beside it as `tri.bin`).
+fn one_node_gltf(dir: &Path) {
+    let corners: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let bin: Vec<u8> = corners.iter().flat_map(|c| c.to_le_bytes()).collect();
+    std::fs::write(dir.join("tri.bin"), bin).unwrap();
+    let gltf = r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":"tri.bin"}]}"#;
+    std::fs::write(dir.join("tri.gltf"), gltf).unwrap();
+}
+
+/// A scene with fewer nodes than a baked file's poses name (the demo path opens the car's
+/// door, node 1; this scene has one node) is the wrong scene, said as such by every command
+/// that reads a scene with a baked file or recording, not an index out of range in the
+/// intersection split.
+#[test]
+fn a_scene_with_fewer_nodes_than_the_poses_is_named_not_indexed() {
+    let Some(dir) = gpu_tempdir() else { return };
+    let d = dir.path();
+    run(
+        d,
+        &args("bake demo:3000 --path demo --size 16x16 -o car.baked"),
+        true,
+    );
+    run(
+        d,
+        &args("record demo:3000 --path demo --size 16x16 --phase visibility -o vis.rec"),
+        true,
+    );
+    one_node_gltf(d);
+    let wrong = "is not the scene car.baked was made over";
+    fails(
+        d,
+        &args("verify car.baked --scene tri.gltf"),
+        &[1],
+        "tri.gltf",
+        wrong,
+    );
+    fails(
+        d,
+        &args("verify car.baked --scene tri.gltf --json"),
+        &[1],
+        "(1 nodes)",
+        wrong,
+    );
+    fails(
+        d,
+        &args("verify car.baked --recording car.baked.rec --scene tri.gltf"),
+        &[1],
+        "tri.gltf",
+        "is not the scene car.baked.rec was made over",
+    );
+    fails(
+        d,
+        &args("export-order car.baked --scene tri.gltf -o car.order"),
+        &[1],
+        "tri.gltf",
+        "not the scene car.baked was baked from",
+    );
+    fails(
+        d,
+        &args("record tri.gltf --path orbit:frames=3 --size 16x16 --phase graphs --visibility vis.rec -o g.rec"),
+        &[1],
+        "vis.rec",
+        "recorded from another scene or path",
+    );
+}

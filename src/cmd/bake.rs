@@ -67,7 +67,14 @@ pub fn bake(
 pub fn run(a: BakeArgs) -> Result<ExitCode> {
     let mut scene = load_scene(&a.scene)?;
     let timeline = load_path(&a.path, &scene, a.record.fps)?;
-    let split = working_scene(&mut scene, &timeline.frames, &a.record.settings());
+    let from = format!("path {}", a.path);
+    let split = working_scene(
+        &mut scene,
+        &a.scene,
+        &timeline.frames,
+        &from,
+        &a.record.settings(),
+    )?;
     let gpu = crate::common::open_gpu()?;
     let (rec, baked, record_s, merge_s) =
         bake(&gpu, &scene, &timeline, &a.record, &a.merge, &a.output)?;

@@ -244,7 +244,14 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
     let mut scene = load_scene(&a.scene)?;
     let timeline = load_path(&a.path, &scene, a.fps)?;
     // Every bake and rival below sees the scene as the default settings record it.
-    working_scene(&mut scene, &timeline.frames, &RecordSettings::default());
+    let from = format!("path {}", a.path);
+    working_scene(
+        &mut scene,
+        &a.scene,
+        &timeline.frames,
+        &from,
+        &RecordSettings::default(),
+    )?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let gpu = crate::common::open_gpu()?;
     let n = timeline.frames.len() as u32;

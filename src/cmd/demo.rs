@@ -55,7 +55,13 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         path.frames.len()
     );
     let record = RecordOpts::new(RecordSettings::new(a.size, a.samples), path.fps);
-    crate::common::working_scene(&mut scene, &path.frames, &record.settings());
+    crate::common::working_scene(
+        &mut scene,
+        "demo",
+        &path.frames,
+        "the demo path",
+        &record.settings(),
+    )?;
     let merge = MergeOpts::defaults();
     let gpu = crate::common::open_gpu()?;
     println!("device: {}", gpu.describe());

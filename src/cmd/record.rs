@@ -164,7 +164,14 @@ pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
     let mut scene = load_scene(&a.scene)?;
     let timeline = load_path(&a.path, &scene, a.opts.fps)?;
-    let split = working_scene(&mut scene, &timeline.frames, &a.opts.settings());
+    let from = format!("path {}", a.path);
+    let split = working_scene(
+        &mut scene,
+        &a.scene,
+        &timeline.frames,
+        &from,
+        &a.opts.settings(),
+    )?;
     if let Some(shard) = a.shard {
         let (i, n) = shard.resolve(&|k| std::env::var(k).ok())?;
         let range = shard_range(i, n, timeline.frames.len() as u32)?;

@@ -299,13 +299,20 @@ fn image_check(
     baked: &Baked,
     recs: &[Recording],
 ) -> Result<(ImageReport, ImageCheck)> {
-    let (states, settings): (&[_], RecordSettings) = match recs.first() {
-        Some(r) => (&r.frame_states, r.settings),
-        None => (&baked.frame_states, baked.settings),
-    };
+    let (states, settings, from): (&[_], RecordSettings, _) =
+        match (recs.first(), a.recording.first()) {
+            (Some(r), Some(file)) => (&r.frame_states, r.settings, file),
+            _ => (&baked.frame_states, baked.settings, &a.baked),
+        };
     let mut scene = load_scene(spec)?;
     // The scene as it was recorded: split where the recording split it.
-    working_scene(&mut scene, states, &settings);
+    working_scene(
+        &mut scene,
+        spec,
+        states,
+        &from.display().to_string(),
+        &settings,
+    )?;
     check_scene(baked, &scene, spec)?;
     for (file, r) in a.recording.iter().zip(recs) {
         if r.scene_hash != scene.hash() {
