@@ -247,3 +247,51 @@ fn bench_leaves_out_a_rival_the_device_cannot_run() {
     assert!(v["methods"]["oit"].is_null());
     assert!(f(&v["methods"]["merged"]["ms_per_frame"]) > 0.0);
 }
+
+#[test]
+fn bench_sweep_robust_factor_plays_each_point_off_its_pattern() {
+    let Some(dir) = gpu_tempdir() else {
+        return;
+    };
+    let sweep = "bench demo:10000 --path orbit:frames=2,degrees=40 --size 48x48 --samples 4 \
+                 --sweep --sweep-factors robust --out sweep";
+    let v = run_json(dir.path(), &args(sweep));
+    let out = dir.path().join("sweep");
+    let points = v["points"].as_array().expect("points");
+    let values: Vec<&str> = points
+        .iter()
+        .map(|p| p["value"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        values,
+        ["1", "2", "4", "8", "conservative", "conservative+4"]
+    );
+    let holes = |p: &serde_json::Value, condition: &str| {
+        let e = p["robustness"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["condition"] == condition)
+            .unwrap_or_else(|| panic!("no {condition} in {p}"));
+        assert!(f(&e["order_errors"]) <= f(&e["blend_differing"]), "{e}");
+        f(&e["holes"])
+    };
+    for p in points {
+        assert_eq!(p["robustness"].as_array().unwrap().len(), 5, "{p}");
+        // Every robust bake is still exact at its recorded pattern.
+        assert_eq!(f(&p["pixels_differing"]), 0.0, "{p}");
+    }
+    // Plain recording opens holes a sixteenth of a pixel away; conservative recording with
+    // its 1/8 px tolerance none, and more patterns fewer.
+    assert!(holes(&points[0], "offset 1/16") > 0.0);
+    assert!(holes(&points[3], "offset 1/16") < holes(&points[0], "offset 1/16"));
+    assert_eq!(holes(&points[4], "offset 1/16"), 0.0);
+    assert_eq!(holes(&points[4], "offset 1/8"), 0.0);
+    assert!(
+        f(&points[4]["source_triangles_per_frame"]) > f(&points[0]["source_triangles_per_frame"])
+    );
+    for name in ["sweep-robust.csv", "sweep-holes-vs-triangles.svg"] {
+        assert!(out.join(name).is_file(), "{name} missing");
+    }
+    no_temp_files(&out);
+}

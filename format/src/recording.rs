@@ -47,10 +47,11 @@ pub struct RecordSettings {
 /// - `patterns` N: the union over N sample patterns, the recorded one and N − 1 moved by
 ///   offsets within ±`tolerance` ([`Robust::offsets`]), for phase 1 (visibility) and phase 2
 ///   (covered sets, edges, ties; edge weights add up over the patterns);
-/// - `conservative`: phase 1 also keeps every triangle whose footprint, dilated by
-///   `tolerance` in x and y, reaches a sample at a depth (its nearest over the dilation) not
-///   behind the nearest opaque surface that covers the sample's whole ±`tolerance` box
-///   (that surface's farthest depth over the box) (`recorder`'s conservative pass).
+/// - `conservative`: phase 1 also keeps every triangle whose footprint, grown by
+///   `tolerance` in x and y, reaches a sample at a depth (its nearest over the box) not
+///   behind the nearest opaque surface's farthest depth over the sample's ±`tolerance` box
+///   (as the samples nearby see it), and phase 2 adds the edges of a peel of the grown
+///   triangles that close no new cycle (`recorder`'s conservative pass).
 ///
 /// The recorded pattern stays one of the patterns, so a robust bake is still exact at it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -59,7 +60,8 @@ pub struct Robust {
     pub patterns: u32,
     /// Tolerance in pixels: the jitter of the extra patterns and the conservative dilation.
     pub tolerance: f32,
-    /// Conservative visibility (dilated coverage against eroded opaque occluders).
+    /// Conservative visibility (grown coverage against the opaque surface's farthest depth
+    /// over the tolerance box) and the grown peel's edges.
     pub conservative: bool,
 }
 

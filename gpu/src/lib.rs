@@ -173,19 +173,53 @@ pub fn peeling_shader(samples: u32) -> String {
     compose(&["primitive_index"], &format!("{PLAYER}\n{body}"))
 }
 
+/// Triangles grown or shrunk by a tolerance box, pulled from storage (bindings in group
+/// `CONS_GROUP`); the base of [`conservative_shader`] and [`peel_grown_shader`].
+pub const GROW: &str = include_str!("wgsl/grow.wgsl");
+
 /// The recorder's conservative visibility passes (`vs_erode`/`fs_erode`,
 /// `vs_dilate`/`fs_mark`); compose with [`conservative_shader`].
 pub const CONSERVATIVE: &str = include_str!("wgsl/conservative.wgsl");
 
-/// The complete conservative visibility shader for a sample count: [`COMMON`] and
-/// [`CONSERVATIVE`] with its occluder-depth texture type and per-sample load filled in.
+/// The complete conservative visibility shader for a sample count: [`COMMON`], [`GROW`] in
+/// group 1 and [`CONSERVATIVE`] with its texture types, per-sample loads and sample count
+/// filled in.
 pub fn conservative_shader(samples: u32) -> String {
-    let (_, depth, at) = sample_types(samples.max(1));
+    let samples = samples.max(1);
+    let (_, depth, at) = sample_types(samples);
+    let float = if samples > 1 {
+        "texture_multisampled_2d<f32>"
+    } else {
+        "texture_2d<f32>"
+    };
+    let at_k = if samples > 1 { "i32(k)" } else { "0" };
     compose(
         &[],
-        &CONSERVATIVE.replace("OCCLUDER_TYPE", depth).replace(
-            "LOAD_OCCLUDER",
-            &format!("textureLoad(occluder, coord, {at})"),
+        &format!("{}\n{CONSERVATIVE}", GROW.replace("CONS_GROUP", "1"))
+            .replace("OCCLUDER_TYPE", float)
+            .replace("SURFACE_TYPE", depth)
+            .replace(
+                "LOAD_OCCLUDER",
+                &format!("textureLoad(occluder, coord, {at}).x"),
+            )
+            .replace("LOAD_SURFACE", &format!("textureLoad(surface, c, {at_k})"))
+            .replace("SAMPLE_COUNT", &format!("{samples}u")),
+    )
+}
+
+/// The grown peel's entry points (`vs_peel_grown`, `fs_peel_grown`); compose with
+/// [`peel_grown_shader`].
+pub const PEEL_GROWN: &str = include_str!("wgsl/peel_grown.wgsl");
+
+/// The complete grown-peel shader for a sample count: [`COMMON`], the peel's bindings and
+/// entry points ([`PEEL`], group 1), [`GROW`] in group 2 and [`PEEL_GROWN`] (needs
+/// `Features::PRIMITIVE_INDEX`, as [`PEEL`] does).
+pub fn peel_grown_shader(samples: u32) -> String {
+    compose(
+        &["primitive_index"],
+        &peel_types(
+            &format!("{PEEL}\n{}\n{PEEL_GROWN}", GROW.replace("CONS_GROUP", "2")),
+            samples,
         ),
     )
 }
@@ -239,6 +273,8 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("coverage", coverage_shader()),
         ("conservative 1x", conservative_shader(1)),
         ("conservative 4x", conservative_shader(4)),
+        ("peel grown 1x", peel_grown_shader(1)),
+        ("peel grown 4x", peel_grown_shader(4)),
         ("blit", blit_shader(false, true, BACKGROUND)),
         ("blit saturate linear", blit_shader(true, false, BACKGROUND)),
     ]

@@ -22,7 +22,7 @@
 //! is a hole. The check is blind to triangles that are not in the file at all (never visible
 //! when recording); `verify --scene` against the exact reference measures those too.
 
-use trisort_format::{Baked, DrawIndexedIndirectArgs, FrameWindow, Mode};
+use trisort_format::{Baked, DrawIndexedIndirectArgs, FrameWindow, Geometry, Mode};
 use trisort_gpu::Gpu;
 
 use crate::error::PlayerError;
@@ -55,17 +55,44 @@ pub struct HoleImages {
 /// in ascending id order: played front to back in `depth` mode, the z-buffer of all of the
 /// file's triangles, agreeing with the frame as baked wherever no left-out triangle is nearer.
 pub fn zbuffer_baked(baked: &Baked) -> Baked {
-    let n = baked.geometry.triangles.len() as u32;
-    let first_index = 3 * baked.copies.len() as u32;
-    let mut copies = baked.copies.clone();
-    copies.extend(0..n);
-    let mut draws = Vec::with_capacity(baked.draws.len() + baked.frames.len());
-    let mut frames = Vec::with_capacity(baked.frames.len());
-    for f in 0..baked.frames.len() {
+    with_zbuffer_draw(baked.clone(), None)
+}
+
+/// [`zbuffer_baked`] over every triangle of `scene`, the full scene the file was baked from
+/// (materials, textures and nodes as the file's, which keeps all of them): the twin then
+/// also shows triangles that never reached the file, so the differing pixels are every hole,
+/// not only those of the file's own triangles. For measurements with the scene at hand
+/// (`trisort bench`); a host on the target has only the file.
+pub fn zbuffer_baked_with_scene(baked: &Baked, scene: &Geometry) -> Baked {
+    with_zbuffer_draw(baked.clone(), Some(scene))
+}
+
+fn with_zbuffer_draw(mut b: Baked, scene: Option<&Geometry>) -> Baked {
+    let first_index = 3 * b.copies.len() as u32;
+    let first_new = b.geometry.triangles.len() as u32;
+    let (appended, first_copy) = match scene {
+        None => (first_new, 0),
+        Some(scene) => {
+            let base = b.geometry.vertices.len() as u32;
+            b.geometry.vertices.extend_from_slice(&scene.vertices);
+            b.geometry
+                .triangles
+                .extend(scene.triangles.iter().map(|t| t.map(|v| v + base)));
+            // Ids past the file's own keep scene_ids strictly ascending; nothing reads them.
+            let next = b.scene_ids.last().map_or(0, |&x| x + 1);
+            b.scene_ids
+                .extend((0..scene.triangles.len() as u32).map(|k| next + k));
+            (scene.triangles.len() as u32, first_new)
+        }
+    };
+    b.copies.extend(first_copy..first_copy + appended);
+    let mut draws = Vec::with_capacity(b.draws.len() + b.frames.len());
+    let mut frames = Vec::with_capacity(b.frames.len());
+    for f in 0..b.frames.len() {
         let first = draws.len() as u32;
-        draws.extend_from_slice(baked.frame_draws(f));
+        draws.extend_from_slice(b.frame_draws(f));
         draws.push(DrawIndexedIndirectArgs {
-            index_count: 3 * n,
+            index_count: 3 * appended,
             instance_count: 1,
             first_index,
             base_vertex: 0,
@@ -76,12 +103,9 @@ pub fn zbuffer_baked(baked: &Baked) -> Baked {
             count: draws.len() as u32 - first,
         });
     }
-    Baked {
-        copies,
-        draws,
-        frames,
-        ..baked.clone()
-    }
+    b.draws = draws;
+    b.frames = frames;
+    b
 }
 
 /// Plays frames of a baked file and of its [`zbuffer_baked`] twin on one device and counts
@@ -110,6 +134,29 @@ impl<'g> SelfCheck<'g> {
         Ok(SelfCheck {
             baked: HeadlessRenderer::new(gpu, baked, &config)?,
             zbuffer: HeadlessRenderer::new(gpu, &zbuffer_baked(baked), &config)?,
+        })
+    }
+
+    /// [`SelfCheck::new`] against the z-buffer of every triangle of `scene`, the full scene
+    /// the file was baked from ([`zbuffer_baked_with_scene`]): counts every hole, including
+    /// triangles that never reached the file. For measurements (`trisort bench`).
+    pub fn against_scene(
+        gpu: &'g Gpu,
+        baked: &Baked,
+        scene: &Geometry,
+        size: (u32, u32),
+        samples: u32,
+    ) -> Result<SelfCheck<'g>, PlayerError> {
+        let config = HeadlessConfig {
+            size,
+            samples,
+            mode: Mode::Depth,
+            ..HeadlessConfig::recorded(baked)
+        };
+        let twin = zbuffer_baked_with_scene(baked, scene);
+        Ok(SelfCheck {
+            baked: HeadlessRenderer::new(gpu, baked, &config)?,
+            zbuffer: HeadlessRenderer::new(gpu, &twin, &config)?,
         })
     }
 

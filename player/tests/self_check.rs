@@ -53,6 +53,23 @@ fn an_honest_frame_has_no_hole_and_a_removed_triangle_is_one() {
 }
 
 #[test]
+fn against_the_scene_it_also_sees_triangles_the_file_lacks() {
+    let Some(gpu) = gpu() else { return };
+    let baked = quads();
+    // The scene: the file's quads and an opaque quad in front of them that never reached it.
+    let mut scene = baked.geometry.clone();
+    trisort_testkit::fixtures::flat_quad(&mut scene, -0.2, 0.2, -0.2, 0.2, 1.0, 2);
+    let own = SelfCheck::new(&gpu, &baked, (SIZE, SIZE), 1).unwrap();
+    assert_eq!(own.check(1).unwrap().holes, 0);
+    let full = SelfCheck::against_scene(&gpu, &baked, &scene, (SIZE, SIZE), 1).unwrap();
+    let h = full.check(1).unwrap();
+    // The quad spans 0.4 of the 2-unit view at z = 0, more nearer the camera: ≈ 8 px wide.
+    assert!(h.holes > 40 && h.holes < 150, "{h:?}");
+    // Frame 0 leaves out the blue quad too: the new quad's pixels and the blue ones.
+    assert!(full.check(0).unwrap().holes > own.check(0).unwrap().holes);
+}
+
+#[test]
 fn the_zbuffer_twin_draws_each_window_then_every_triangle() {
     let baked = quads();
     let z = zbuffer_baked(&baked);

@@ -1,17 +1,26 @@
 //! Conservative visibility (`record --conservative`, [`trisort_format::Robust`]): the
 //! triangles that can win a sample when the sample pattern moves by up to the tolerance, found
-//! in two render passes per frame (see `gpu/src/wgsl/conservative.wgsl`):
-//! 1. the opaque triangles shrunk by the tolerance box write their farthest depth over the box
-//!    (depth test `Less`): per sample, a depth that some opaque surface is nearer than under
-//!    every placement of the sample within the box;
-//! 2. every triangle grown by the box sets its flag where its nearest depth over the box is not
-//!    behind that depth.
+//! in three render passes per frame (see `gpu/src/wgsl/conservative.wgsl`):
+//! 1. the opaque triangles as rasterized at the recorded pattern write their plane's farthest
+//!    depth over a box of ±(tolerance + 0.55) px: the nearest opaque surface, raised by its
+//!    slope;
+//! 2. per sample, the largest of those depths over the samples within ±(tolerance + 0.55) px
+//!    (1 beyond the image): a depth the opaque surface is nearer than everywhere in the
+//!    sample's ±tolerance box;
+//! 3. every triangle grown by the box sets its flag where its nearest depth over the box is
+//!    not behind that depth.
 //!
-//! The flags are read back per frame. This over-approximates "wins a sample under some
-//! placement": transparent surfaces never occlude (a stack of them that saturates the sample
-//! still lets what lies behind through), and the grown triangle is the edge-offset triangle
-//! clipped to its grown bounding box, a superset of the exact Minkowski sum. What it adds to
-//! V_f costs draws, never exactness: a triangle drawn where it is hidden changes no pixel.
+//! The flags are read back per frame and join V_f. Phase 2 takes the edges these triangles
+//! need from a peel of the grown triangles ([`crate::Peeler::grown`]).
+//!
+//! What it guarantees, and where not: a triangle that wins a sample moved by up to the
+//! tolerance is flagged unless the opaque surface in front of it leaves a gap narrower than
+//! the sample spacing that no sample of the pattern falls in (pass 2 sees the surface only at
+//! samples; a per-triangle test, exact but blind to surfaces made of triangles smaller than
+//! the box, kept 12 times too many triangles on CarConcept at 128²). Transparent surfaces never
+//! occlude (a stack of them that saturates a sample still lets what lies behind through).
+//! What it adds to V_f costs draws, never exactness: a triangle drawn where it is hidden
+//! changes no pixel.
 
 use trisort_format::{FrameState, Geometry};
 use trisort_gpu::scene_gpu::{SceneGpu, View};
@@ -20,22 +29,214 @@ use wgpu::util::DeviceExt;
 
 use crate::RecordError;
 
-const OCCLUDER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+const SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+const OCCLUDER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 const MARK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 
 /// The conservative visibility passes for one scene at one view.
 pub struct Conservative<'g> {
     gpu: &'g Gpu,
     scene: SceneGpu,
-    erode: wgpu::RenderPipeline,
+    occlude: wgpu::RenderPipeline,
+    spread: wgpu::RenderPipeline,
     mark: wgpu::RenderPipeline,
-    erode_group: wgpu::BindGroup,
+    occlude_group: wgpu::BindGroup,
+    spread_group: wgpu::BindGroup,
     mark_group: wgpu::BindGroup,
+    surface: wgpu::TextureView,
     occluder: wgpu::TextureView,
     target: wgpu::TextureView,
     flags: wgpu::Buffer,
     staging: wgpu::Buffer,
     triangles: u32,
+}
+
+/// The storage a grown or shrunk triangle is pulled from (`grow.wgsl`, bindings 0–2 of its
+/// group): the tolerance and pixel scale, every vertex's position and node, and the drawn
+/// triangles' vertex indices and material, in draw order.
+pub(crate) struct GrowBuffers {
+    params: wgpu::Buffer,
+    vertices: wgpu::Buffer,
+    triangle_buffer: wgpu::Buffer,
+    /// Triangles drawn.
+    pub(crate) triangles: u32,
+}
+
+impl GrowBuffers {
+    /// The buffers for drawing `triangles` (indices into `geometry.triangles`, in draw order)
+    /// at `view` with a tolerance of `tolerance` pixels.
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        geometry: &Geometry,
+        triangles: &[u32],
+        view: View,
+        tolerance: f32,
+    ) -> GrowBuffers {
+        let params: [f32; 4] = [
+            tolerance,
+            tolerance,
+            view.width as f32 / 2.0,
+            view.height as f32 / 2.0,
+        ];
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let params = buffer(
+            "grow params",
+            bytemuck::cast_slice(&params),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let mut vertices: Vec<[f32; 4]> = geometry
+            .vertices
+            .iter()
+            .map(|v| {
+                [
+                    v.position[0],
+                    v.position[1],
+                    v.position[2],
+                    f32::from_bits(v.node),
+                ]
+            })
+            .collect();
+        if vertices.is_empty() {
+            vertices.push([0.0; 4]);
+        }
+        let mut tris: Vec<[u32; 4]> = triangles
+            .iter()
+            .map(|&t| {
+                let t = geometry.triangles[t as usize];
+                [t[0], t[1], t[2], geometry.vertices[t[0] as usize].material]
+            })
+            .collect();
+        let count = tris.len() as u32;
+        if tris.is_empty() {
+            tris.push([0; 4]);
+        }
+        GrowBuffers {
+            params,
+            vertices: buffer(
+                "grow vertices",
+                bytemuck::cast_slice(&vertices),
+                wgpu::BufferUsages::STORAGE,
+            ),
+            triangle_buffer: buffer(
+                "grow triangles",
+                bytemuck::cast_slice(&tris),
+                wgpu::BufferUsages::STORAGE,
+            ),
+            triangles: count,
+        }
+    }
+
+    /// The layout entries of bindings 0–2.
+    pub(crate) fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 3] {
+        let uniform = wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        [uniform, storage_entry(1, true), storage_entry(2, true)]
+    }
+
+    /// The bind group entries of bindings 0–2.
+    pub(crate) fn entries(&self) -> [wgpu::BindGroupEntry<'_>; 3] {
+        [
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: self.params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: self.vertices.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: self.triangle_buffer.as_entire_binding(),
+            },
+        ]
+    }
+}
+
+/// A pipeline whose vertex stage pulls triangles from storage (no vertex buffers, the
+/// triangle is `vertex_index / 3`): counter-clockwise front faces, no hardware culling (the
+/// shader discards culled faces), `samples` MSAA samples, an optional colour target (`None`:
+/// depth only) with writes off unless it is the peel's id target, an optional depth test
+/// (written).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn pulled_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    module: &wgpu::ShaderModule,
+    entries: (&str, &str),
+    target: Option<wgpu::TextureFormat>,
+    depth: Option<(wgpu::TextureFormat, wgpu::CompareFunction)>,
+    samples: u32,
+) -> wgpu::RenderPipeline {
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
+    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    });
+    let targets: Vec<Option<wgpu::ColorTargetState>> = target
+        .map(|format| {
+            Some(wgpu::ColorTargetState {
+                format,
+                blend: None,
+                write_mask: if format == MARK_FORMAT {
+                    wgpu::ColorWrites::empty()
+                } else {
+                    wgpu::ColorWrites::ALL
+                },
+            })
+        })
+        .into_iter()
+        .collect();
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pl),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(entries.0),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState {
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: depth.map(|(format, compare)| wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState {
+            count: samples,
+            mask: !0,
+            alpha_to_coverage_enabled: false,
+        },
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(entries.1),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
@@ -67,59 +268,10 @@ impl<'g> Conservative<'g> {
             label: Some("conservative"),
             source: wgpu::ShaderSource::Wgsl(trisort_gpu::conservative_shader(view.samples).into()),
         });
-        let params: [f32; 4] = [
-            tolerance,
-            tolerance,
-            view.width as f32 / 2.0,
-            view.height as f32 / 2.0,
-        ];
-        let buffer = |label, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
-        };
-        let params = buffer(
-            "conservative params",
-            bytemuck::cast_slice(&params),
-            wgpu::BufferUsages::UNIFORM,
-        );
-        let mut vertices: Vec<[f32; 4]> = geometry
-            .vertices
-            .iter()
-            .map(|v| {
-                [
-                    v.position[0],
-                    v.position[1],
-                    v.position[2],
-                    f32::from_bits(v.node),
-                ]
-            })
-            .collect();
-        if vertices.is_empty() {
-            vertices.push([0.0; 4]);
-        }
-        let mut triangles: Vec<[u32; 4]> = geometry
-            .triangles
-            .iter()
-            .map(|t| [t[0], t[1], t[2], geometry.vertices[t[0] as usize].material])
-            .collect();
-        let count = triangles.len() as u32;
-        if triangles.is_empty() {
-            triangles.push([0; 4]);
-        }
-        let vertices = buffer(
-            "conservative vertices",
-            bytemuck::cast_slice(&vertices),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let triangle_buffer = buffer(
-            "conservative triangles",
-            bytemuck::cast_slice(&triangles),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let flags_size = 4 * triangles.len() as u64;
+        let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
+        let grow = GrowBuffers::new(device, geometry, &all, view, tolerance);
+        let count = grow.triangles;
+        let flags_size = 4 * count.max(1) as u64;
         let flags = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("conservative flags"),
             size: flags_size,
@@ -134,32 +286,30 @@ impl<'g> Conservative<'g> {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let uniform = wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let base = [uniform, storage_entry(1, true), storage_entry(2, true)];
-        let erode_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("conservative erode"),
+        let base = GrowBuffers::layout_entries();
+        let occlude_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("conservative occluders"),
             entries: &base,
         });
-        let mut mark_layout_entries = base.to_vec();
-        mark_layout_entries.push(wgpu::BindGroupLayoutEntry {
-            binding: 3,
+        let texture_entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+            binding,
             visibility: wgpu::ShaderStages::FRAGMENT,
             ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Depth,
+                sample_type,
                 view_dimension: wgpu::TextureViewDimension::D2,
                 multisampled: view.samples > 1,
             },
             count: None,
+        };
+        let spread_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("conservative spread"),
+            entries: &[base[0], texture_entry(5, wgpu::TextureSampleType::Depth)],
         });
+        let mut mark_layout_entries = base.to_vec();
+        mark_layout_entries.push(texture_entry(
+            3,
+            wgpu::TextureSampleType::Float { filterable: false },
+        ));
         let mut flags_entry = storage_entry(4, false);
         flags_entry.visibility = wgpu::ShaderStages::FRAGMENT;
         mark_layout_entries.push(flags_entry);
@@ -178,26 +328,25 @@ impl<'g> Conservative<'g> {
             )
             .create_view(&Default::default())
         };
+        let surface = texture("conservative surface", SURFACE_FORMAT);
         let occluder = texture("conservative occluders", OCCLUDER_FORMAT);
         let target = texture("conservative mark target", MARK_FORMAT);
-        let base_entries = [
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: vertices.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: triangle_buffer.as_entire_binding(),
-            },
-        ];
-        let erode_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("conservative erode"),
-            layout: &erode_layout,
+        let base_entries = grow.entries();
+        let occlude_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("conservative occluders"),
+            layout: &occlude_layout,
             entries: &base_entries,
+        });
+        let spread_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("conservative spread"),
+            layout: &spread_layout,
+            entries: &[
+                base_entries[0].clone(),
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&surface),
+                },
+            ],
         });
         let mut mark_entries = base_entries.to_vec();
         mark_entries.push(wgpu::BindGroupEntry {
@@ -213,73 +362,46 @@ impl<'g> Conservative<'g> {
             layout: &mark_layout,
             entries: &mark_entries,
         });
-        let pipeline =
-            |label, layout: &wgpu::BindGroupLayout, entries: (&str, &str), erode: bool| {
-                let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(label),
-                    bind_group_layouts: &[Some(&scene.layout), Some(layout)],
-                    immediate_size: 0,
-                });
-                let mark_target = [Some(wgpu::ColorTargetState {
-                    format: MARK_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::empty(),
-                })];
-                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(label),
-                    layout: Some(&pl),
-                    vertex: wgpu::VertexState {
-                        module: &module,
-                        entry_point: Some(entries.0),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: wgpu::PrimitiveState {
-                        front_face: wgpu::FrontFace::Ccw,
-                        cull_mode: None,
-                        ..Default::default()
-                    },
-                    depth_stencil: erode.then_some(wgpu::DepthStencilState {
-                        format: OCCLUDER_FORMAT,
-                        depth_write_enabled: Some(true),
-                        depth_compare: Some(wgpu::CompareFunction::Less),
-                        stencil: Default::default(),
-                        bias: Default::default(),
-                    }),
-                    multisample: wgpu::MultisampleState {
-                        count: view.samples,
-                        mask: !0,
-                        alpha_to_coverage_enabled: false,
-                    },
-                    fragment: Some(wgpu::FragmentState {
-                        module: &module,
-                        entry_point: Some(entries.1),
-                        compilation_options: Default::default(),
-                        targets: if erode { &[] } else { &mark_target },
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
-            };
-        let erode = pipeline(
-            "conservative erode",
-            &erode_layout,
-            ("vs_erode", "fs_erode"),
-            true,
+        let occlude = pulled_pipeline(
+            device,
+            "conservative occluders",
+            &[&scene.layout, &occlude_layout],
+            &module,
+            ("vs_occlude", "fs_occlude"),
+            None,
+            Some((SURFACE_FORMAT, wgpu::CompareFunction::Less)),
+            view.samples,
         );
-        let mark = pipeline(
+        let spread = pulled_pipeline(
+            device,
+            "conservative spread",
+            &[&scene.layout, &spread_layout],
+            &module,
+            ("vs_full", "fs_spread"),
+            Some(OCCLUDER_FORMAT),
+            None,
+            view.samples,
+        );
+        let mark = pulled_pipeline(
+            device,
             "conservative mark",
-            &mark_layout,
+            &[&scene.layout, &mark_layout],
+            &module,
             ("vs_dilate", "fs_mark"),
-            false,
+            Some(MARK_FORMAT),
+            None,
+            view.samples,
         );
         Ok(Conservative {
             gpu,
             scene,
-            erode,
+            occlude,
+            spread,
             mark,
-            erode_group,
+            occlude_group,
+            spread_group,
             mark_group,
+            surface,
             occluder,
             target,
             flags,
@@ -287,7 +409,6 @@ impl<'g> Conservative<'g> {
             triangles: count,
         })
     }
-
     /// The triangles (indices into the geometry) that may win a sample of frame `frame` when
     /// the pattern moves within the tolerance, ascending.
     pub fn visible(&self, frame: u32) -> Result<Vec<u32>, RecordError> {
@@ -301,10 +422,10 @@ impl<'g> Conservative<'g> {
         enc.clear_buffer(&self.flags, 0, None);
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("conservative erode"),
+                label: Some("conservative occluders"),
                 color_attachments: &[],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &self.occluder,
+                    view: &self.surface,
                     depth_ops: Some(wgpu::Operations {
                         load: wgpu::LoadOp::Clear(1.0),
                         store: wgpu::StoreOp::Store,
@@ -315,10 +436,32 @@ impl<'g> Conservative<'g> {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.erode);
+            pass.set_pipeline(&self.occlude);
             pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
-            pass.set_bind_group(1, &self.erode_group, &[]);
+            pass.set_bind_group(1, &self.occlude_group, &[]);
             pass.draw(0..3 * self.triangles, 0..1);
+        }
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("conservative spread"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &self.occluder,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.spread);
+            pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+            pass.set_bind_group(1, &self.spread_group, &[]);
+            pass.draw(0..3, 0..1);
         }
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -166,8 +166,11 @@ fn visibility_frame(
 }
 
 /// Phase 2 of one frame over G (`g` = scene ids of the drawn list): covered set, edges, ties.
+/// With robust settings, the union over the sample patterns of [`Robust::offsets`] and, for
+/// conservative recording, the grown peel (`grown`, [`Peeler::grown`]): edge weights add up.
 fn graph_frame(
     peeler: &Peeler,
+    grown: Option<&Peeler>,
     frame: u32,
     g: &[u32],
     s: &RecordSettings,
@@ -179,8 +182,14 @@ fn graph_frame(
     let (mut layers, mut truncated) = (0, false);
     // Robust settings: the union over the sample patterns (edge weights add up).
     let offsets = s.robust.offsets();
-    for &offset in &offsets {
-        if offsets.len() > 1 {
+    // The grown peel's edges, kept apart: they may only add order, never a cycle.
+    let mut grown_edges: HashMap<(u32, u32), u32> = HashMap::new();
+    let passes = offsets
+        .iter()
+        .map(|&o| (peeler, o, offsets.len() > 1, false))
+        .chain(grown.map(|p| (p, [0.0, 0.0], false, true)));
+    for (peeler, offset, shift, is_grown) in passes {
+        if shift {
             peeler.set_subpixel_offset(offset);
         }
         let mut last_id = vec![0u32; slots];
@@ -195,9 +204,14 @@ fn graph_frame(
                 let prev = last_id[i];
                 if prev != 0 {
                     let key = (g[(prev - 1) as usize], g[(id - 1) as usize]);
-                    *edges.entry(key).or_default() += 1;
-                    if layer.depth[i] == last_depth[i] {
-                        *ties.entry(key).or_default() += 1;
+                    if is_grown {
+                        // Depths extended past a triangle's edges: order, never ties.
+                        *grown_edges.entry(key).or_default() += 1;
+                    } else {
+                        *edges.entry(key).or_default() += 1;
+                        if layer.depth[i] == last_depth[i] {
+                            *ties.entry(key).or_default() += 1;
+                        }
                     }
                 }
                 last_id[i] = id;
@@ -211,6 +225,7 @@ fn graph_frame(
     if offsets.len() > 1 {
         peeler.set_subpixel_offset([0.0, 0.0]);
     }
+    merge_grown_edges(&mut edges, grown_edges);
     let covered: Vec<u32> = covered
         .iter()
         .enumerate()
@@ -226,6 +241,36 @@ fn graph_frame(
         v
     };
     Ok((covered, to_edges(edges), to_edges(ties), layers, truncated))
+}
+
+/// Adds the grown peel's edges to the patterns' `edges` (weights add up), except those that
+/// would close a cycle the patterns' edges do not have: a grown-only edge on a cycle of the
+/// union (both ends in one strongly connected component) is dropped. The union's cycles are
+/// then those of the patterns' edges alone (any kept grown-only edge joins two components),
+/// so the order the recorded pattern needs is never given up for a speculative one: depths
+/// extended past a triangle's edges can disagree where the triangles never overlap.
+fn merge_grown_edges(edges: &mut HashMap<(u32, u32), u32>, grown: HashMap<(u32, u32), u32>) {
+    if grown.is_empty() {
+        return;
+    }
+    let union: Vec<Edge> = edges
+        .iter()
+        .chain(grown.iter().filter(|(k, _)| !edges.contains_key(k)))
+        .map(|(&(from, to), &weight)| Edge { from, to, weight })
+        .collect();
+    let on_cycle: std::collections::HashSet<(u32, u32)> = trisort_verify::cycle_edges(&union)
+        .into_iter()
+        .map(|e| (e.from, e.to))
+        .collect();
+    for (key, w) in grown {
+        match edges.get_mut(&key) {
+            Some(v) => *v += w,
+            None if !on_cycle.contains(&key) => {
+                edges.insert(key, w);
+            }
+            None => {}
+        }
+    }
 }
 
 /// Records a job. Finished frames are stored in `partial` (if given) as they finish, and
@@ -328,6 +373,7 @@ pub fn record(
     if job.phase == Phase::Graphs {
         let total = frames.len() as u32;
         let mut peeler = None;
+        let mut grown = None;
         for (k, rec) in frames.iter_mut().enumerate() {
             let f = rec.frame;
             let result = match partial.and_then(|p| p.load_graph(f)) {
@@ -336,7 +382,17 @@ pub fn record(
                     if peeler.is_none() {
                         peeler = Some(Peeler::new(gpu, job.geometry, &g, job.frames, view)?);
                     }
-                    let r = graph_frame(peeler.as_ref().unwrap(), f, &g, &s)?;
+                    if s.robust.conservative && grown.is_none() {
+                        grown = Some(Peeler::grown(
+                            gpu,
+                            job.geometry,
+                            &g,
+                            job.frames,
+                            view,
+                            s.robust.tolerance,
+                        )?);
+                    }
+                    let r = graph_frame(peeler.as_ref().unwrap(), grown.as_ref(), f, &g, &s)?;
                     if let Some(p) = partial {
                         p.store_graph(f, &r)?;
                     }
@@ -377,4 +433,26 @@ pub fn record(
         unique_visible: g,
         geometry,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grown_edges_add_order_but_never_a_cycle() {
+        let mut edges: HashMap<(u32, u32), u32> = [((1, 2), 5), ((2, 3), 4)].into();
+        let grown: HashMap<(u32, u32), u32> = [
+            ((1, 2), 2), // seen by the patterns too: weights add
+            ((3, 1), 1), // would close 1 → 2 → 3 → 1: dropped
+            ((3, 4), 7), // new order: kept
+            ((5, 6), 1),
+            ((6, 5), 1), // a cycle of grown edges alone: both dropped
+        ]
+        .into();
+        merge_grown_edges(&mut edges, grown);
+        let mut got: Vec<_> = edges.into_iter().collect();
+        got.sort();
+        assert_eq!(got, vec![((1, 2), 7), ((2, 3), 4), ((3, 4), 7)]);
+    }
 }

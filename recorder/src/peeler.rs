@@ -12,6 +12,7 @@ use trisort_gpu::scene_gpu::{
 use trisort_gpu::Gpu;
 use wgpu::util::DeviceExt;
 
+use crate::conservative::GrowBuffers;
 use crate::RecordError;
 
 /// One peel layer read back: per sample (id + 1 or 0, alpha, depth). Sample `s` of pixel
@@ -48,6 +49,8 @@ pub struct Peeler<'g> {
     dims: wgpu::Buffer,
     view: View,
     plain: wgpu::RenderPipeline,
+    /// The grown peel's triangle storage (group 2), for [`Peeler::grown`].
+    grown: Option<wgpu::BindGroup>,
 }
 
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
@@ -190,12 +193,43 @@ impl<'g> Peeler<'g> {
         frames: &[FrameState],
         view: View,
     ) -> Result<Self, RecordError> {
+        Peeler::build(gpu, geometry, triangles, frames, view, None)
+    }
+
+    /// [`Peeler::new`] over the triangles grown by `tolerance` pixels (`peel_grown.wgsl`):
+    /// each sample's layers list every triangle that could cover it when the pattern moves
+    /// within the tolerance, by the depth of its plane at the sample. Phase 2 of
+    /// `record --conservative` takes the edges of the triangles it adds from here. Layers
+    /// carry alpha 1.
+    pub fn grown(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        triangles: &[u32],
+        frames: &[FrameState],
+        view: View,
+        tolerance: f32,
+    ) -> Result<Self, RecordError> {
+        Peeler::build(gpu, geometry, triangles, frames, view, Some(tolerance))
+    }
+
+    fn build(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        triangles: &[u32],
+        frames: &[FrameState],
+        view: View,
+        grow: Option<f32>,
+    ) -> Result<Self, RecordError> {
         let device = &gpu.device;
         check_device(gpu, view)?;
         let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let source = match grow {
+            None => trisort_gpu::peel_shader(view.samples),
+            Some(_) => trisort_gpu::peel_grown_shader(view.samples),
+        };
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("peel"),
-            source: wgpu::ShaderSource::Wgsl(trisort_gpu::peel_shader(view.samples).into()),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         let previous = previous_key_entries(view.samples);
         let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -217,17 +251,45 @@ impl<'g> Peeler<'g> {
             ],
         });
         let depth_less = Some((DEPTH_FORMAT, wgpu::CompareFunction::Less, true));
-        let pipeline = ScenePipeline {
-            label: "peel",
-            layouts: &[&scene.layout, &peel_layout],
-            module: &module,
-            vertex: "vs_peel",
-            fragment: "fs_peel",
-            target: ID_FORMAT.into(),
-            depth: depth_less,
-            samples: view.samples,
-        }
-        .build(device);
+        let (pipeline, grown) = match grow {
+            None => (
+                ScenePipeline {
+                    label: "peel",
+                    layouts: &[&scene.layout, &peel_layout],
+                    module: &module,
+                    vertex: "vs_peel",
+                    fragment: "fs_peel",
+                    target: ID_FORMAT.into(),
+                    depth: depth_less,
+                    samples: view.samples,
+                }
+                .build(device),
+                None,
+            ),
+            Some(tolerance) => {
+                let buffers = GrowBuffers::new(device, geometry, triangles, view, tolerance);
+                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("grown peel"),
+                    entries: &GrowBuffers::layout_entries(),
+                });
+                let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("grown peel"),
+                    layout: &layout,
+                    entries: &buffers.entries(),
+                });
+                let pipeline = crate::conservative::pulled_pipeline(
+                    device,
+                    "grown peel",
+                    &[&scene.layout, &peel_layout, &layout],
+                    &module,
+                    ("vs_peel_grown", "fs_peel_grown"),
+                    Some(ID_FORMAT),
+                    depth_less.map(|(f, c, _)| (f, c)),
+                    view.samples,
+                );
+                (pipeline, Some(group))
+            }
+        };
 
         let (gather_layout, gather_pipeline) = gather_pipeline(device, view.samples);
 
@@ -309,6 +371,7 @@ impl<'g> Peeler<'g> {
             params_stride,
             dims,
             view,
+            grown,
         })
     }
 
@@ -530,6 +593,9 @@ impl<'g> Peeler<'g> {
             pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
             pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
             pass.set_index_buffer(self.index.slice(..), wgpu::IndexFormat::Uint32);
+            if let Some(g) = &self.grown {
+                pass.set_bind_group(2, g, &[]);
+            }
             let group = if layer_no == 0 { 0 } else { chunks.len() };
             for (c, r) in chunks.iter().enumerate() {
                 if r.is_empty() {
@@ -540,7 +606,12 @@ impl<'g> Peeler<'g> {
                     &peel_bg,
                     &[((group + c) as u64 * self.params_stride) as u32],
                 );
-                pass.draw_indexed(r.start * 3..r.end * 3, 0, 0..1);
+                if self.grown.is_some() {
+                    // Pulled from storage: the triangle is vertex_index / 3, no index buffer.
+                    pass.draw(r.start * 3..r.end * 3, 0..1);
+                } else {
+                    pass.draw_indexed(r.start * 3..r.end * 3, 0, 0..1);
+                }
             }
         }
         {

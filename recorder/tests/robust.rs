@@ -92,6 +92,12 @@ fn a_near_miss_is_kept_by_robust_recording_and_a_hidden_triangle_is_not() {
     // the sample's whole box lies in front.
     let cons = run(robust(1, true)).unwrap();
     assert_eq!(cons.frames[0].visible, with_2);
+    // No sample of the recorded pattern reaches 2; the grown peel orders it before the wall.
+    assert!(cons.frames[0]
+        .edges
+        .iter()
+        .any(|e| e.from == 2 && (e.to == 0 || e.to == 1)));
+    assert!(cons.frames[0].covered.contains(&2));
     // A tolerance below the miss (0.05 px) does not reach it.
     let tight = run(Robust {
         tolerance: 0.04,

@@ -87,8 +87,9 @@ pub struct RecordOpts {
     #[arg(long, value_name = "N", default_value_t = RecordSettings::default().robust.patterns)]
     pub robust: u32,
     /// Robust recording: also keep every triangle whose footprint grown by --robust-tolerance
-    /// pixels reaches a sample not behind the nearest opaque surface covering the sample's
-    /// whole tolerance box (two extra passes per frame; edges come from the --robust patterns).
+    /// pixels reaches a sample not behind the nearest opaque surface's farthest depth over
+    /// the sample's tolerance box, with the edges of a peel of the grown triangles (three
+    /// passes per frame in phase 1, a grown peel in phase 2).
     #[arg(long)]
     pub conservative: bool,
     /// Tolerance in pixels of --robust's jittered patterns and of --conservative.

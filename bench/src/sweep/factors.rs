@@ -3,7 +3,7 @@
 
 use std::str::FromStr;
 
-use trisort_format::RecordSettings;
+use trisort_format::{RecordSettings, Robust};
 use trisort_merger::{Bridge, Choice, Layout, MergeOptions, Strategy};
 
 use super::SweepConfig;
@@ -26,11 +26,14 @@ pub enum Factor {
     StrategyLayout,
     /// Segment length: none, 64, 16, 4.
     Segment,
+    /// Robust recording: 1, 2, 4, 8 sample patterns, conservative with 1 and 4; each point
+    /// is also played off its pattern ([`super::robustness`]).
+    Robust,
 }
 
 impl Factor {
     /// Every factor, in the order the sweep runs them.
-    pub const ALL: [Factor; 7] = [
+    pub const ALL: [Factor; 8] = [
         Factor::RecordSize,
         Factor::Samples,
         Factor::Saturation,
@@ -38,6 +41,7 @@ impl Factor {
         Factor::Bridge,
         Factor::StrategyLayout,
         Factor::Segment,
+        Factor::Robust,
     ];
 
     /// The factor's name on the command line and in the outputs (`record-size`, …).
@@ -50,6 +54,7 @@ impl Factor {
             Factor::Bridge => "bridge",
             Factor::StrategyLayout => "strategy-layout",
             Factor::Segment => "segment",
+            Factor::Robust => "robust",
         }
     }
 
@@ -57,7 +62,11 @@ impl Factor {
     pub fn records(self) -> bool {
         matches!(
             self,
-            Factor::RecordSize | Factor::Samples | Factor::Saturation | Factor::GlassOpacity
+            Factor::RecordSize
+                | Factor::Samples
+                | Factor::Saturation
+                | Factor::GlassOpacity
+                | Factor::Robust
         )
     }
 
@@ -113,7 +122,9 @@ pub(super) struct Variant {
     pub(super) merge: MergeOptions,
 }
 
-fn settings_key(s: &RecordSettings) -> (u32, u32, u32, u32, u32, u32) {
+type SettingsKey = (u32, u32, u32, u32, u32, u32, (u32, u32, bool));
+
+fn settings_key(s: &RecordSettings) -> SettingsKey {
     (
         s.width,
         s.height,
@@ -121,7 +132,21 @@ fn settings_key(s: &RecordSettings) -> (u32, u32, u32, u32, u32, u32) {
         s.saturation.to_bits(),
         s.glass_opacity.to_bits(),
         s.max_layers,
+        (
+            s.robust.patterns,
+            s.robust.tolerance.to_bits(),
+            s.robust.conservative,
+        ),
     )
+}
+
+/// A robust setting as the sweep names it (`1`, `4`, `conservative`, `conservative+4`).
+pub(super) fn robust_name(r: &Robust) -> String {
+    match (r.conservative, r.patterns) {
+        (false, n) => n.to_string(),
+        (true, 1) => "conservative".into(),
+        (true, n) => format!("conservative+{n}"),
+    }
 }
 
 pub(super) fn same_settings(a: &RecordSettings, b: &RecordSettings) -> bool {
@@ -228,6 +253,30 @@ pub(super) fn variants(config: &SweepConfig, base: RecordSettings) -> Vec<Varian
                     }
                 }
             }
+            Factor::Robust => {
+                let mut values: Vec<Robust> = [1, 2, 4, 8]
+                    .into_iter()
+                    .map(|patterns| Robust {
+                        patterns,
+                        conservative: false,
+                        ..base.robust
+                    })
+                    .collect();
+                for patterns in [1, 4] {
+                    values.push(Robust {
+                        patterns,
+                        conservative: true,
+                        ..base.robust
+                    });
+                }
+                if !values.contains(&base.robust) {
+                    values.push(base.robust);
+                }
+                for r in values {
+                    let s = RecordSettings { robust: r, ..base };
+                    out.push(v(robust_name(&r), s, merge));
+                }
+            }
             Factor::Segment => {
                 let default = Some(MergeOptions::DEFAULT_SEGMENT);
                 for seg in [None, default, Some(16), Some(4)] {
@@ -276,6 +325,16 @@ mod tests {
         assert_eq!(count(Factor::Bridge), 3);
         assert_eq!(count(Factor::StrategyLayout), 13);
         assert_eq!(count(Factor::Segment), 4);
+        assert_eq!(count(Factor::Robust), 6);
+        let robust: Vec<_> = v
+            .iter()
+            .filter(|x| x.factor == Factor::Robust)
+            .map(|x| x.value.as_str())
+            .collect();
+        assert_eq!(
+            robust,
+            ["1", "2", "4", "8", "conservative", "conservative+4"]
+        );
         // Each factor has exactly one default point, and it is the same bake.
         for f in Factor::ALL {
             let defaults = v

@@ -26,6 +26,8 @@ pub(super) struct Measured {
     pub(super) pixels_differing: u64,
     pub(super) max_channel_diff: u8,
     pub(super) flip: Vec<f64>,
+    /// Played off the recorded pattern (the robust factor's points only).
+    pub(super) robustness: Vec<super::robustness::ConditionError>,
 }
 
 /// Size, figures, play time and error of one bake.
@@ -96,6 +98,7 @@ pub(super) fn measure(
         pixels_differing,
         max_channel_diff,
         flip,
+        robustness: Vec::new(),
     })
 }
 

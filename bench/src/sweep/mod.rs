@@ -14,6 +14,12 @@
 //! | `bridge` | hidden, ignored | merge |
 //! | `strategy-layout` | auto, and lib lbi ilb ibl bli bil × paper compact | merge |
 //! | `segment` | none, 64, 16, 4 | merge |
+//! | `robust` | 1, 2, 4, 8 sample patterns; conservative, conservative + 4 patterns (`record --robust N`, `--conservative`) | record + merge |
+//!
+//! The `robust` factor's points are also played off their recorded pattern
+//! ([`robustness`]: the projection shifted by 1/16, 1/8 and 1/4 px, and 1.5× and 2× the
+//! size), their error split into holes and order errors: `sweep-robust.csv` and
+//! `sweep-holes-vs-triangles.svg`.
 //!
 //! Every point with the default recording shares it; identical bakes (the default point of
 //! every factor) are baked and played once. `bake_seconds` is what it costs to get the point
@@ -36,18 +42,20 @@
 //! | `factors.rs` | the factors, their values and the variants to bake |
 //! | `run.rs` | the sweep itself: recordings, references, merges |
 //! | `measurement.rs` | one bake's size, play time and error |
+//! | `robustness.rs` | the robust factor's error off the recorded pattern |
 //! | `output.rs` | CSV, JSON and the plots |
 
 mod factors;
 mod measurement;
 mod output;
+pub mod robustness;
 mod run;
 
 use serde::Serialize;
 use trisort_format::RecordSettings;
 
 pub use factors::Factor;
-pub use output::{to_csv, CSV_COLUMNS};
+pub use output::{robust_csv, to_csv, CSV_COLUMNS, ROBUST_CSV_COLUMNS};
 pub use run::run;
 
 /// Timed renders of each compared frame per point (after one untimed warm-up render of each);
@@ -145,6 +153,12 @@ pub struct SweepPoint {
     pub max_channel_diff: u8,
     /// Mean LDR-FLIP over the compared frames (0 identical).
     pub flip_mean: f64,
+    /// Σ|V_f| ÷ frames: triangles the frame's own visible set holds (the bake draws at least
+    /// these).
+    pub source_triangles_per_frame: f64,
+    /// The `robust` factor's points: the error played off the recorded pattern, per
+    /// condition ([`robustness`]); empty for the other factors.
+    pub robustness: Vec<robustness::ConditionError>,
 }
 
 /// The sweep's results.

@@ -81,6 +81,48 @@ pub fn to_csv(points: &[SweepPoint]) -> String {
     out
 }
 
+/// The columns of `sweep-robust.csv`, in order.
+pub const ROBUST_CSV_COLUMNS: [&str; 11] = [
+    "value",
+    "condition",
+    "source_triangles_per_frame",
+    "index_triangles",
+    "baked_bytes",
+    "record_seconds",
+    "holes",
+    "holes_fraction",
+    "blend_differing",
+    "order_errors",
+    "pixels_differing_at_pattern",
+];
+
+/// The `robust` factor's points played off their pattern as CSV: one line per point and
+/// condition ([`super::robustness`]).
+pub fn robust_csv(points: &[SweepPoint]) -> String {
+    let mut out = ROBUST_CSV_COLUMNS.join(",");
+    out.push('\n');
+    for p in points {
+        for e in &p.robustness {
+            let fields = [
+                csv_field(&p.value),
+                csv_field(&e.condition),
+                csv_float(p.source_triangles_per_frame),
+                p.index_triangles.to_string(),
+                p.baked_bytes.to_string(),
+                csv_float(p.record_seconds),
+                e.holes.to_string(),
+                csv_float(e.holes_fraction),
+                e.blend_differing.to_string(),
+                e.order_errors.to_string(),
+                p.pixels_differing.to_string(),
+            ];
+            out.push_str(&fields.join(","));
+            out.push('\n');
+        }
+    }
+    out
+}
+
 /// One series per factor, in the order the factors ran, with each point's value as label.
 fn per_factor(
     points: &[SweepPoint],
@@ -157,6 +199,47 @@ pub(super) fn write_outputs(
         "baked file size (MiB)",
         |p| p.baked_bytes as f64 / (1024.0 * 1024.0),
     )?;
+    if report.points.iter().any(|p| !p.robustness.is_empty()) {
+        write_atomic(
+            &out_dir.join("sweep-robust.csv"),
+            robust_csv(&report.points).as_bytes(),
+        )?;
+        // Holes against triangles per frame, one series per condition, labelled by value.
+        let mut series: Vec<Series> = Vec::new();
+        let mut labels: Vec<Vec<String>> = Vec::new();
+        for p in report.points.iter().filter(|p| !p.robustness.is_empty()) {
+            for e in &p.robustness {
+                let k = match series.iter().position(|s| s.name == e.condition) {
+                    Some(k) => k,
+                    None => {
+                        series.push(Series {
+                            name: e.condition.clone(),
+                            points: Vec::new(),
+                        });
+                        labels.push(Vec::new());
+                        series.len() - 1
+                    }
+                };
+                series[k]
+                    .points
+                    .push((p.source_triangles_per_frame, e.holes_fraction));
+                labels[k].push(p.value.clone());
+            }
+        }
+        write_svg_labelled(
+            &out_dir.join("sweep-holes-vs-triangles.svg"),
+            &Chart {
+                title: format!("Robust recording: holes off the recorded pattern ({subtitle})"),
+                x_label: "visible triangles per frame (Σ|V_f| / frames)".into(),
+                y_label: "hole pixels (fraction)".into(),
+                log_x: false,
+                log_y: false,
+                series,
+            },
+            Style::Points,
+            &labels,
+        )?;
+    }
     let along = |name: String, draws: &[u32]| Series {
         name,
         points: draws
@@ -219,7 +302,26 @@ mod tests {
             pixels_differing_fraction: 0.0,
             max_channel_diff: 0,
             flip_mean: 0.0,
+            source_triangles_per_frame: 2.5,
+            robustness: vec![],
         };
+        let mut robust = p.clone();
+        robust.value = "conservative".into();
+        robust.robustness = vec![super::super::robustness::ConditionError {
+            condition: "offset 1/16".into(),
+            holes: 3,
+            holes_fraction: 0.25,
+            blend_differing: 5,
+            order_errors: 2,
+        }];
+        let lines = robust_csv(&[p.clone(), robust]);
+        assert_eq!(
+            lines.lines().collect::<Vec<_>>(),
+            [
+                ROBUST_CSV_COLUMNS.join(",").as_str(),
+                "conservative,offset 1/16,2.5,3,10,1,3,0.25,5,2,0"
+            ]
+        );
         let csv = to_csv(&[p.clone(), p]);
         let lines: Vec<_> = csv.lines().collect();
         assert_eq!(lines.len(), 3);

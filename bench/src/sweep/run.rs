@@ -16,6 +16,7 @@ use trisort_reference::{ExactReference, ReferenceConfig};
 use super::factors::{number, same_settings, variants, Factor, Variant};
 use super::measurement::{max, mean, measure, Measured};
 use super::output::write_outputs;
+use super::robustness;
 use super::{SweepConfig, SweepPoint, SweepReport};
 use crate::BenchError;
 
@@ -115,6 +116,8 @@ impl Sweep<'_> {
             }
         }
         let mut references: HashMap<u32, Vec<Vec<u8>>> = HashMap::new();
+        // The robust factor's references under each off-pattern condition, rendered once.
+        let mut elsewhere: Option<Vec<Vec<Vec<u8>>>> = None;
         let mut measured: Bakes = Vec::new();
         let mut done = 0usize;
         for settings in &recording_order {
@@ -150,7 +153,7 @@ impl Sweep<'_> {
                 let t = Instant::now();
                 let baked = trisort_merger::merge(std::slice::from_ref(&rec), &v.merge)?;
                 let merge_seconds = t.elapsed().as_secs_f64();
-                let m = measure(
+                let mut m = measure(
                     self.gpu,
                     &baked,
                     self.config,
@@ -159,6 +162,36 @@ impl Sweep<'_> {
                     record_seconds,
                     merge_seconds,
                 )?;
+                if v.factor == Factor::Robust {
+                    if elsewhere.is_none() {
+                        (self.progress)(&format!(
+                            "sweep: exact reference under {} off-pattern conditions",
+                            robustness::conditions(self.config.size).len()
+                        ));
+                        elsewhere = Some(robustness::references(
+                            self.gpu,
+                            &self.scene.geometry,
+                            &self.timeline.frames,
+                            self.config,
+                            self.frames,
+                            settings.glass_opacity,
+                        )?);
+                    }
+                    m.robustness = robustness::measure(
+                        self.gpu,
+                        &self.scene.geometry,
+                        &baked,
+                        self.config,
+                        self.frames,
+                        elsewhere.as_ref().expect("rendered above"),
+                    )?;
+                    let holes: Vec<String> = m
+                        .robustness
+                        .iter()
+                        .map(|e| format!("{} {}", e.condition, e.holes))
+                        .collect();
+                    (self.progress)(&format!("{step}: holes {}", holes.join(", ")));
+                }
                 (self.progress)(&format!(
                     "{step}: merge {:.2} s, {} index triangles, {:.1} draws/frame, error {} px, FLIP {:.4}",
                     merge_seconds, m.stats.index_triangles,
@@ -211,6 +244,13 @@ impl Sweep<'_> {
                     },
                     max_channel_diff: m.max_channel_diff,
                     flip_mean: mean(&m.flip),
+                    source_triangles_per_frame: m.stats.source_triangles as f64
+                        / self.timeline.frames.len().max(1) as f64,
+                    robustness: if v.factor == Factor::Robust {
+                        m.robustness.clone()
+                    } else {
+                        Vec::new()
+                    },
                 }
             })
             .collect();
@@ -241,12 +281,13 @@ impl Sweep<'_> {
     /// recording and its wall time in seconds.
     fn record(&self, settings: RecordSettings) -> Result<(Recording, f64), BenchError> {
         (self.progress)(&format!(
-            "sweep: recording {}x{}, {} samples, saturation {}, glass {} ({} frames)",
+            "sweep: recording {}x{}, {} samples, saturation {}, glass {}, robust {} ({} frames)",
             settings.width,
             settings.height,
             settings.samples,
             number(settings.saturation),
             number(settings.glass_opacity),
+            super::factors::robust_name(&settings.robust),
             self.timeline.frames.len()
         ));
         let t = Instant::now();

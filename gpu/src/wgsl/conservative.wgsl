@@ -2,192 +2,33 @@
 // sample pattern moves by up to `tolerance` pixels in x and y (another rasterizer's snapping,
 // a modest resize)?
 //
-// Pass 1 (vs_erode + fs_erode, depth target, test Less): every opaque triangle shrunk by the
-// tolerance box (each edge moved inwards by t·(|nx| + |ny|)), so it covers a sample only where
-// it covers the sample's whole ±t box; it writes its *farthest* depth over the box. The depth
-// target then holds, per sample, a depth that some opaque surface is nearer than under every
-// placement of the sample within the box.
-// Pass 2 (vs_dilate + fs_mark, per sample): every triangle grown by the box (edges moved
-// outwards, clipped to its bounding box grown by t), so it covers every sample whose box it
-// touches; where its *nearest* depth over the box is not behind pass 1's depth, it may win the
-// sample: its flag is set.
+// Pass 1 (vs_occlude + fs_occlude, depth target, test Less): the opaque triangles as
+// rasterized at the recorded pattern, each writing its plane's *farthest* depth over a box of
+// ±(tolerance + REACH) px around the sample: per sample, the nearest opaque surface raised by
+// its slope.
+// Pass 2 (vs_full + fs_spread, per sample, R32Float target): the largest pass-1 depth over the
+// samples within ±(tolerance + REACH) px (background, 1, beyond the image): a depth that the
+// opaque surfaces are nearer than anywhere in the sample's ±tolerance box, as long as they
+// leave no gap narrower than the sample spacing that no sample falls in (a surface of small
+// triangles covers the box although none of them does alone, which a per-triangle test would
+// never see).
+// Pass 3 (vs_dilate + fs_mark, per sample): every triangle grown by the box (grow.wgsl), so it
+// covers every sample whose box it touches; where its *nearest* depth over the box is not
+// behind pass 2's depth, it may win the sample: its flag is set.
 //
-// Triangles are pulled from storage (three vertices per invocation group, non-indexed draw),
-// transformed by the one vertex transform, and grown or shrunk in pixel units after the
-// perspective divide; depth is the triangle's plane z = a·x + b·y + c in NDC, evaluated at the
-// sample. A triangle reaching behind the camera (w ≤ ε at a corner) is not an occluder and is
-// drawn ungrown in pass 2 with its interpolated depth.
+// Composed after grow.wgsl (group 1).
 
-struct Cons {
-    // Tolerance in pixels (x, y), pixels per NDC unit (width / 2, height / 2).
-    tol_px: vec2<f32>,
-    px_per_ndc: vec2<f32>,
-}
-
-@group(1) @binding(0) var<uniform> cons: Cons;
-// Per vertex: local position (xyz) and node (w, bitcast).
-@group(1) @binding(1) var<storage, read> cons_vertices: array<vec4<f32>>;
-// Per triangle: its three vertex indices and its material.
-@group(1) @binding(2) var<storage, read> cons_triangles: array<vec4<u32>>;
-
-struct ConsVarying {
-    @invariant @builtin(position) position: vec4<f32>,
-    @location(0) @interpolate(flat) tri: u32,
-    // Plane z = a·x + b·y + c (NDC); w: 1 when the plane is valid.
-    @location(1) @interpolate(flat) plane: vec4<f32>,
-    // Edge k's half-plane in pixel units, moved by the box: inside iff n·p ≤ c (xy: n, z: c).
-    @location(2) @interpolate(flat) e0: vec3<f32>,
-    @location(3) @interpolate(flat) e1: vec3<f32>,
-    @location(4) @interpolate(flat) e2: vec3<f32>,
-    // Grown bounding box in pixel units (min x, min y, max x, max y).
-    @location(5) @interpolate(flat) bounds: vec4<f32>,
-    @location(6) @interpolate(flat) material: u32,
-}
-
-fn cons_dropped() -> ConsVarying {
-    var out: ConsVarying;
-    // Outside the clip volume: nothing is rasterized.
-    out.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-    out.tri = 0u;
-    out.plane = vec4<f32>(0.0);
-    out.e0 = vec3<f32>(0.0);
-    out.e1 = vec3<f32>(0.0);
-    out.e2 = vec3<f32>(0.0);
-    out.bounds = vec4<f32>(0.0);
-    out.material = 0u;
-    return out;
-}
-
-fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
-    return a.x * b.y - a.y * b.x;
-}
-
-// Corner `corner` of the primitive drawn for triangle `tri`: grown (`grow` = 1), a triangle
-// around its bounding box grown by the box, whose fragments keep the samples whose box meets
-// the triangle (the separating-axis test of box and triangle: the three edge half-planes
-// moved out by the box's support, and the grown bounding box); shrunk (`grow` = −1), the
-// triangle itself, whose fragments keep the samples whose whole box lies inside it (the
-// half-planes moved in). Tested per fragment, so no corner of an offset triangle is ever
-// computed (slivers would put it anywhere).
-fn cons_corner(tri: u32, corner: u32, grow: f32) -> ConsVarying {
-    let t = cons_triangles[tri];
-    var clip: array<vec4<f32>, 3>;
-    for (var k = 0u; k < 3u; k++) {
-        let v = cons_vertices[t[k]];
-        clip[k] = transform_position(v.xyz, bitcast<u32>(v.w));
-    }
-    var out = cons_dropped();
-    out.tri = tri;
-    out.material = t.w;
-    let behind = min(min(clip[0].w, clip[1].w), clip[2].w) <= 1e-6;
-    if (behind) {
-        if (grow < 0.0) {
-            return cons_dropped();
-        }
-        // Ungrown, with its own interpolated depth (plane.w = 0).
-        out.position = clip[corner];
-        return out;
-    }
-    var ndc: array<vec3<f32>, 3>;
-    var p: array<vec2<f32>, 3>;
-    for (var k = 0u; k < 3u; k++) {
-        ndc[k] = clip[k].xyz / clip[k].w;
-        p[k] = ndc[k].xy * cons.px_per_ndc;
-    }
-    let area = cross2(p[1] - p[0], p[2] - p[0]);
-    if (abs(area) < 1e-12) {
-        return cons_dropped();
-    }
-    let s = sign(area);
-    var e: array<vec3<f32>, 3>;
-    for (var k = 0u; k < 3u; k++) {
-        let d = p[(k + 1u) % 3u] - p[k];
-        let n = s * normalize(vec2<f32>(d.y, -d.x));
-        let support = abs(n.x) * cons.tol_px.x + abs(n.y) * cons.tol_px.y;
-        e[k] = vec3<f32>(n, dot(n, p[k]) + grow * support);
-    }
-    out.e0 = e[0];
-    out.e1 = e[1];
-    out.e2 = e[2];
-    // The plane through the three NDC points.
-    let d1 = ndc[1] - ndc[0];
-    let d2 = ndc[2] - ndc[0];
-    let det3 = d1.x * d2.y - d2.x * d1.y;
-    let pa = (d1.z * d2.y - d2.z * d1.y) / det3;
-    let pb = (d1.x * d2.z - d2.x * d1.z) / det3;
-    let pc = ndc[0].z - pa * ndc[0].x - pb * ndc[0].y;
-    out.plane = vec4<f32>(pa, pb, pc, 1.0);
-    let lo = min(min(p[0], p[1]), p[2]) - cons.tol_px;
-    let hi = max(max(p[0], p[1]), p[2]) + cons.tol_px;
-    out.bounds = vec4<f32>(lo, hi);
-    var q = p[corner];
-    if (grow > 0.0) {
-        // A right triangle around the grown box, with a pixel to spare.
-        let a = lo - vec2<f32>(1.0);
-        let size = 2.0 * (hi - lo + vec2<f32>(2.0));
-        if (corner == 0u) {
-            q = a;
-        } else if (corner == 1u) {
-            q = a + vec2<f32>(size.x, 0.0);
-        } else {
-            q = a + vec2<f32>(0.0, size.y);
-        }
-        // Keep the drawn triangle's winding, so front_facing is the triangle's own.
-        if (s < 0.0) {
-            if (corner == 1u) {
-                q = a + vec2<f32>(0.0, size.y);
-            } else if (corner == 2u) {
-                q = a + vec2<f32>(size.x, 0.0);
-            }
-        }
-    }
-    // Depth comes from the plane in the fragment stage; any z inside the clip volume will do.
-    out.position = vec4<f32>(q / cons.px_per_ndc, 0.5, 1.0);
-    return out;
-}
-
-// The sample's position in pixel units of the NDC frame (x right, y up, origin at the centre):
-// with per-sample shading (`sample_index`), `position.xy` is the sample's location.
-fn cons_point(position: vec4<f32>) -> vec2<f32> {
-    let ndc = vec2<f32>(position.x / cons.px_per_ndc.x - 1.0, 1.0 - position.y / cons.px_per_ndc.y);
-    return ndc * cons.px_per_ndc;
-}
-
-// Whether the sample passes the three edge tests (and, grown, lies in the grown bounds).
-fn cons_inside(in: ConsVarying, grow: f32) -> bool {
-    let p = cons_point(in.position);
-    let edges = dot(in.e0.xy, p) <= in.e0.z && dot(in.e1.xy, p) <= in.e1.z
-        && dot(in.e2.xy, p) <= in.e2.z;
-    if (grow < 0.0) {
-        return edges;
-    }
-    return edges && all(p >= in.bounds.xy) && all(p <= in.bounds.zw);
-}
-
-// The depth range of the plane over the tolerance box around the sample.
-fn cons_slack(plane: vec4<f32>) -> f32 {
-    let tol_ndc = cons.tol_px / cons.px_per_ndc;
-    return abs(plane.x) * tol_ndc.x + abs(plane.y) * tol_ndc.y;
-}
-
-fn cons_plane_depth(in: ConsVarying) -> f32 {
-    let p = cons_point(in.position) / cons.px_per_ndc;
-    return in.plane.x * p.x + in.plane.y * p.y + in.plane.z;
-}
-
-fn cons_occludes(material: u32) -> bool {
-    let m = material_at(material);
-    // Opaque materials only (no blend, no mask cut-outs, no glass).
-    return u32(m.params.x) == 0u && m.emissive.a <= 0.0;
-}
+// How far beyond the tolerance the spread reaches: half the largest gap between samples of
+// the standard patterns (1×: 1 px apart; 4×: 0.5 px), a little more.
+const REACH: f32 = 0.55;
 
 @vertex
-fn vs_erode(@builtin(vertex_index) vi: u32) -> ConsVarying {
+fn vs_occlude(@builtin(vertex_index) vi: u32) -> ConsVarying {
     let tri = vi / 3u;
     if (!cons_occludes(cons_triangles[tri].w)) {
         return cons_dropped();
     }
-    return cons_corner(tri, vi % 3u, -1.0);
+    return cons_corner(tri, vi % 3u, 0.0);
 }
 
 @vertex
@@ -195,25 +36,84 @@ fn vs_dilate(@builtin(vertex_index) vi: u32) -> ConsVarying {
     return cons_corner(vi / 3u, vi % 3u, 1.0);
 }
 
-struct ErodeOut {
+struct OccludeOut {
     @builtin(frag_depth) depth: f32,
 }
 
 @fragment
-fn fs_erode(
+fn fs_occlude(
     in: ConsVarying,
     @builtin(front_facing) front_facing: bool,
     @builtin(sample_index) sample: u32,
-) -> ErodeOut {
-    if (culled(in.material, front_facing) || !cons_inside(in, -1.0)) {
+) -> OccludeOut {
+    if (culled(in.material, front_facing)) {
         discard;
     }
-    var out: ErodeOut;
-    out.depth = clamp(cons_plane_depth(in) + cons_slack(in.plane), 0.0, 1.0);
+    var out: OccludeOut;
+    var z = in.position.z;
+    if (in.plane.w > 0.5) {
+        let reach = (cons.tol_px + vec2<f32>(REACH)) / cons.px_per_ndc;
+        z = cons_plane_depth(in) + abs(in.plane.x) * reach.x + abs(in.plane.y) * reach.y;
+    }
+    out.depth = clamp(z, 0.0, 1.0);
     return out;
 }
 
-// Pass 2's bindings: pass 1's depth and the per-triangle flags.
+// Pass 1's depth (the spread pass's group 1: the tolerance, binding 0, and this).
+@group(1) @binding(5) var surface: SURFACE_TYPE;
+
+@vertex
+fn vs_full(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.5, 1.0);
+}
+
+// The standard sample positions within a pixel (Vulkan, D3D): 1× at the centre, 4× rotated.
+fn sample_position(k: u32) -> vec2<f32> {
+    if (SAMPLE_COUNT == 1u) {
+        return vec2<f32>(0.5, 0.5);
+    }
+    var p = array<vec2<f32>, 4>(
+        vec2<f32>(0.375, 0.125),
+        vec2<f32>(0.875, 0.375),
+        vec2<f32>(0.125, 0.625),
+        vec2<f32>(0.625, 0.875),
+    );
+    return p[k];
+}
+
+@fragment
+fn fs_spread(
+    @builtin(position) position: vec4<f32>,
+    @builtin(sample_index) sample: u32,
+) -> @location(0) vec4<f32> {
+    let size = vec2<i32>(textureDimensions(surface));
+    let here = vec2<i32>(position.xy);
+    let me = vec2<f32>(here) + sample_position(sample);
+    let reach = cons.tol_px + vec2<f32>(REACH);
+    let r = i32(ceil(max(reach.x, reach.y)));
+    var m = 0.0;
+    for (var dy = -r; dy <= r; dy++) {
+        for (var dx = -r; dx <= r; dx++) {
+            let c = here + vec2<i32>(dx, dy);
+            for (var k = 0u; k < SAMPLE_COUNT; k++) {
+                let d = abs(vec2<f32>(c) + sample_position(k) - me);
+                if (d.x > reach.x || d.y > reach.y) {
+                    continue;
+                }
+                if (any(c < vec2<i32>(0)) || any(c >= size)) {
+                    // Beyond the image nothing is known: no occluder.
+                    m = 1.0;
+                } else {
+                    m = max(m, LOAD_SURFACE);
+                }
+            }
+        }
+    }
+    return vec4<f32>(m, 0.0, 0.0, 0.0);
+}
+
+// Pass 3's bindings: pass 2's depth and the per-triangle flags.
 @group(1) @binding(3) var occluder: OCCLUDER_TYPE;
 @group(1) @binding(4) var<storage, read_write> flags: array<atomic<u32>>;
 

@@ -1,0 +1,47 @@
+// The grown peel (record --conservative, phase 2): the peel of peel.wgsl over triangles grown
+// by the tolerance box (grow.wgsl, group 2), so that at each sample it lists, in (depth, id)
+// order, every triangle that could cover the sample when the pattern moves within the
+// tolerance; consecutive fragments give the edges that order the triangles conservative
+// visibility adds. A fragment's depth is its triangle's plane at the sample (extended past the
+// triangle's edges); its id is its position in the drawn list (the non-indexed draw's
+// triangle, no primitive index needed). Alpha is not evaluated (phase 2 needs none): 1.
+
+@vertex
+fn vs_peel_grown(@builtin(vertex_index) vi: u32) -> ConsVarying {
+    return cons_corner(vi / 3u, vi % 3u, 1.0);
+}
+
+@fragment
+fn fs_peel_grown(
+    in: ConsVarying,
+    @builtin(front_facing) front_facing: bool,
+    @builtin(sample_index) sample: u32,
+) -> PeelOut {
+    let coord = vec2<i32>(in.position.xy);
+    let slot = (u32(coord.y) * peel.width + u32(coord.x)) * peel.samples + sample;
+    if (done[slot] != 0u) {
+        discard;
+    }
+    if (culled(in.material, front_facing)) {
+        discard;
+    }
+    var z = in.position.z;
+    if (in.plane.w > 0.5) {
+        if (!cons_inside(in, 1.0)) {
+            discard;
+        }
+        z = clamp(cons_plane_depth(in), 0.0, 1.0);
+    }
+    let id = in.tri;
+    if (peel.first_layer == 0u) {
+        let pd = LOAD_PREV_DEPTH;
+        let pid = LOAD_PREV_IDS.x;
+        if (z < pd || (z == pd && id + 1u <= pid)) {
+            discard;
+        }
+    }
+    var out: PeelOut;
+    out.ids = vec2<u32>(id + 1u, bitcast<u32>(1.0));
+    out.depth = z;
+    return out;
+}
