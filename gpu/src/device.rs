@@ -125,41 +125,57 @@ impl Gpu {
     }
 
     #[cfg(not(target_arch = "wasm32"))]
-    /// The one adapter and device request behind [`Gpu::with_flags`] and [`Gpu::for_surface`].
+    /// The one adapter and device request behind [`Gpu::with_flags`] and [`Gpu::for_surface`]:
+    /// [`Gpu::open_async`], waited for.
     fn open(
         instance: &wgpu::Instance,
         compatible_surface: Option<&wgpu::Surface<'_>>,
         label: &str,
         limits: DeviceLimits,
     ) -> Result<Gpu, GpuError> {
-        let adapter =
-            pollster::block_on(
-                instance.request_adapter(&wgpu::RequestAdapterOptions {
-                    power_preference: wgpu::PowerPreference::from_env()
-                        .unwrap_or(wgpu::PowerPreference::HighPerformance),
-                    force_fallback_adapter: false,
-                    compatible_surface,
-                    apply_limit_buckets: false,
-                }),
-            )
+        pollster::block_on(Gpu::open_async(instance, compatible_surface, label, limits))
+    }
+
+    /// Requests an adapter of `instance` (compatible with `compatible_surface` when given)
+    /// and a device on it with `limits` and the [`wanted_features`] it supports. The one
+    /// request behind every constructor; a browser awaits it directly (it never completes a
+    /// blocking wait), natively [`Gpu::new`] and the others wait for it.
+    pub async fn open_async(
+        instance: &wgpu::Instance,
+        compatible_surface: Option<&wgpu::Surface<'_>>,
+        label: &str,
+        limits: DeviceLimits,
+    ) -> Result<Gpu, GpuError> {
+        let power_preference =
+            wgpu::PowerPreference::from_env().unwrap_or(wgpu::PowerPreference::HighPerformance);
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference,
+                force_fallback_adapter: false,
+                compatible_surface,
+                apply_limit_buckets: false,
+            })
+            .await
             .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
         let features = adapter.features() & wanted_features();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some(label),
-            required_features: features,
-            required_limits: match limits {
-                DeviceLimits::Adapter => adapter.limits(),
-                DeviceLimits::Webgl2 => {
-                    wgpu::Limits::downlevel_webgl2_defaults().using_resolution(adapter.limits())
-                }
-            },
-            ..Default::default()
-        }))
-        .map_err(|e| GpuError::Device {
-            adapter: info.name.clone(),
-            reason: e.to_string(),
-        })?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some(label),
+                required_features: features,
+                required_limits: match limits {
+                    DeviceLimits::Adapter => adapter.limits(),
+                    DeviceLimits::Webgl2 => {
+                        wgpu::Limits::downlevel_webgl2_defaults().using_resolution(adapter.limits())
+                    }
+                },
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| GpuError::Device {
+                adapter: info.name.clone(),
+                reason: e.to_string(),
+            })?;
         Ok(Gpu {
             adapter,
             device,

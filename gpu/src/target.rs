@@ -276,6 +276,7 @@ impl FrameTarget {
         Ok(self.unpad(&gpu.map_read(staging)))
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// [`FrameTarget::read`] of an `Rgba16Float` frame as 8-bit sRGB RGBA (see
     /// [`FrameTarget::rgba8`]).
     pub fn read_rgba8(

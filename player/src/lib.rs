@@ -30,6 +30,7 @@ pub mod draw_calls;
 mod error;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod headless;
+pub mod on_screen;
 mod player;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod self_check;
@@ -39,9 +40,10 @@ pub use draw_calls::{Call, CallLog, DrawCalls};
 pub use error::PlayerError;
 #[cfg(not(target_arch = "wasm32"))]
 pub use headless::{render_frames, HeadlessConfig, HeadlessRenderer, RenderedFrame};
+pub use on_screen::{OnScreen, OnScreenSettings};
+pub use player::{baked_from_bytes, blend_state, fragment_entry_point, open_baked, Player};
 #[cfg(not(target_arch = "wasm32"))]
 pub use self_check::{SelfCheck, SelfCheckFrame};
-pub use player::{blend_state, fragment_entry_point, open_baked, Player};
 pub use trisort_format::{Mode, ParseOptionError};
 /// The background every frame is drawn over (re-exported from the GPU crate for hosts).
 pub use trisort_gpu::BACKGROUND;

@@ -18,11 +18,21 @@ const ARGS_SIZE: u64 = std::mem::size_of::<DrawIndexedIndirectArgs>() as u64;
 /// Reads a baked file and checks its structure, so that every draw lies inside its index
 /// buffer. Errors name the file.
 pub fn open_baked(path: &Path) -> Result<Baked, PlayerError> {
-    let baked: Baked = trisort_format::read_file(FileKind::Baked, path)?;
+    let bytes = std::fs::read(path).map_err(|source| trisort_format::FormatError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    baked_from_bytes(&bytes, path)
+}
+
+/// [`open_baked`] for a file already in memory (a browser's fetch or dropped file); `name`
+/// names it in errors.
+pub fn baked_from_bytes(bytes: &[u8], name: &Path) -> Result<Baked, PlayerError> {
+    let baked: Baked = trisort_format::container::decode(FileKind::Baked, bytes, name)?;
     baked
         .check_structure()
         .map_err(|reason| PlayerError::Structure {
-            path: Some(path.to_path_buf()),
+            path: Some(name.to_path_buf()),
             reason,
         })?;
     Ok(baked)
@@ -133,7 +143,14 @@ impl Player {
         let indirect = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("trisort frame windows"),
             contents: command_bytes,
-            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
+            // WebGL2 has no indirect buffers: the direct path draws from the CPU copy, and
+            // keeps this one only for tools that read it back.
+            usage: match config.draw_path {
+                DrawPath::MultiDrawIndirect => {
+                    wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC
+                }
+                DrawPath::Direct => wgpu::BufferUsages::COPY_SRC,
+            },
         });
         let pipeline = create_pipeline(device, &scene.layout, &config, bindings);
 
@@ -222,7 +239,8 @@ impl Player {
         self.windows[frame as usize].first as u64 * ARGS_SIZE
     }
 
-    /// The indirect buffer: every frame's commands back to back.
+    /// The indirect buffer: every frame's commands back to back (`INDIRECT` usage only on the
+    /// [`DrawPath::MultiDrawIndirect`] path; the direct path draws from a CPU copy).
     pub fn indirect_buffer(&self) -> &wgpu::Buffer {
         &self.indirect
     }

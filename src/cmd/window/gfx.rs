@@ -1,5 +1,5 @@
 //! The viewer's GPU side: the window's surface and device, the player and its offscreen
-//! target, and the blit that presents the target ([`trisort_gpu::present`]). The event loop
+//! target ([`trisort_player::OnScreen`]), and the blit that presents the target ([`trisort_gpu::present`]). The event loop
 //! (`mod.rs`) decides what to show; this draws it.
 
 use std::sync::{Arc, Mutex};
@@ -7,18 +7,13 @@ use std::sync::{Arc, Mutex};
 use anyhow::{anyhow, bail, Context, Result};
 use trisort_format::Baked;
 use trisort_gpu::present::{configure_surface, Blit};
-use trisort_gpu::{clear_colour, FrameTarget, Gpu, TargetConfig, COLOR_FORMAT, DEPTH_FORMAT};
-use trisort_player::{Mode, Player, PlayerConfig};
+use trisort_gpu::Gpu;
+use trisort_player::{OnScreen, OnScreenSettings};
 use winit::event_loop::OwnedDisplayHandle;
 use winit::window::Window;
 
 /// How the viewer plays: sample count, mode and glass opacity (`None`: as recorded).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct PlaySettings {
-    pub samples: u32,
-    pub mode: Mode,
-    pub glass_opacity: Option<f32>,
-}
+pub(super) type PlaySettings = OnScreenSettings;
 
 /// The window, its surface and device, the copy-to-surface pipeline and the player's targets.
 pub(super) struct Gfx {
@@ -32,15 +27,7 @@ pub(super) struct Gfx {
     play: PlaySettings,
     /// The first wgpu error no error scope caught.
     uncaptured: Arc<Mutex<Option<String>>>,
-    pub targets: Targets,
-}
-
-/// A player and the offscreen target it draws into, at one size.
-pub(super) struct Targets {
-    pub size: (u32, u32),
-    pub player: Player,
-    frame: FrameTarget,
-    blit_group: wgpu::BindGroup,
+    pub targets: OnScreen,
 }
 
 impl Gfx {
@@ -74,7 +61,7 @@ impl Gfx {
         let (width, height) = (inner.width.max(1), inner.height.max(1));
         let setup = configure_surface(&gpu, &surface, (width, height))?;
         let blit = Blit::new(&gpu.device, setup.view_format, play.mode);
-        let targets = Targets::new(&gpu, baked, &blit, (width, height), play)?;
+        let targets = OnScreen::new(&gpu, baked, &blit, (width, height), play)?;
         eprintln!(
             "trisort: window {width}x{height} on {} ({:?}), surface {:?} written as {:?}, \
              {} sample(s), {} mode",
@@ -105,7 +92,7 @@ impl Gfx {
         self.surface_config.height = size.1;
         self.surface
             .configure(&self.gpu.device, &self.surface_config);
-        size != self.targets.size
+        size != self.targets.size()
     }
 
     /// Rebuilds the player and its targets at `size`.
@@ -115,7 +102,7 @@ impl Gfx {
             .device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
-        self.targets = Targets::new(&self.gpu, baked, &self.blit, size, self.play)?;
+        self.targets = OnScreen::new(&self.gpu, baked, &self.blit, size, self.play)?;
         Ok(())
     }
 
@@ -153,21 +140,14 @@ impl Gfx {
                 format: Some(self.view_format),
                 ..Default::default()
             });
-        let t = &self.targets;
         let mut enc = self
             .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("trisort window frame"),
             });
-        {
-            // In saturate mode the background goes under the accumulated colour in the blit.
-            let mut pass = t
-                .frame
-                .begin_pass(&mut enc, clear_colour(self.play.mode), None);
-            t.player.draw(&mut pass, frame)?;
-        }
-        self.blit.encode(&mut enc, &surface_view, &t.blit_group);
+        self.targets
+            .encode(&mut enc, &self.blit, &surface_view, frame)?;
         self.gpu.queue.submit([enc.finish()]);
         if let Some(e) = self.take_uncaptured() {
             bail!("wgpu: {e}");
@@ -182,44 +162,5 @@ impl Gfx {
             .lock()
             .unwrap_or_else(|p| p.into_inner())
             .take()
-    }
-}
-
-impl Targets {
-    /// A player for `size` and its target: `Rgba16Float` (multisampled and resolved when
-    /// `samples > 1`), `Depth32Float` in `depth` mode.
-    fn new(
-        gpu: &Gpu,
-        baked: &Baked,
-        blit: &Blit,
-        size: (u32, u32),
-        play: PlaySettings,
-    ) -> Result<Targets> {
-        let depth_format = (play.mode == Mode::Depth).then_some(DEPTH_FORMAT);
-        let target = TargetConfig {
-            size,
-            samples: play.samples,
-            format: COLOR_FORMAT,
-            depth: depth_format.is_some(),
-            readback: false,
-        };
-        let frame = FrameTarget::new(&gpu.adapter, &gpu.device, target)
-            .map_err(|e| anyhow!("{e} (--samples)"))?;
-        let config = PlayerConfig {
-            depth_format,
-            sample_count: play.samples,
-            size,
-            mode: play.mode,
-            glass_opacity: play.glass_opacity,
-            ..PlayerConfig::for_adapter(baked, &gpu.adapter, COLOR_FORMAT)
-        };
-        let player = Player::new(&gpu.device, &gpu.queue, baked, config)?;
-        let blit_group = blit.bind(&gpu.device, frame.resolved_view())?;
-        Ok(Targets {
-            size,
-            player,
-            frame,
-            blit_group,
-        })
     }
 }

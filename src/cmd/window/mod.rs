@@ -263,7 +263,7 @@ impl ApplicationHandler for Viewer {
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         let Some(g) = &self.gfx else { return };
         let surface_size = (g.surface_config.width, g.surface_config.height);
-        let targets_size = g.targets.size;
+        let targets_size = g.targets.size();
         let now = Instant::now();
         let mut wake: Option<Instant> = None;
         if let Some(t) = self.resized_at {
@@ -409,7 +409,7 @@ impl Viewer {
         };
         let gfx = Gfx::open(window, event_loop.owned_display_handle(), &self.baked, play)
             .with_context(|| format!("playing {}", self.path.display()))?;
-        self.print_warnings(gfx.targets.player.warnings());
+        self.print_warnings(gfx.targets.player().warnings());
         Ok(gfx)
     }
 
@@ -417,7 +417,7 @@ impl Viewer {
     fn rebuild(&mut self, size: (u32, u32)) -> Result<()> {
         let g = self.gfx.as_mut().expect("rebuild after open");
         g.rebuild(&self.baked, size)?;
-        let warnings = g.targets.player.warnings().to_vec();
+        let warnings = g.targets.player().warnings().to_vec();
         self.print_warnings(&warnings);
         Ok(())
     }
