@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Makes sure the web player can be built and tested: the wasm32 target, the wasm-bindgen CLI
+# of the version web/Cargo.toml pins (from crates.io), and, with --browser, Debian's Chromium
+# and Node.js/npm (for playwright-core). Installs what is missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+want=$(sed -n 's/^wasm-bindgen = "=\([0-9.]*\)".*/\1/p' web/Cargo.toml)
+if ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown; then
+  echo "trisort: installing the wasm32-unknown-unknown target" >&2
+  rustup target add wasm32-unknown-unknown
+fi
+if [ "$(wasm-bindgen --version 2>/dev/null | awk '{print $2}')" != "$want" ]; then
+  echo "trisort: installing wasm-bindgen-cli $want from crates.io (a few minutes, once)" >&2
+  cargo install --quiet wasm-bindgen-cli --version "=$want"
+fi
+if [ "${1:-}" = "--browser" ]; then
+  missing=()
+  command -v chromium >/dev/null || missing+=(chromium)
+  command -v node >/dev/null || missing+=(nodejs)
+  command -v npm >/dev/null || missing+=(npm)
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "trisort: installing ${missing[*]}" >&2
+    SUDO=""; if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+    export DEBIAN_FRONTEND=noninteractive
+    $SUDO apt-get update -qq
+    $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  fi
+  if [ ! -d web/test/node_modules/playwright-core ]; then
+    echo "trisort: installing playwright-core (npm) into web/test/node_modules" >&2
+    (cd web/test && npm install --no-audit --no-fund --silent)
+  fi
+fi

@@ -1,0 +1,251 @@
+//! The wasm side: [`WebPlayer`], exported to the page with wasm-bindgen.
+
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+
+use trisort_format::{Baked, DeviceLimits, Mode};
+use trisort_gpu::present::{configure_surface, Blit};
+use trisort_gpu::Gpu;
+use trisort_player::{OnScreen, OnScreenSettings};
+use wasm_bindgen::prelude::*;
+
+use crate::{BrowserBackend, FrameFigures};
+
+/// Reports a Rust panic on the browser console instead of an opaque "unreachable".
+#[wasm_bindgen(start)]
+fn start() {
+    std::panic::set_hook(Box::new(|info| {
+        web_sys::console::error_1(&format!("trisort: {info}").into());
+    }));
+}
+
+/// A baked file playing on a canvas: the device, the canvas's surface, and the player
+/// drawing into its off-screen frame, copied to the canvas each [`WebPlayer::render`].
+#[wasm_bindgen]
+pub struct WebPlayer {
+    gpu: Gpu,
+    surface: wgpu::Surface<'static>,
+    surface_config: wgpu::SurfaceConfiguration,
+    view_format: wgpu::TextureFormat,
+    blit: Blit,
+    on_screen: OnScreen,
+    backend: &'static str,
+    warnings: Vec<String>,
+    uncaptured: Arc<Mutex<Option<String>>>,
+}
+
+fn js_error(e: impl std::fmt::Display) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+#[wasm_bindgen]
+impl WebPlayer {
+    /// Decodes `bytes` (a baked file; `name` names it in errors), sizes `canvas` to the
+    /// recorded size, and opens a device on `backend` (`auto`, `webgpu`, `webgl2`) that draws
+    /// into it in `mode` (`blend`, `depth`, `saturate`) at the recorded sample count.
+    pub async fn open(
+        canvas: web_sys::HtmlCanvasElement,
+        bytes: Vec<u8>,
+        name: String,
+        backend: String,
+        mode: String,
+    ) -> Result<WebPlayer, JsError> {
+        let backend: BrowserBackend = backend.parse().map_err(|e: String| JsError::new(&e))?;
+        let mode: Mode = mode.parse().map_err(js_error)?;
+        let baked: Baked =
+            trisort_player::baked_from_bytes(&bytes, Path::new(&name)).map_err(js_error)?;
+        drop(bytes);
+        let (width, height) = (baked.settings.width.max(1), baked.settings.height.max(1));
+        canvas.set_width(width);
+        canvas.set_height(height);
+
+        let (instance, backend_name) = instance_for(backend).await?;
+        let surface = instance
+            .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
+            .map_err(|e| js_error(format!("{backend_name} surface for the canvas: {e}")))?;
+        let gpu = Gpu::open_async(
+            &instance,
+            Some(&surface),
+            "trisort web",
+            DeviceLimits::Adapter,
+        )
+        .await
+        .map_err(js_error)?;
+        let uncaptured = Arc::new(Mutex::new(None::<String>));
+        {
+            let slot = uncaptured.clone();
+            gpu.device
+                .on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+                    let mut slot = slot.lock().unwrap_or_else(|p| p.into_inner());
+                    slot.get_or_insert_with(|| e.to_string());
+                }));
+        }
+        let setup = configure_surface(&gpu, &surface, (width, height)).map_err(js_error)?;
+        let blit = Blit::new(&gpu.device, setup.view_format, mode);
+        let settings = OnScreenSettings::recorded(&baked, mode);
+        let on_screen =
+            OnScreen::new(&gpu, &baked, &blit, (width, height), settings).map_err(js_error)?;
+        let warnings = on_screen.player().warnings().to_vec();
+        Ok(WebPlayer {
+            gpu,
+            surface,
+            surface_config: setup.config,
+            view_format: setup.view_format,
+            blit,
+            on_screen,
+            backend: backend_name,
+            warnings,
+            uncaptured,
+        })
+    }
+
+    /// Draws frame `frame` and presents it on the canvas. The canvas holds the frame until the
+    /// page's task ends, so a caller can copy it (`drawImage`) right after this returns.
+    pub fn render(&mut self, frame: u32) -> Result<(), JsError> {
+        let texture = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface
+                    .configure(&self.gpu.device, &self.surface_config);
+                match self.surface.get_current_texture() {
+                    wgpu::CurrentSurfaceTexture::Success(t)
+                    | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+                    _ => return Err(JsError::new("the canvas's surface is unavailable")),
+                }
+            }
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(());
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                return Err(js_error(format!(
+                    "wgpu: {}",
+                    self.take_uncaptured().unwrap_or_default()
+                )))
+            }
+        };
+        let view = texture.texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(self.view_format),
+            ..Default::default()
+        });
+        let mut enc = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("trisort web frame"),
+            });
+        self.on_screen
+            .encode(&mut enc, &self.blit, &view, frame)
+            .map_err(js_error)?;
+        self.gpu.queue.submit([enc.finish()]);
+        if let Some(e) = self.take_uncaptured() {
+            return Err(js_error(format!("wgpu: {e}")));
+        }
+        self.gpu.queue.present(texture);
+        Ok(())
+    }
+
+    /// Frames in the file.
+    pub fn frame_count(&self) -> u32 {
+        self.on_screen.player().frame_count()
+    }
+
+    /// The canvas width (the recorded width).
+    pub fn width(&self) -> u32 {
+        self.on_screen.size().0
+    }
+
+    /// The canvas height (the recorded height).
+    pub fn height(&self) -> u32 {
+        self.on_screen.size().1
+    }
+
+    /// Triangles frame `frame` draws (0 beyond the last frame).
+    pub fn frame_triangles(&self, frame: u32) -> f64 {
+        if frame >= self.frame_count() {
+            return 0.0;
+        }
+        self.on_screen.player().frame_triangles(frame) as f64
+    }
+
+    /// Draw calls frame `frame` issues on this path (ranges of its window).
+    pub fn frame_draws(&self, frame: u32) -> u32 {
+        if frame >= self.frame_count() {
+            return 0;
+        }
+        self.on_screen.player().frame_commands(frame).len() as u32
+    }
+
+    /// The figures line the page shows for `frame`, drawn in `ms` milliseconds.
+    pub fn figures(&self, frame: u32, ms: f64) -> String {
+        FrameFigures {
+            frame,
+            frames: self.frame_count(),
+            triangles: self.frame_triangles(frame) as u64,
+            draws: self.frame_draws(frame),
+            ms,
+        }
+        .to_string()
+    }
+
+    /// `WebGPU` or `WebGL2`.
+    pub fn backend(&self) -> String {
+        self.backend.to_string()
+    }
+
+    /// The adapter, as the browser names it.
+    pub fn adapter(&self) -> String {
+        self.gpu.describe()
+    }
+
+    /// How draws are issued: `multi-draw-indirect` or `direct` (one `draw_indexed` per range).
+    pub fn draw_path(&self) -> String {
+        self.on_screen
+            .player()
+            .config()
+            .draw_path
+            .name()
+            .to_string()
+    }
+
+    /// How node matrices and materials are bound: `storage` or `textures`.
+    pub fn bindings(&self) -> String {
+        self.on_screen.player().bindings().name().to_string()
+    }
+
+    /// What makes this playback inexact (another device than the recording's, …).
+    pub fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
+    }
+
+    fn take_uncaptured(&self) -> Option<String> {
+        self.uncaptured
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .take()
+    }
+}
+
+/// The instance for `backend`, and the API's name. `Auto` asks the browser for a WebGPU
+/// adapter first and falls back to WebGL2 without touching the canvas.
+async fn instance_for(backend: BrowserBackend) -> Result<(wgpu::Instance, &'static str), JsError> {
+    let webgl2 = || {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::GL;
+        (wgpu::Instance::new(desc), "WebGL2")
+    };
+    let webgpu = || {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::BROWSER_WEBGPU;
+        (wgpu::Instance::new(desc), "WebGPU")
+    };
+    match backend {
+        BrowserBackend::WebGl2 => Ok(webgl2()),
+        BrowserBackend::WebGpu if wgpu::util::is_browser_webgpu_supported().await => Ok(webgpu()),
+        BrowserBackend::WebGpu => Err(JsError::new(
+            "this browser offers no WebGPU adapter (try ?backend=webgl2)",
+        )),
+        BrowserBackend::Auto if wgpu::util::is_browser_webgpu_supported().await => Ok(webgpu()),
+        BrowserBackend::Auto => Ok(webgl2()),
+    }
+}

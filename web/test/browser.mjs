@@ -1,0 +1,154 @@
+// Plays a baked file in Debian's headless Chromium (WebGL2 on SwiftShader, or WebGPU when
+// asked and offered) through the web player page, reads chosen frames back from the canvas,
+// and compares each with the native player's PNG of the same frame.
+//
+//   node web/test/browser.mjs --dist web/dist --native DIR --frames 0,12,24 --out DIR
+//        [--backend webgl2] [--mode blend] [--chromium /usr/bin/chromium]
+//
+// Writes the browser's frames as DIR/frame-NNNNN.png (for `trisort verify --frames-dir`) and
+// prints one JSON object: the device, and per frame pixels differing from the native frame
+// and the largest channel difference. Exit 0 when it ran; the caller gates the figures.
+import { createServer } from "node:http";
+import { readFile, writeFile, mkdir } from "node:fs/promises";
+import { extname, join, normalize } from "node:path";
+import { chromium } from "playwright-core";
+
+function args() {
+  const a = { backend: "webgl2", mode: "blend", chromium: "/usr/bin/chromium" };
+  const argv = process.argv.slice(2);
+  for (let i = 0; i < argv.length; i += 2) a[argv[i].replace(/^--/, "")] = argv[i + 1];
+  for (const k of ["dist", "native", "frames", "out"]) {
+    if (!a[k]) throw new Error(`missing --${k}`);
+  }
+  a.frames = a.frames.split(",").map(Number);
+  return a;
+}
+
+const TYPES = {
+  ".html": "text/html", ".js": "text/javascript", ".wasm": "application/wasm",
+  ".png": "image/png", ".baked": "application/octet-stream",
+};
+
+// A static server: / is the page's folder, /native/ the native frames.
+function serve(dist, native) {
+  const server = createServer(async (req, res) => {
+    const url = new URL(req.url, "http://x");
+    let path = decodeURIComponent(url.pathname);
+    const root = path.startsWith("/native/") ? native : dist;
+    if (path.startsWith("/native/")) path = path.slice("/native".length);
+    if (path === "/") path = "/index.html";
+    const file = join(root, normalize(path).replace(/^(\.\.[/\\])+/, ""));
+    try {
+      const body = await readFile(file);
+      res.writeHead(200, { "content-type": TYPES[extname(file)] || "application/octet-stream" });
+      res.end(body);
+    } catch {
+      res.writeHead(404);
+      res.end("not found");
+    }
+  });
+  return new Promise((ok) => server.listen(0, "127.0.0.1", () => ok(server)));
+}
+
+const a = args();
+const server = await serve(a.dist, a.native);
+const port = server.address().port;
+const browser = await chromium.launch({
+  executablePath: a.chromium,
+  headless: true,
+  args: [
+    "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+    "--ignore-gpu-blocklist", "--enable-unsafe-webgpu", "--disable-background-networking",
+    "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
+    "--force-color-profile=srgb",
+  ],
+});
+let failed = null;
+try {
+  const page = await browser.newPage({ viewport: { width: 800, height: 800 }, deviceScaleFactor: 1 });
+  // A hung page (a GPU process that never answers) fails the test instead of stalling CI.
+  page.setDefaultTimeout(Number(a.timeout || 120) * 1000);
+  const logs = [];
+  page.on("console", (m) => logs.push(`${m.type()}: ${m.text()}`));
+  page.on("pageerror", (e) => logs.push(`pageerror: ${e.message}`));
+  // A panic in the wasm player leaves its promises unsettled: fail at the first page error.
+  const pageError = new Promise((_, reject) =>
+    page.on("pageerror", (e) => reject(new Error(`page error: ${e.message}\n${logs.join("\n")}`))));
+  pageError.catch(() => {});
+  const guard = (p) => Promise.race([p, pageError]);
+  await page.goto(`http://127.0.0.1:${port}/index.html?backend=${a.backend}&mode=${a.mode}&test=1`);
+  try {
+    await guard(page.waitForFunction(() => window.trisort && window.trisort.ready));
+    await guard(page.evaluate(() => window.trisort.ready.then(() => true)));
+  } catch (e) {
+    throw new Error(`the page did not open the bake: ${e.message}\n${logs.join("\n")}`);
+  }
+  const device = await page.evaluate(() => {
+    const p = window.trisort.state.player;
+    return {
+      backend: p.backend(), adapter: p.adapter(), bindings: p.bindings(),
+      draw_path: p.draw_path(), frames: p.frame_count(), width: p.width(), height: p.height(),
+      user_agent: navigator.userAgent,
+    };
+  });
+  await mkdir(a.out, { recursive: true });
+  const frames = [];
+  for (const frame of a.frames) {
+    const r = await guard(page.evaluate(async (frame) => {
+      const name = `frame-${String(frame).padStart(5, "0")}.png`;
+      const t = window.trisort;
+      const ms = t.renderFrame(frame);
+      // Copy the canvas in the same task as the draw, while its drawing buffer holds the frame.
+      const gl = document.getElementById("canvas");
+      const w = gl.width, h = gl.height;
+      const got = new OffscreenCanvas(w, h).getContext("2d", { colorSpace: "srgb" });
+      got.drawImage(gl, 0, 0);
+      const ours = got.getImageData(0, 0, w, h).data;
+      const resp = await fetch(`/native/${name}`);
+      if (!resp.ok) throw new Error(`native frame ${name}: HTTP ${resp.status}`);
+      const bmp = await createImageBitmap(await resp.blob(), {
+        colorSpaceConversion: "none", premultiplyAlpha: "none",
+      });
+      if (bmp.width !== w || bmp.height !== h) {
+        throw new Error(`native ${name} is ${bmp.width}x${bmp.height}, the canvas ${w}x${h}`);
+      }
+      const ref = new OffscreenCanvas(w, h).getContext("2d", { colorSpace: "srgb" });
+      ref.drawImage(bmp, 0, 0);
+      const theirs = ref.getImageData(0, 0, w, h).data;
+      // Any difference, and differences above 1/255 (the GPU's sRGB encoding at the copy to
+      // the canvas rounds where the native player's CPU quantisation may round the other way).
+      let differing = 0, over1 = 0, maxDiff = 0;
+      for (let i = 0; i < ours.length; i += 4) {
+        let d = 0;
+        for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(ours[i + c] - theirs[i + c]));
+        if (d > 0) differing++;
+        if (d > 1) over1++;
+        maxDiff = Math.max(maxDiff, d);
+      }
+      const blob = await got.canvas.convertToBlob({ type: "image/png" });
+      const png = Array.from(new Uint8Array(await blob.arrayBuffer()));
+      return {
+        frame, ms, triangles: t.state.player.frame_triangles(frame),
+        draws: t.state.player.frame_draws(frame), pixels: w * h,
+        pixels_differing_native: differing, pixels_over_1_native: over1,
+        max_channel_diff_native: maxDiff, png, name,
+      };
+    }, frame));
+    await writeFile(join(a.out, r.name), Buffer.from(r.png));
+    delete r.png;
+    delete r.name;
+    frames.push(r);
+    if (process.env.TRISORT_WEB_VERBOSE) console.error(`frame ${frame}: ${r.pixels_differing_native} px differ`);
+  }
+  const errors = logs.filter((l) => l.startsWith("error") || l.startsWith("pageerror"));
+  console.log(JSON.stringify({ device, frames, console_errors: errors }, null, 1));
+} catch (e) {
+  failed = e;
+} finally {
+  await browser.close();
+  server.close();
+}
+if (failed) {
+  console.error(`browser test: ${failed.message}`);
+  process.exit(1);
+}
