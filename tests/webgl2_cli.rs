@@ -112,3 +112,36 @@ fn gl_player_samples_a_one_texture_scene_like_vulkan() {
         }
     }
 }
+
+/// `bench --limits webgl2` adds `merged_device`: the bake played on the GLES 3.0 / WebGL2
+/// path, timed and checked against the exact reference like `merged`.
+#[test]
+fn bench_plays_merged_on_the_webgl2_path_too() {
+    let Some(dir) = gpu_tempdir() else { return };
+    let d = dir.path();
+    let b = run_json(
+        d,
+        &args(
+            "bench demo:3000 --path orbit:frames=2 --size 48x48 --samples 4 --mode blend \
+             --methods merged --repeats 1 --limits webgl2 --out b",
+        ),
+    );
+    let rows = b["groups"][0]["rows"].as_array().unwrap();
+    let row = |name: &str| {
+        rows.iter()
+            .find(|r| r["method"] == name)
+            .unwrap_or_else(|| panic!("no {name} row: {b}"))
+    };
+    let device = row("merged_device");
+    let variant = device["variant"].as_str().unwrap();
+    assert!(
+        variant.contains("textures bindings") && variant.contains("direct draws"),
+        "{variant}"
+    );
+    assert_eq!(row("merged")["error"]["frames_exact"], 2, "{b}");
+    assert_eq!(device["error"]["frames_exact"], 2, "{b}");
+    assert!(
+        b["methods"]["merged_device"]["ms_per_frame"].is_number(),
+        "{b}"
+    );
+}

@@ -143,7 +143,7 @@ impl<'g> PlayerMethod<'g> {
             size: view.size,
             mode,
             glass_opacity: Some(view.glass_opacity),
-            draw_path: DrawPath::for_adapter(&gpu.adapter),
+            draw_path: DrawPath::for_device(&gpu.adapter, &gpu.device),
             device: None,
         };
         let player = Player::new(&gpu.device, &gpu.queue, baked, config)?;

@@ -9,7 +9,7 @@
 use serde::Serialize;
 use trisort_format::{Baked, FrameState, Geometry};
 use trisort_gpu::Gpu;
-use trisort_player::Mode;
+use trisort_player::{config::DrawPath, Mode};
 use trisort_reference::{compare, ExactReference, ReferenceConfig, ReferenceError, UnorderedEdges};
 
 use crate::harness::{pipeline_statistics, time_methods, FragmentCounter, Summary, Timing};
@@ -91,6 +91,9 @@ pub struct GroupInput<'a> {
     pub repeats: u32,
     /// Also time `merged` on a device with wgpu's indirect-call validation off.
     pub unvalidated: Option<&'a Gpu>,
+    /// Also play `merged` on this device (`bench --backend/--limits`): the method
+    /// `merged_device`, on the tier and draw path the device allows.
+    pub other_device: Option<&'a Gpu>,
 }
 
 /// Error of one method's frames against the exact reference.
@@ -284,6 +287,23 @@ fn build_methods<'a>(
                     methods.push(Box::new(PlayerMethod::new(
                         "merged_unvalidated",
                         "indirect validation off".into(),
+                        g,
+                        input.baked,
+                        mode,
+                        view,
+                    )?));
+                }
+                if let Some(g) = input.other_device {
+                    let tier = trisort_gpu::Bindings::for_limits(&g.device.limits());
+                    let path = DrawPath::for_device(&g.adapter, &g.device);
+                    methods.push(Box::new(PlayerMethod::new(
+                        "merged_device",
+                        format!(
+                            "{:?} backend, {} bindings, {} draws",
+                            g.info.backend,
+                            tier.name(),
+                            path.name()
+                        ),
                         g,
                         input.baked,
                         mode,

@@ -69,6 +69,11 @@ pub struct BenchArgs {
     /// Skip timing `merged` with wgpu's indirect-call validation off.
     #[arg(long)]
     no_unvalidated: bool,
+    /// `--backend`/`--limits` other than auto/default: `merged` is also played on that device
+    /// (gl: OpenGL/GLES through EGL; webgl2: the player's GLES 3.0 / WebGL2 path), as the
+    /// method `merged_device`; baking, the reference and the rivals stay on the default device.
+    #[command(flatten)]
+    device: crate::cmd::play::DeviceArgs,
     /// Output folder: bench.json, bench.csv, bench.md, SVG plots, and the bakes (reused by a
     /// later run with the same scene, path and settings).
     #[arg(long, default_value = "bench-out")]
@@ -271,6 +276,20 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
                 .context("opening a second device with indirect validation off")?,
         )
     };
+    let other = if a.device.options() == trisort_gpu::GpuOptions::default()
+        || !a.methods.contains(&MethodKind::Merged)
+    {
+        None
+    } else {
+        let g = crate::common::open_gpu_with(a.device.options()).with_context(|| {
+            format!(
+                "opening the --backend {} --limits {} device",
+                a.device.backend, a.device.limits
+            )
+        })?;
+        say(&format!("merged_device plays on {}", g.describe()));
+        Some(g)
+    };
     say(&format!(
         "{} on {}: {} frames measured of {}, {} repeats",
         a.scene,
@@ -303,6 +322,7 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
                 frames: &frames,
                 repeats: a.repeats,
                 unvalidated: unvalidated.as_ref(),
+                other_device: other.as_ref(),
             };
             let label = format!("{}x {}", b.samples, mode.name());
             groups.push(run_group(&gpu, &input, &|m| {
