@@ -113,6 +113,48 @@ impl Bindings {
             Bindings::Textures => "textures",
         }
     }
+
+    /// Whether `frames` frames of `geometry` fit this tier on a device with `limits`: on
+    /// [`Bindings::Textures`], the node matrices of every frame (4 texels a node) and the
+    /// materials must fit in data textures [`DATA_WIDTH`] texels wide and at most
+    /// `max_texture_dimension_2d` rows (2,048 on WebGL2's minimum). The error says what
+    /// does not fit and by how much.
+    pub fn check_fits(
+        self,
+        limits: &wgpu::Limits,
+        geometry: &Geometry,
+        frames: usize,
+    ) -> Result<(), String> {
+        if self == Bindings::Storage {
+            return Ok(());
+        }
+        let max = limits.max_texture_dimension_2d as u64;
+        if (DATA_WIDTH as u64) > max {
+            return Err(format!(
+                "the device's largest texture is {max} texels wide; the data textures need {DATA_WIDTH}"
+            ));
+        }
+        let rows = |texels: u64| texels.div_ceil(DATA_WIDTH as u64).max(1);
+        let nodes = geometry.nodes.len().max(1) as u64;
+        let node_rows = rows(frames.max(1) as u64 * nodes * 4);
+        if node_rows > max {
+            return Err(format!(
+                "{frames} frames of {nodes} node matrices need {node_rows} rows of node data and \
+                 the device allows {max}: play a shorter path per file (record --frames), or \
+                 fewer animated nodes"
+            ));
+        }
+        let material_texels = (std::mem::size_of::<MaterialGpu>() as u64 / 16)
+            * geometry.materials.len().max(1) as u64;
+        if rows(material_texels) > max {
+            return Err(format!(
+                "{} materials need {} rows of material data and the device allows {max}",
+                geometry.materials.len(),
+                rows(material_texels)
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Texels per row of the data textures of [`Bindings::Textures`] (`DATA_WIDTH` in the WGSL).

@@ -24,6 +24,10 @@ pub enum PlayerError {
         /// Frames in the file.
         frames: u32,
     },
+    /// The file does not fit the device's binding tier (e.g. too many frames × nodes for the
+    /// data textures of a WebGL2-class device).
+    #[error("this baked file does not fit the device: {0}")]
+    DeviceTooSmall(String),
     /// `depth` mode without a depth attachment format.
     #[error("depth mode needs a depth attachment: set PlayerConfig::depth_format")]
     DepthFormatMissing,

@@ -107,6 +107,9 @@ impl Player {
             glass_opacity: config.glass_opacity_for(baked),
         };
         let bindings = Bindings::for_limits(&device.limits());
+        bindings
+            .check_fits(&device.limits(), &baked.geometry, baked.frame_states.len())
+            .map_err(PlayerError::DeviceTooSmall)?;
         let scene = SceneGpu::with_bindings(
             device,
             queue,
