@@ -10,6 +10,7 @@ mod bake_play_cli;
 mod bench_cli;
 mod c_host;
 mod cli_basics;
+mod compressed_gltf;
 mod export_order;
 mod extremes;
 mod extremes_no_lost_work;

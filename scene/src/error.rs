@@ -103,6 +103,16 @@ pub enum SceneError {
         /// Primitive index within the mesh.
         primitive: usize,
     },
+    /// The file requires (`extensionsRequired`) a glTF extension trisort does not implement.
+    #[error("{}: unsupported extension {name}: {hint}", file.display())]
+    UnsupportedExtension {
+        /// The glTF file.
+        file: PathBuf,
+        /// The extension's name.
+        name: String,
+        /// What to do about it.
+        hint: String,
+    },
     /// The file is valid but uses something trisort cannot import.
     #[error("{}: unsupported: {problem}", file.display())]
     Unsupported {

@@ -8,3 +8,4 @@ mod demo_car;
 mod import;
 mod import_bad_input;
 mod import_built;
+mod import_compressed;

@@ -5,6 +5,9 @@
 //!   `TRISORT_REQUIRE_GPU=1` (CI) makes that a failure;
 //! - [`scene_path`]: a shared test scene, or a skip where it is missing, unless
 //!   `TRISORT_REQUIRE_SCENES=1` (CI) makes that a failure;
+//! - [`gltfpack`]: meshoptimizer's glTF packer (to make compressed, quantized test scenes at
+//!   test time), or a skip where it is missing, unless `TRISORT_REQUIRE_GLTFPACK=1` (CI, after
+//!   `scripts/ensure-gltfpack.sh`) makes that a failure;
 //! - [`fixtures`]: small hand-built scenes with known answers.
 //!
 //! A crate's own unit tests (`#[cfg(test)]` in its `src/`) cannot use this crate where this
@@ -66,5 +69,44 @@ pub fn scene_path(rel: &str) -> Option<PathBuf> {
         "skipping: test scene {} not found (set {SCENES_ENV})",
         path.display()
     );
+    None
+}
+
+/// Environment variable naming the `gltfpack` executable; by default
+/// `<workspace>/target/tools/gltfpack/node_modules/.bin/gltfpack` (where
+/// `scripts/ensure-gltfpack.sh` installs the npm package), else `gltfpack` on the `PATH`.
+pub const GLTFPACK_ENV: &str = "TRISORT_GLTFPACK";
+
+/// Environment variable that, when `1` (CI sets it), turns a missing `gltfpack` into a test
+/// failure instead of a skip.
+pub const REQUIRE_GLTFPACK_ENV: &str = "TRISORT_REQUIRE_GLTFPACK";
+
+/// The `gltfpack` executable (see [`GLTFPACK_ENV`]), or `None` (the caller skips, printing
+/// why) where there is none, unless `TRISORT_REQUIRE_GLTFPACK=1`, in which case it panics.
+pub fn gltfpack() -> Option<PathBuf> {
+    let candidates = match std::env::var_os(GLTFPACK_ENV) {
+        Some(p) => vec![PathBuf::from(p)],
+        None => vec![
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../target/tools/gltfpack/node_modules/.bin/gltfpack"),
+            PathBuf::from("gltfpack"),
+        ],
+    };
+    for exe in &candidates {
+        let runs = std::process::Command::new(exe)
+            .arg("-v")
+            .output()
+            .is_ok_and(|o| {
+                let text = [o.stdout, o.stderr].concat();
+                String::from_utf8_lossy(&text).contains("gltfpack")
+            });
+        if runs {
+            return Some(exe.clone());
+        }
+    }
+    if std::env::var(REQUIRE_GLTFPACK_ENV).as_deref() == Ok("1") {
+        panic!("gltfpack not found ({candidates:?}) and {REQUIRE_GLTFPACK_ENV}=1; run scripts/ensure-gltfpack.sh");
+    }
+    eprintln!("skipping: gltfpack not found ({candidates:?}); run scripts/ensure-gltfpack.sh or set {GLTFPACK_ENV}");
     None
 }

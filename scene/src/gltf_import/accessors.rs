@@ -43,7 +43,11 @@ fn index_reader(kind: DataType) -> Option<fn(&[u8]) -> u32> {
 
 impl Importer<'_> {
     /// The bytes of a buffer view, checked against its buffer.
+    /// For a meshopt-compressed view, its decoded bytes.
     pub(super) fn view_bytes(&self, view: &gltf::buffer::View) -> Result<&[u8], String> {
+        if let Some(Some(decoded)) = self.decoded.get(view.index()) {
+            return Ok(decoded);
+        }
         let data = &self.buffers[view.buffer().index()];
         let start = view.offset();
         start

@@ -3,27 +3,72 @@
 
 use std::path::{Path, PathBuf};
 
+use super::meshopt::{self, Compression};
 use super::Importer;
 use crate::SceneError;
 
-/// Extensions whose content the importer uses.
+/// Extensions whose content the importer uses. A file may require these
+/// (`extensionsRequired`); requiring any other is an [`SceneError::UnsupportedExtension`].
 const HANDLED_EXTENSIONS: &[&str] = &[
     "KHR_materials_transmission",
     "KHR_materials_emissive_strength",
+    // Quantized attributes: the accessor reader converts every component type.
     "KHR_mesh_quantization",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
 ];
 
-/// Parses a file into its glTF document and, for GLB, its binary chunk.
-pub(super) fn parse<'a>(
-    bytes: &'a [u8],
-    file: &Path,
-) -> Result<(gltf::Document, Option<&'a [u8]>), SceneError> {
+/// What to do about a required extension trisort lacks.
+fn unsupported_hint(name: &str) -> String {
+    match name {
+        "KHR_draco_mesh_compression" => "trisort has no Draco decoder; convert the file without \
+            Draco first (with a Draco-capable glTF tool such as glTF-Transform or gltf-pipeline), \
+            then compress it with meshopt if you like (gltfpack -cc -i in.glb -o out.glb), which \
+            trisort reads"
+            .into(),
+        _ => "the file requires it and trisort does not implement it".into(),
+    }
+}
+
+/// A parsed file: its glTF document, for GLB its binary chunk, and its meshopt-compressed
+/// buffer views.
+pub(super) struct Parsed<'a> {
+    /// The document (validated by the `gltf` crate).
+    pub doc: gltf::Document,
+    /// The GLB binary chunk.
+    pub bin: Option<&'a [u8]>,
+    /// `EXT_meshopt_compression` / `KHR_meshopt_compression` views and fallback buffers.
+    pub compression: Compression,
+}
+
+/// Parses a file into its glTF document and, for GLB, its binary chunk. A required extension
+/// outside [`HANDLED_EXTENSIONS`] is an error naming it.
+pub(super) fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>, SceneError> {
     let (json, bin) = split_container(bytes, file)?;
     let json = json.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json);
-    let root = gltf::json::Root::from_slice(json).map_err(|e| SceneError::Malformed {
+    let mut root = gltf::json::Root::from_slice(json).map_err(|e| SceneError::Malformed {
         file: file.to_path_buf(),
         problem: format!("invalid JSON: {e}"),
     })?;
+    if let Some(name) =
+        (root.extensions_required.iter()).find(|e| !HANDLED_EXTENSIONS.contains(&e.as_str()))
+    {
+        return Err(SceneError::UnsupportedExtension {
+            file: file.to_path_buf(),
+            name: name.clone(),
+            hint: unsupported_hint(name),
+        });
+    }
+    // The `gltf` crate's validation refuses required extensions it does not know itself;
+    // these are handled here.
+    root.extensions_required
+        .retain(|e| gltf::json::extensions::ENABLED_EXTENSIONS.contains(&e.as_str()));
+    let compression =
+        if (root.extensions_used.iter()).any(|e| meshopt::EXTENSIONS.contains(&e.as_str())) {
+            meshopt::read(json, file)?
+        } else {
+            Compression::default()
+        };
     // gltf-json's validation indexes the POSITION accessor before checking that it exists
     // (gltf-json 1.4.1, mesh.rs); check it first so a dangling index is an error, not a panic.
     for (m, mesh) in root.meshes.iter().enumerate() {
@@ -47,7 +92,11 @@ pub(super) fn parse<'a>(
         file: file.to_path_buf(),
         problem: e.to_string(),
     })?;
-    Ok((doc, bin))
+    Ok(Parsed {
+        doc,
+        bin,
+        compression,
+    })
 }
 
 /// Splits a file into its JSON text and, for GLB, its binary chunk.
@@ -197,6 +246,8 @@ pub(super) fn read_uri(uri: &str, base: Option<&Path>) -> Result<Vec<u8>, String
 }
 
 impl Importer<'_> {
+    /// Reads every buffer (a meshopt fallback buffer without data of its own stays empty),
+    /// then decodes every meshopt-compressed buffer view.
     pub(super) fn load_buffers(&mut self, bin: Option<&[u8]>) -> Result<(), SceneError> {
         let mut bin = bin;
         for buffer in self.doc.buffers() {
@@ -205,6 +256,12 @@ impl Importer<'_> {
                 buffer: buffer.index(),
                 problem,
             };
+            let fallback = self.compression.fallback.get(buffer.index()) == Some(&true);
+            if fallback && matches!(buffer.source(), gltf::buffer::Source::Bin) {
+                // Its views are decoded from other buffers; it has no bytes of its own.
+                self.buffers.push(Vec::new());
+                continue;
+            }
             let data = match buffer.source() {
                 gltf::buffer::Source::Bin => bin
                     .take()
@@ -227,6 +284,49 @@ impl Importer<'_> {
                 )));
             }
             self.buffers.push(data);
+        }
+        self.decode_views()
+    }
+
+    /// Decodes the meshopt-compressed buffer views into [`Importer::decoded`].
+    fn decode_views(&mut self) -> Result<(), SceneError> {
+        let views = std::mem::take(&mut self.compression.views);
+        self.decoded = Vec::with_capacity(views.len());
+        for (i, v) in views.iter().enumerate() {
+            let Some(v) = v else {
+                self.decoded.push(None);
+                continue;
+            };
+            let err = |problem: String| SceneError::Malformed {
+                file: self.file.clone(),
+                problem: format!("buffer view {i}: {problem}"),
+            };
+            let declared = self.doc.views().nth(i).map(|view| view.length());
+            if declared != Some(v.decoded_len()) {
+                return Err(err(format!(
+                    "decodes to {} bytes, the view declares {declared:?}",
+                    v.decoded_len()
+                )));
+            }
+            let data = self.buffers.get(v.buffer).ok_or_else(|| {
+                err(format!(
+                    "compressed data in buffer {}, the file has {}",
+                    v.buffer,
+                    self.buffers.len()
+                ))
+            })?;
+            let compressed = (v.offset.checked_add(v.length))
+                .and_then(|end| data.get(v.offset..end))
+                .ok_or_else(|| {
+                    err(format!(
+                        "compressed bytes {}+{} exceed buffer {} of {} bytes",
+                        v.offset,
+                        v.length,
+                        v.buffer,
+                        data.len()
+                    ))
+                })?;
+            self.decoded.push(Some(v.decode(compressed).map_err(err)?));
         }
         Ok(())
     }

@@ -30,6 +30,14 @@
 //!   values (LINEAR, STEP, CUBICSPLINE); morph-weight channels are skipped with a note.
 //! - **Cameras**: perspective cameras on nodes of the scene; orthographic ones are noted and
 //!   skipped.
+//! - **Compression and quantization**: quantized attributes (`KHR_mesh_quantization`: any
+//!   component type, normalized or not, with gltfpack's dequantizing node transforms) and
+//!   meshopt-compressed buffer views (`EXT_meshopt_compression`, `KHR_meshopt_compression`,
+//!   decoded by meshoptimizer; their fallback buffers need no data), see `meshopt.rs`. A
+//!   file whose `extensionsRequired` names any other extension than these two, the
+//!   transmission and the emissive-strength one is refused with
+//!   [`SceneError::UnsupportedExtension`] naming it (for `KHR_draco_mesh_compression`, with
+//!   what to do: there is no Draco decoder here).
 //!
 //! # Triangle ids
 //!
@@ -63,6 +71,7 @@ mod animations;
 mod cameras;
 mod container;
 mod materials;
+mod meshopt;
 mod nodes;
 mod primitives;
 
@@ -126,12 +135,18 @@ pub fn load_slice_with_sources(
     bytes: &[u8],
     file: &Path,
 ) -> Result<(Scene, Vec<TriangleSource>), SceneError> {
-    let (doc, bin) = container::parse(bytes, file)?;
+    let container::Parsed {
+        doc,
+        bin,
+        compression,
+    } = container::parse(bytes, file)?;
     let mut importer = Importer {
         file: file.to_path_buf(),
         base: file.parent().map(Path::to_path_buf),
         doc: &doc,
         buffers: Vec::new(),
+        compression,
+        decoded: Vec::new(),
         notes: Vec::new(),
         sources: Vec::new(),
     };
@@ -164,6 +179,11 @@ struct Importer<'d> {
     doc: &'d gltf::Document,
     /// Every buffer's bytes, by buffer index.
     buffers: Vec<Vec<u8>>,
+    /// Meshopt-compressed buffer views and fallback buffers, as the JSON declares them.
+    compression: meshopt::Compression,
+    /// By buffer view index, the decoded bytes of a meshopt-compressed view (which stand for
+    /// the view's bytes).
+    decoded: Vec<Option<Vec<u8>>>,
     /// Warnings and notes for [`Scene::notes`].
     notes: Vec<String>,
     /// Per imported triangle, where it comes from.

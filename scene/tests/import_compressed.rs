@@ -1,0 +1,240 @@
+//! glTF as real pipelines deliver it (issue 17, part 2): CarConcept packed by gltfpack at test
+//! time (never committed) — quantized (`KHR_mesh_quantization`), meshopt-compressed
+//! (`EXT_meshopt_compression`, `-c`/`-cc`), with named nodes kept (`-kn`) — imports; a file
+//! that *requires* an extension trisort lacks is refused naming it.
+
+use std::path::{Path, PathBuf};
+
+use trisort_scene::{load, SceneError};
+
+/// CarConcept's triangles as gltfpack writes them: it welds vertices equal in every
+/// attribute and drops the 44 triangles that then repeat an index (all of zero area; 43 of
+/// them have two vertices equal in every attribute of the source file already).
+const PACKED_TRIANGLES: usize = 213_347 - 44;
+
+/// Runs gltfpack on `input` with `options`, writing `dir/name.glb`.
+fn pack(gltfpack: &Path, input: &Path, dir: &Path, name: &str, options: &[&str]) -> PathBuf {
+    let out = dir.join(format!("{name}.glb"));
+    let status = std::process::Command::new(gltfpack)
+        .arg("-i")
+        .arg(input)
+        .arg("-o")
+        .arg(&out)
+        .args(options)
+        .status()
+        .unwrap();
+    assert!(status.success(), "gltfpack {options:?} failed");
+    out
+}
+
+/// One corner of a triangle as exact bits: its position, uv, material and node.
+type Corner = ([u32; 3], [u32; 2], u32, u32);
+
+/// The geometry's triangles as a sorted list of [`Corner`] triples, each in its smallest
+/// rotation (the winding is kept): equal for two files that hold the same triangles in any
+/// order and rotation.
+fn triangle_set(g: &trisort_format::Geometry) -> Vec<[Corner; 3]> {
+    let mut out: Vec<[Corner; 3]> = (g.triangles.iter())
+        .map(|t| {
+            let c = t.map(|i| {
+                let v = &g.vertices[i as usize];
+                (
+                    v.position.map(f32::to_bits),
+                    v.uv.map(f32::to_bits),
+                    v.material,
+                    v.node,
+                )
+            });
+            (0..3)
+                .map(|k| [c[k], c[(k + 1) % 3], c[(k + 2) % 3]])
+                .min()
+                .unwrap()
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+#[test]
+fn gltfpack_outputs_of_car_concept_import() {
+    let Some(car) = trisort_testkit::scene_path("CarConcept/CarConcept.glb") else {
+        return;
+    };
+    let Some(gltfpack) = trisort_testkit::gltfpack() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // Unquantized and uncompressed: what the importer read before these extensions.
+    let plain = load(&pack(&gltfpack, &car, d, "noq", &["-noq"])).unwrap();
+    assert_eq!(plain.geometry.triangles.len(), PACKED_TRIANGLES);
+    let quantized = load(&pack(&gltfpack, &car, d, "q", &[])).unwrap();
+    assert_eq!(quantized.geometry.triangles.len(), PACKED_TRIANGLES);
+    for (name, options, base) in [
+        ("c", &["-c"][..], &quantized),
+        ("cc", &["-cc"][..], &quantized),
+    ] {
+        let scene = load(&pack(&gltfpack, &car, d, name, options)).unwrap();
+        // Meshopt's codecs are lossless, but gltfpack orders vertices and triangles (and
+        // rotates triangles) for them: the triangles are the quantized file's, bit for bit,
+        // as a set; normals and tangents, stored with the octahedral filter, may differ.
+        let (g, b) = (&scene.geometry, &base.geometry);
+        assert_eq!(g.nodes, b.nodes, "{name}");
+        assert_eq!(g.materials, b.materials, "{name}");
+        assert_eq!(triangle_set(g), triangle_set(b), "{name}");
+        for v in &g.vertices {
+            let length: f32 = v.normal.iter().map(|x| x * x).sum::<f32>().sqrt();
+            assert!((length - 1.0).abs() < 1e-3, "{name}: normal {:?}", v.normal);
+        }
+    }
+    hostile_meshopt_views_are_errors(&std::fs::read(d.join("cc.glb")).unwrap(), d);
+    // Named nodes kept: the car's 101 nodes are there again (gltfpack adds nodes of its own
+    // for the dequantizing transforms), with the same triangles.
+    for (name, options) in [("kn", &["-kn"][..]), ("cckn", &["-cc", "-kn"][..])] {
+        let scene = load(&pack(&gltfpack, &car, d, name, options)).unwrap();
+        assert_eq!(scene.geometry.triangles.len(), PACKED_TRIANGLES, "{name}");
+        let original = load(&car).unwrap();
+        for node in original
+            .geometry
+            .nodes
+            .iter()
+            .filter(|n| !n.name.is_empty())
+        {
+            assert!(
+                scene.geometry.nodes.iter().any(|m| m.name == node.name),
+                "{name}: node {:?} lost",
+                node.name
+            );
+        }
+    }
+}
+
+/// Replaces the JSON chunk of GLB `bytes` with `json` (padded with spaces).
+fn with_json(bytes: &[u8], json: &str) -> Vec<u8> {
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    let rest = &bytes[20 + word(12)..];
+    let mut json = json.as_bytes().to_vec();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + json.len() + rest.len()) as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(json);
+    out.extend(rest);
+    out
+}
+
+#[test]
+fn required_extensions_trisort_lacks_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("tri.gltf");
+    let gltf = |required: &str| {
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":[{required}],"extensionsRequired":[{required}],
+            "scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}}],
+            "buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}}]}}"#
+        )
+    };
+    for (required, hint) in [
+        ("\"KHR_draco_mesh_compression\"", "no Draco decoder"),
+        ("\"KHR_texture_basisu\"", "does not implement it"),
+        ("\"EXT_whatever\"", "does not implement it"),
+        (
+            "\"KHR_mesh_quantization\",\"EXT_lights_image_based\"",
+            "does not implement it",
+        ),
+    ] {
+        std::fs::write(&file, gltf(required)).unwrap();
+        let err = load(&file).unwrap_err();
+        let text = err.to_string();
+        assert!(
+            matches!(err, SceneError::UnsupportedExtension { .. }),
+            "{required}: {text}"
+        );
+        let name = required.rsplit('"').nth(1).unwrap();
+        assert!(text.contains("tri.gltf"), "{text}");
+        assert!(
+            text.contains(&format!("unsupported extension {name}")),
+            "{text}"
+        );
+        assert!(text.contains(hint), "{text}");
+        assert!(!text.contains("malformed"), "{text}");
+    }
+    // Required and handled: imports.
+    for required in ["\"KHR_mesh_quantization\"", "\"EXT_meshopt_compression\""] {
+        std::fs::write(&file, gltf(required)).unwrap();
+        let scene = load(&file).unwrap();
+        assert_eq!(scene.geometry.triangles.len(), 1, "{required}");
+    }
+}
+
+/// Every lie in a meshopt view's extension object is an error naming the file and the view,
+/// never a panic, an abort in meshoptimizer's decoders or a huge allocation.
+fn hostile_meshopt_views_are_errors(glb: &[u8], dir: &Path) {
+    let n = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&glb[20..20 + n]).unwrap();
+    let views = json["bufferViews"].as_array().unwrap();
+    let first = |mode: &str| {
+        (views.iter())
+            .position(|v| v["extensions"]["EXT_meshopt_compression"]["mode"] == mode)
+            .unwrap()
+    };
+    let (attributes, triangles) = (first("ATTRIBUTES"), first("TRIANGLES"));
+    type Lie = fn(&mut serde_json::Value);
+    let cases: [(usize, Lie, &str); 9] = [
+        (
+            attributes,
+            |e| e["count"] = (1u64 << 40).into(),
+            "cannot come from",
+        ),
+        (
+            attributes,
+            |e| e["byteStride"] = 3.into(),
+            "not a multiple of 4",
+        ),
+        (
+            attributes,
+            |e| e["byteStride"] = 260.into(),
+            "not a multiple of 4",
+        ),
+        (attributes, |e| e["mode"] = "FOO".into(), "unknown mode"),
+        (attributes, |e| e["buffer"] = 9.into(), "the file has 2"),
+        (
+            attributes,
+            |e| e["byteOffset"] = (1u64 << 40).into(),
+            "exceed buffer",
+        ),
+        (
+            triangles,
+            |e| e["filter"] = "OCTAHEDRAL".into(),
+            "does not apply",
+        ),
+        (triangles, |e| e["count"] = 4.into(), "not a multiple of 3"),
+        (
+            attributes,
+            |e| {
+                let half = e["byteLength"].as_u64().unwrap() / 2;
+                e["byteLength"] = half.into();
+            },
+            "does not decode",
+        ),
+    ];
+    for (view, lie, problem) in cases {
+        let mut json = json.clone();
+        lie(&mut json["bufferViews"][view]["extensions"]["EXT_meshopt_compression"]);
+        let file = dir.join("lie.glb");
+        std::fs::write(&file, with_json(glb, &json.to_string())).unwrap();
+        let err = load(&file).unwrap_err();
+        let text = err.to_string();
+        assert!(matches!(err, SceneError::Malformed { .. }), "{text}");
+        assert!(text.contains("lie.glb"), "{text}");
+        assert!(text.contains(&format!("buffer view {view}")), "{text}");
+        assert!(text.contains(problem), "{problem}: {text}");
+    }
+}
