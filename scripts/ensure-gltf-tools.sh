@@ -1,25 +1,33 @@
 #!/usr/bin/env bash
-# Makes sure gltfpack (meshoptimizer's glTF packer, npm package `gltfpack`, a WebAssembly
-# build run by Node.js) is installed where the tests look for it
-# (target/tools/gltfpack/node_modules/.bin/gltfpack, see testkit's `gltfpack()`): the
-# compressed-glTF import tests make meshopt-compressed, quantized copies of CarConcept with
-# it at test time. Installs Node.js/npm (Debian) and the pinned package when missing.
+# Makes sure the glTF tools the compressed-glTF import tests run at test time are installed
+# where the tests look for them (testkit's `gltfpack()` and `gltf_pipeline()`):
+# - gltfpack (meshoptimizer's packer, npm `gltfpack`, WebAssembly): quantized and
+#   meshopt-compressed copies of CarConcept, in target/tools/gltfpack;
+# - gltf-pipeline (Cesium's, npm `gltf-pipeline`, Draco through draco3d): a Draco-compressed
+#   copy, in target/tools/gltf-pipeline.
+# Installs Node.js/npm (Debian) and the pinned packages when missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-version=1.3.0
-dir=target/tools/gltfpack
-exe=$dir/node_modules/.bin/gltfpack
-if [ -x "$exe" ] && [ "$("$exe" -v 2>&1 | head -1)" = "gltfpack ${version%.0}" ]; then
-  exit 0
-fi
-if ! command -v npm >/dev/null || ! command -v node >/dev/null; then
-  echo "trisort: installing nodejs npm (for gltfpack)" >&2
-  SUDO=""; if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
-fi
-echo "trisort: installing gltfpack $version (npm) into $dir" >&2
-mkdir -p "$dir"
-npm install --prefix "$dir" --no-audit --no-fund --silent "gltfpack@$version"
-"$exe" -v
+need_npm() {
+  if ! command -v npm >/dev/null || ! command -v node >/dev/null; then
+    echo "trisort: installing nodejs npm (for the glTF tools)" >&2
+    SUDO=""; if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+    export DEBIAN_FRONTEND=noninteractive
+    $SUDO apt-get update -qq
+    $SUDO apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
+  fi
+}
+# install PACKAGE VERSION: npm install into target/tools/PACKAGE unless that version is there.
+install() {
+  local dir=target/tools/$1
+  if [ "$(node -p "require('./$dir/node_modules/$1/package.json').version" 2>/dev/null)" = "$2" ]; then
+    return 0
+  fi
+  need_npm
+  echo "trisort: installing $1 $2 (npm) into $dir" >&2
+  mkdir -p "$dir"
+  npm install --prefix "$dir" --no-audit --no-fund --silent "$1@$2"
+}
+command -v node >/dev/null || need_npm
+install gltfpack 1.3.0
+install gltf-pipeline 4.3.1

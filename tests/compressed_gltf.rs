@@ -1,10 +1,12 @@
-//! glTF as real pipelines deliver it (issue 17, part 2), end to end: CarConcept packed by
-//! gltfpack at test time — quantized (`KHR_mesh_quantization`), meshopt-compressed (`-cc`,
-//! `EXT_meshopt_compression`), named nodes kept (`-kn`) — is inspected and recorded like the
-//! original. The packed files hold 44 fewer triangles (gltfpack drops triangles that repeat a
-//! vertex after welding; see scene's `import_compressed`), and positions snap to gltfpack's
-//! 14-bit grid, so visible counts may move by a few triangles at silhouettes; the quantized
-//! file and its meshopt-compressed copy hold the same triangles and see the same counts.
+//! glTF as real pipelines deliver it (issue 17, part 2), end to end: CarConcept packed at test
+//! time by gltfpack — quantized (`KHR_mesh_quantization`), meshopt-compressed (`-cc`,
+//! `EXT_meshopt_compression`), named nodes kept (`-kn`) — and by gltf-pipeline
+//! (`KHR_draco_mesh_compression`, `-d`) is inspected and recorded like the original. The
+//! gltfpack files hold 44 fewer triangles (it drops triangles that repeat a vertex after
+//! welding), the Draco one 66 fewer (those with two corners at one position; see scene's
+//! `import_compressed`), and positions snap to a 14-bit (gltfpack) or 11-bit (Draco) grid, so
+//! visible counts may move by a few triangles at silhouettes; the quantized file and its
+//! meshopt-compressed copy hold the same triangles and see the same counts.
 
 use std::path::Path;
 
@@ -20,27 +22,31 @@ fn visible(d: &Path, rec: &str) -> (Vec<u64>, u64) {
 }
 
 #[test]
-fn gltfpack_compressed_car_concept_records_like_the_original() {
+fn compressed_car_concept_records_like_the_original() {
     let Some(car) = scene("CarConcept") else {
         return;
     };
     let Some(gltfpack) = trisort_testkit::gltfpack() else {
         return;
     };
+    let Some(pipeline) = trisort_testkit::gltf_pipeline() else {
+        return;
+    };
     let Some(dir) = gpu_tempdir() else { return };
     let d = dir.path();
     let mut counts = Vec::new();
-    for (name, options) in [
-        ("original", None),
-        ("q", Some(&[][..])),
-        ("cc", Some(&["-cc"][..])),
-        ("cckn", Some(&["-cc", "-kn"][..])),
+    for (name, tool, options, triangles) in [
+        ("original", None, &[][..], 213_347),
+        ("q", Some(&gltfpack), &[][..], 213_303),
+        ("cc", Some(&gltfpack), &["-cc"][..], 213_303),
+        ("cckn", Some(&gltfpack), &["-cc", "-kn"][..], 213_303),
+        ("draco", Some(&pipeline), &["-d"][..], 213_281),
     ] {
-        let file = match options {
+        let file = match tool {
             None => car.clone(),
-            Some(options) => {
+            Some(tool) => {
                 let out = d.join(format!("{name}.glb"));
-                let status = std::process::Command::new(&gltfpack)
+                let status = std::process::Command::new(tool)
                     .arg("-i")
                     .arg(&car)
                     .arg("-o")
@@ -48,12 +54,11 @@ fn gltfpack_compressed_car_concept_records_like_the_original() {
                     .args(options)
                     .status()
                     .unwrap();
-                assert!(status.success(), "gltfpack {options:?}");
+                assert!(status.success(), "{} {options:?}", tool.display());
                 out.display().to_string()
             }
         };
         let inspect = run_json(d, &["inspect", &file]);
-        let triangles = if options.is_none() { 213_347 } else { 213_303 };
         assert_eq!(inspect["triangles"], triangles, "{name}: {inspect}");
         let rec = format!("{name}.rec");
         run(

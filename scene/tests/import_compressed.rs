@@ -1,6 +1,7 @@
-//! glTF as real pipelines deliver it (issue 17, part 2): CarConcept packed by gltfpack at test
-//! time (never committed) — quantized (`KHR_mesh_quantization`), meshopt-compressed
-//! (`EXT_meshopt_compression`, `-c`/`-cc`), with named nodes kept (`-kn`) — imports; a file
+//! glTF as real pipelines deliver it (issue 17, part 2): CarConcept packed at test time (never
+//! committed) by gltfpack — quantized (`KHR_mesh_quantization`), meshopt-compressed
+//! (`EXT_meshopt_compression`, `-c`/`-cc`), with named nodes kept (`-kn`) — and by
+//! gltf-pipeline — Draco-compressed (`KHR_draco_mesh_compression`, `-d`) — imports; a file
 //! that *requires* an extension trisort lacks is refused naming it.
 
 use std::path::{Path, PathBuf};
@@ -12,10 +13,11 @@ use trisort_scene::{load, SceneError};
 /// them have two vertices equal in every attribute of the source file already).
 const PACKED_TRIANGLES: usize = 213_347 - 44;
 
-/// Runs gltfpack on `input` with `options`, writing `dir/name.glb`.
-fn pack(gltfpack: &Path, input: &Path, dir: &Path, name: &str, options: &[&str]) -> PathBuf {
+/// Runs `tool` (gltfpack or gltf-pipeline, which share `-i IN -o OUT`) on `input` with
+/// `options`, writing `dir/name.glb`.
+fn pack(tool: &Path, input: &Path, dir: &Path, name: &str, options: &[&str]) -> PathBuf {
     let out = dir.join(format!("{name}.glb"));
-    let status = std::process::Command::new(gltfpack)
+    let status = std::process::Command::new(tool)
         .arg("-i")
         .arg(input)
         .arg("-o")
@@ -23,7 +25,7 @@ fn pack(gltfpack: &Path, input: &Path, dir: &Path, name: &str, options: &[&str])
         .args(options)
         .status()
         .unwrap();
-    assert!(status.success(), "gltfpack {options:?} failed");
+    assert!(status.success(), "{} {options:?} failed", tool.display());
     out
 }
 
@@ -142,7 +144,10 @@ fn required_extensions_trisort_lacks_are_named() {
         )
     };
     for (required, hint) in [
-        ("\"KHR_draco_mesh_compression\"", "no Draco decoder"),
+        (
+            "\"KHR_draco_mesh_compression\",\"KHR_texture_basisu\"",
+            "does not implement it",
+        ),
         ("\"KHR_texture_basisu\"", "does not implement it"),
         ("\"EXT_whatever\"", "does not implement it"),
         (
@@ -167,7 +172,11 @@ fn required_extensions_trisort_lacks_are_named() {
         assert!(!text.contains("malformed"), "{text}");
     }
     // Required and handled: imports.
-    for required in ["\"KHR_mesh_quantization\"", "\"EXT_meshopt_compression\""] {
+    for required in [
+        "\"KHR_mesh_quantization\"",
+        "\"EXT_meshopt_compression\"",
+        "\"KHR_draco_mesh_compression\"",
+    ] {
         std::fs::write(&file, gltf(required)).unwrap();
         let scene = load(&file).unwrap();
         assert_eq!(scene.geometry.triangles.len(), 1, "{required}");
@@ -236,5 +245,135 @@ fn hostile_meshopt_views_are_errors(glb: &[u8], dir: &Path) {
         assert!(text.contains("lie.glb"), "{text}");
         assert!(text.contains(&format!("buffer view {view}")), "{text}");
         assert!(text.contains(problem), "{problem}: {text}");
+    }
+}
+
+#[test]
+fn draco_compressed_car_concept_imports() {
+    let Some(car) = trisort_testkit::scene_path("CarConcept/CarConcept.glb") else {
+        return;
+    };
+    let Some(pipeline) = trisort_testkit::gltf_pipeline() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let original = load(&car).unwrap();
+    let file = pack(&pipeline, &car, d, "draco", &["-d"]);
+    let scene = load(&file).unwrap();
+    // Draco's encoder drops the triangles with two corners at one position (66 in
+    // CarConcept); every other triangle is there, in the same nodes.
+    let g = &original.geometry;
+    let collapsed = (g.triangles.iter())
+        .filter(|t| {
+            let p = t.map(|i| g.vertices[i as usize].position);
+            p[0] == p[1] || p[1] == p[2] || p[0] == p[2]
+        })
+        .count();
+    assert_eq!(collapsed, 66);
+    assert_eq!(scene.geometry.triangles.len(), 213_347 - collapsed);
+    assert_eq!(scene.geometry.nodes, original.geometry.nodes);
+    // gltf-pipeline drops the 6 materials only KHR_materials_variants uses; the others keep
+    // what decides visibility (it rewrites the JSON, so other factors may differ in their
+    // last bits).
+    let visibility = |m: &trisort_format::Material| {
+        (
+            m.alpha_mode,
+            m.alpha_cutoff,
+            m.double_sided,
+            m.transmission > 0.0,
+        )
+    };
+    assert_eq!(scene.geometry.materials.len(), 23);
+    for m in &scene.geometry.materials {
+        let o = (original.geometry.materials.iter())
+            .find(|o| o.name == m.name)
+            .unwrap();
+        assert_eq!(visibility(m), visibility(o), "{}", m.name);
+    }
+    // Positions are quantized (gltf-pipeline's default: 11 bits per mesh): the car's bounds
+    // stay within 1/1000 of its size.
+    let (lo, hi) = original.bounds().unwrap();
+    let (dlo, dhi) = scene.bounds().unwrap();
+    let tolerance = (hi - lo).length() / 1000.0;
+    assert!(
+        (dlo - lo).length() < tolerance && (dhi - hi).length() < tolerance,
+        "{lo} {hi} vs {dlo} {dhi}"
+    );
+    hostile_draco_primitives_are_errors(&std::fs::read(&file).unwrap(), d);
+}
+
+/// A Draco primitive whose bitstream is cut or corrupt, or whose extension object or
+/// accessors disagree with it, is an error naming the file and the primitive, never a panic.
+fn hostile_draco_primitives_are_errors(glb: &[u8], dir: &Path) {
+    let n = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&glb[20..20 + n]).unwrap();
+    let prim = &json["meshes"][0]["primitives"][0];
+    let ext = &prim["extensions"]["KHR_draco_mesh_compression"];
+    let view = ext["bufferView"].as_u64().unwrap() as usize;
+    let position = prim["attributes"]["POSITION"].as_u64().unwrap() as usize;
+    type Lie = Box<dyn Fn(&mut serde_json::Value)>;
+    let cases: Vec<(Lie, &str)> = vec![
+        (
+            Box::new(move |j| {
+                let half = j["bufferViews"][view]["byteLength"].as_u64().unwrap() / 2;
+                j["bufferViews"][view]["byteLength"] = half.into();
+            }),
+            "does not decode",
+        ),
+        (
+            Box::new(move |j| j["bufferViews"][view]["byteLength"] = 7.into()),
+            "does not decode",
+        ),
+        (
+            Box::new(|j| {
+                j["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]
+                    ["attributes"]["POSITION"] = 99.into()
+            }),
+            "no attribute with id 99",
+        ),
+        (
+            Box::new(move |j| {
+                let count = j["accessors"][position]["count"].as_u64().unwrap();
+                j["accessors"][position]["count"] = (count + 1).into();
+            }),
+            "points",
+        ),
+        (
+            Box::new(|j| {
+                j["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]
+                    ["bufferView"] = "x".into()
+            }),
+            "bufferView is missing or not an index",
+        ),
+    ];
+    for (lie, problem) in cases {
+        let mut json = json.clone();
+        lie(&mut json);
+        let file = dir.join("lie.glb");
+        std::fs::write(&file, with_json(glb, &json.to_string())).unwrap();
+        let err = load(&file).unwrap_err();
+        let text = err.to_string();
+        assert!(matches!(err, SceneError::Malformed { .. }), "{text}");
+        assert!(text.contains("lie.glb"), "{text}");
+        assert!(text.contains("primitive 0"), "{text}");
+        assert!(text.contains(problem), "{problem}: {text}");
+    }
+    // Bytes of the bitstream overwritten: an error or (where Draco cannot tell) other
+    // geometry, never a panic.
+    let at = 20
+        + n
+        + 8
+        + json["bufferViews"][view]["byteOffset"]
+            .as_u64()
+            .unwrap_or(0) as usize;
+    for offset in [4, 16, 64, 256] {
+        let mut bytes = glb.to_vec();
+        bytes[at + offset..at + offset + 8].fill(0xA5);
+        let file = dir.join("flipped.glb");
+        std::fs::write(&file, bytes).unwrap();
+        if let Err(err) = load(&file) {
+            assert!(err.to_string().contains("flipped.glb"), "{err}");
+        }
     }
 }

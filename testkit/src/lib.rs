@@ -5,9 +5,9 @@
 //!   `TRISORT_REQUIRE_GPU=1` (CI) makes that a failure;
 //! - [`scene_path`]: a shared test scene, or a skip where it is missing, unless
 //!   `TRISORT_REQUIRE_SCENES=1` (CI) makes that a failure;
-//! - [`gltfpack`]: meshoptimizer's glTF packer (to make compressed, quantized test scenes at
-//!   test time), or a skip where it is missing, unless `TRISORT_REQUIRE_GLTFPACK=1` (CI, after
-//!   `scripts/ensure-gltfpack.sh`) makes that a failure;
+//! - [`gltfpack`], [`gltf_pipeline`]: glTF tools that make compressed, quantized test scenes
+//!   at test time, or a skip where they are missing, unless `TRISORT_REQUIRE_GLTF_TOOLS=1`
+//!   (CI, after `scripts/ensure-gltf-tools.sh`) makes that a failure;
 //! - [`fixtures`]: small hand-built scenes with known answers.
 //!
 //! A crate's own unit tests (`#[cfg(test)]` in its `src/`) cannot use this crate where this
@@ -72,41 +72,62 @@ pub fn scene_path(rel: &str) -> Option<PathBuf> {
     None
 }
 
-/// Environment variable naming the `gltfpack` executable; by default
-/// `<workspace>/target/tools/gltfpack/node_modules/.bin/gltfpack` (where
-/// `scripts/ensure-gltfpack.sh` installs the npm package), else `gltfpack` on the `PATH`.
-pub const GLTFPACK_ENV: &str = "TRISORT_GLTFPACK";
+/// Environment variable that, when `1` (CI sets it, after `scripts/ensure-gltf-tools.sh`),
+/// turns a missing [`gltfpack`] or [`gltf_pipeline`] into a test failure instead of a skip.
+pub const REQUIRE_GLTF_TOOLS_ENV: &str = "TRISORT_REQUIRE_GLTF_TOOLS";
 
-/// Environment variable that, when `1` (CI sets it), turns a missing `gltfpack` into a test
-/// failure instead of a skip.
-pub const REQUIRE_GLTFPACK_ENV: &str = "TRISORT_REQUIRE_GLTFPACK";
-
-/// The `gltfpack` executable (see [`GLTFPACK_ENV`]), or `None` (the caller skips, printing
-/// why) where there is none, unless `TRISORT_REQUIRE_GLTFPACK=1`, in which case it panics.
+/// meshoptimizer's glTF packer: `$TRISORT_GLTFPACK`, by default where
+/// `scripts/ensure-gltf-tools.sh` installs the npm package, else `gltfpack` on the `PATH`.
+/// `None` (the caller skips, printing why) where there is none, unless
+/// `TRISORT_REQUIRE_GLTF_TOOLS=1`, in which case it panics.
 pub fn gltfpack() -> Option<PathBuf> {
-    let candidates = match std::env::var_os(GLTFPACK_ENV) {
+    npm_tool("gltfpack", "TRISORT_GLTFPACK", &["-v"], "gltfpack")
+}
+
+/// Cesium's glTF pipeline (Draco compression): `$TRISORT_GLTF_PIPELINE`, by default where
+/// `scripts/ensure-gltf-tools.sh` installs the npm package, else `gltf-pipeline` on the
+/// `PATH`; skips or panics as [`gltfpack`] does.
+pub fn gltf_pipeline() -> Option<PathBuf> {
+    npm_tool(
+        "gltf-pipeline",
+        "TRISORT_GLTF_PIPELINE",
+        &["--help"],
+        "--draco",
+    )
+}
+
+/// The command-line tool `name` of the npm package of the same name: `$env`, else
+/// `<workspace>/target/tools/NAME/node_modules/.bin/NAME`, else `NAME` on the `PATH`; the
+/// first that runs with `probe` and prints `expect`.
+fn npm_tool(name: &str, env: &str, probe: &[&str], expect: &str) -> Option<PathBuf> {
+    let candidates = match std::env::var_os(env) {
         Some(p) => vec![PathBuf::from(p)],
         None => vec![
             Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../target/tools/gltfpack/node_modules/.bin/gltfpack"),
-            PathBuf::from("gltfpack"),
+                .join(format!("../target/tools/{name}/node_modules/.bin/{name}")),
+            PathBuf::from(name),
         ],
     };
     for exe in &candidates {
         let runs = std::process::Command::new(exe)
-            .arg("-v")
+            .args(probe)
             .output()
             .is_ok_and(|o| {
                 let text = [o.stdout, o.stderr].concat();
-                String::from_utf8_lossy(&text).contains("gltfpack")
+                String::from_utf8_lossy(&text).contains(expect)
             });
         if runs {
             return Some(exe.clone());
         }
     }
-    if std::env::var(REQUIRE_GLTFPACK_ENV).as_deref() == Ok("1") {
-        panic!("gltfpack not found ({candidates:?}) and {REQUIRE_GLTFPACK_ENV}=1; run scripts/ensure-gltfpack.sh");
+    if std::env::var(REQUIRE_GLTF_TOOLS_ENV).as_deref() == Ok("1") {
+        panic!(
+            "{name} not found ({candidates:?}) and {REQUIRE_GLTF_TOOLS_ENV}=1; run \
+             scripts/ensure-gltf-tools.sh"
+        );
     }
-    eprintln!("skipping: gltfpack not found ({candidates:?}); run scripts/ensure-gltfpack.sh or set {GLTFPACK_ENV}");
+    eprintln!(
+        "skipping: {name} not found ({candidates:?}); run scripts/ensure-gltf-tools.sh or set {env}"
+    );
     None
 }

@@ -166,6 +166,26 @@ impl Importer<'_> {
         Ok(out)
     }
 
+    /// An accessor of a Draco primitive that the primitive's bitstream did not give values
+    /// to has no data: an error rather than the bitstream's bytes.
+    fn check_not_placeholder(
+        &self,
+        accessor: &gltf::Accessor,
+        usage: &str,
+    ) -> Result<(), SceneError> {
+        if self.draco_placeholders.contains(&accessor.index()) {
+            return Err(SceneError::Accessor {
+                file: self.file.clone(),
+                accessor: accessor.index(),
+                usage: usage.to_string(),
+                problem: "has no buffer view, and its KHR_draco_mesh_compression primitive \
+                          does not carry it"
+                    .into(),
+            });
+        }
+        Ok(())
+    }
+
     /// Reads a float accessor of one of the given shapes; returns the flattened values.
     pub(super) fn read_floats(
         &self,
@@ -184,6 +204,10 @@ impl Importer<'_> {
                 ),
             });
         }
+        if let Some(values) = self.draco_floats.get(&accessor.index()) {
+            return Ok(values.clone());
+        }
+        self.check_not_placeholder(accessor, usage)?;
         let convert = float_reader(accessor.data_type(), accessor.normalized());
         self.read_components(accessor, usage, convert)
     }
@@ -202,6 +226,10 @@ impl Importer<'_> {
         accessor: &gltf::Accessor,
         usage: &str,
     ) -> Result<Vec<u32>, SceneError> {
+        if let Some(values) = self.draco_indices.get(&accessor.index()) {
+            return Ok(values.clone());
+        }
+        self.check_not_placeholder(accessor, usage)?;
         let convert = index_reader(accessor.data_type())
             .filter(|_| accessor.dimensions() == Dimensions::Scalar)
             .ok_or_else(|| SceneError::Accessor {

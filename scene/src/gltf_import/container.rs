@@ -3,6 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
+use std::collections::{BTreeMap, BTreeSet};
+
+use super::draco::{self, DracoPrimitive};
 use super::meshopt::{self, Compression};
 use super::Importer;
 use crate::SceneError;
@@ -16,19 +19,8 @@ const HANDLED_EXTENSIONS: &[&str] = &[
     "KHR_mesh_quantization",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
+    draco::EXTENSION,
 ];
-
-/// What to do about a required extension trisort lacks.
-fn unsupported_hint(name: &str) -> String {
-    match name {
-        "KHR_draco_mesh_compression" => "trisort has no Draco decoder; convert the file without \
-            Draco first (with a Draco-capable glTF tool such as glTF-Transform or gltf-pipeline), \
-            then compress it with meshopt if you like (gltfpack -cc -i in.glb -o out.glb), which \
-            trisort reads"
-            .into(),
-        _ => "the file requires it and trisort does not implement it".into(),
-    }
-}
 
 /// A parsed file: its glTF document, for GLB its binary chunk, and its meshopt-compressed
 /// buffer views.
@@ -39,6 +31,11 @@ pub(super) struct Parsed<'a> {
     pub bin: Option<&'a [u8]>,
     /// `EXT_meshopt_compression` / `KHR_meshopt_compression` views and fallback buffers.
     pub compression: Compression,
+    /// `KHR_draco_mesh_compression` primitives by `(mesh, primitive)`.
+    pub draco: BTreeMap<(usize, usize), DracoPrimitive>,
+    /// Accessors of Draco primitives that have no data of their own (their buffer view is a
+    /// placeholder in `doc`).
+    pub placeholders: BTreeSet<usize>,
 }
 
 /// Parses a file into its glTF document and, for GLB, its binary chunk. A required extension
@@ -56,19 +53,49 @@ pub(super) fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>, Scen
         return Err(SceneError::UnsupportedExtension {
             file: file.to_path_buf(),
             name: name.clone(),
-            hint: unsupported_hint(name),
+            hint: "the file requires it and trisort does not implement it".into(),
         });
     }
     // The `gltf` crate's validation refuses required extensions it does not know itself;
     // these are handled here.
     root.extensions_required
         .retain(|e| gltf::json::extensions::ENABLED_EXTENSIONS.contains(&e.as_str()));
-    let compression =
-        if (root.extensions_used.iter()).any(|e| meshopt::EXTENSIONS.contains(&e.as_str())) {
-            meshopt::read(json, file)?
-        } else {
-            Compression::default()
+    let uses = |names: &[&str]| (root.extensions_used.iter()).any(|e| names.contains(&e.as_str()));
+    let (compression, draco) = if uses(&meshopt::EXTENSIONS) || uses(&[draco::EXTENSION]) {
+        // The `gltf` crate drops extension objects it does not know: read them from the JSON.
+        let raw: serde_json::Value =
+            serde_json::from_slice(json).map_err(|e| SceneError::Malformed {
+                file: file.to_path_buf(),
+                problem: format!("invalid JSON: {e}"),
+            })?;
+        let draco = draco::read(&raw).map_err(|problem| SceneError::Malformed {
+            file: file.to_path_buf(),
+            problem,
+        })?;
+        (meshopt::read(&raw, file)?, draco)
+    } else {
+        Default::default()
+    };
+    // A Draco primitive's accessors have no data of their own, which the `gltf` crate's
+    // validation refuses: point them at the primitive's bitstream view for validation's sake.
+    // They are never read from there ([`Importer::read_floats`] takes the decoded values).
+    let mut placeholders = BTreeSet::new();
+    for (&(m, p), d) in &draco {
+        let Some(prim) = root.meshes.get(m).and_then(|mesh| mesh.primitives.get(p)) else {
+            continue;
         };
+        let used: Vec<usize> = (prim.attributes.values().map(|i| i.value()))
+            .chain(prim.indices.map(|i| i.value()))
+            .collect();
+        for a in used {
+            if let Some(acc) = root.accessors.get_mut(a) {
+                if acc.buffer_view.is_none() && acc.sparse.is_none() {
+                    acc.buffer_view = Some(gltf::json::Index::new(d.view as u32));
+                    placeholders.insert(a);
+                }
+            }
+        }
+    }
     // gltf-json's validation indexes the POSITION accessor before checking that it exists
     // (gltf-json 1.4.1, mesh.rs); check it first so a dangling index is an error, not a panic.
     for (m, mesh) in root.meshes.iter().enumerate() {
@@ -96,6 +123,8 @@ pub(super) fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>, Scen
         doc,
         bin,
         compression,
+        draco,
+        placeholders,
     })
 }
 

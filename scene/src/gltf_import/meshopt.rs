@@ -73,13 +73,11 @@ pub(super) struct Compression {
 }
 
 /// Reads the extension objects of the document's buffer views and buffers from its JSON.
-pub(super) fn read(json: &[u8], file: &Path) -> Result<Compression, SceneError> {
+pub(super) fn read(root: &Value, file: &Path) -> Result<Compression, SceneError> {
     let malformed = |problem: String| SceneError::Malformed {
         file: file.to_path_buf(),
         problem,
     };
-    let root: Value =
-        serde_json::from_slice(json).map_err(|e| malformed(format!("invalid JSON: {e}")))?;
     fn ext_of(item: &Value) -> Option<(&'static str, &Value)> {
         EXTENSIONS
             .iter()

@@ -33,11 +33,11 @@
 //! - **Compression and quantization**: quantized attributes (`KHR_mesh_quantization`: any
 //!   component type, normalized or not, with gltfpack's dequantizing node transforms) and
 //!   meshopt-compressed buffer views (`EXT_meshopt_compression`, `KHR_meshopt_compression`,
-//!   decoded by meshoptimizer; their fallback buffers need no data), see `meshopt.rs`. A
-//!   file whose `extensionsRequired` names any other extension than these two, the
-//!   transmission and the emissive-strength one is refused with
-//!   [`SceneError::UnsupportedExtension`] naming it (for `KHR_draco_mesh_compression`, with
-//!   what to do: there is no Draco decoder here).
+//!   decoded by meshoptimizer; their fallback buffers need no data), see `meshopt.rs`, and
+//!   Draco-compressed primitives (`KHR_draco_mesh_compression`, decoded by the pure-Rust
+//!   `draco-core` when a primitive of the scene is read), see `draco.rs`. A file whose
+//!   `extensionsRequired` names any other extension than these, the transmission and the
+//!   emissive-strength one is refused with [`SceneError::UnsupportedExtension`] naming it.
 //!
 //! # Triangle ids
 //!
@@ -70,6 +70,7 @@ mod accessors;
 mod animations;
 mod cameras;
 mod container;
+mod draco;
 mod materials;
 mod meshopt;
 mod nodes;
@@ -139,6 +140,8 @@ pub fn load_slice_with_sources(
         doc,
         bin,
         compression,
+        draco,
+        placeholders,
     } = container::parse(bytes, file)?;
     let mut importer = Importer {
         file: file.to_path_buf(),
@@ -147,6 +150,10 @@ pub fn load_slice_with_sources(
         buffers: Vec::new(),
         compression,
         decoded: Vec::new(),
+        draco,
+        draco_floats: Default::default(),
+        draco_indices: Default::default(),
+        draco_placeholders: placeholders,
         notes: Vec::new(),
         sources: Vec::new(),
     };
@@ -184,6 +191,15 @@ struct Importer<'d> {
     /// By buffer view index, the decoded bytes of a meshopt-compressed view (which stand for
     /// the view's bytes).
     decoded: Vec<Option<Vec<u8>>>,
+    /// `KHR_draco_mesh_compression` primitives by `(mesh, primitive)`.
+    draco: std::collections::BTreeMap<(usize, usize), draco::DracoPrimitive>,
+    /// By accessor index, the decoded components of a Draco primitive's attribute (which
+    /// stand for the accessor's data), filled as its primitive is read.
+    draco_floats: std::collections::HashMap<usize, Vec<f32>>,
+    /// By accessor index, the decoded indices of a Draco primitive.
+    draco_indices: std::collections::HashMap<usize, Vec<u32>>,
+    /// Accessors of Draco primitives without data of their own (see `container::Parsed`).
+    draco_placeholders: std::collections::BTreeSet<usize>,
     /// Warnings and notes for [`Scene::notes`].
     notes: Vec<String>,
     /// Per imported triangle, where it comes from.

@@ -156,6 +156,7 @@ impl Importer<'_> {
                 primitive: prim.index(),
             });
         }
+        self.decode_draco(mesh, prim)?;
         let Some(pos_acc) = prim.get(&Semantic::Positions) else {
             self.notes
                 .push(format!("skipped {where_}: it has no POSITION attribute"));
