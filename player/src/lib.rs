@@ -32,7 +32,6 @@ mod error;
 pub mod headless;
 pub mod on_screen;
 mod player;
-#[cfg(not(target_arch = "wasm32"))]
 pub mod self_check;
 
 pub use config::{playback_warnings, DrawPath, PlayerConfig};

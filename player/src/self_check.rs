@@ -22,10 +22,15 @@
 //! is a hole. The check is blind to triangles that are not in the file at all (never visible
 //! when recording); `verify --scene` against the exact reference measures those too.
 
-use trisort_format::{Baked, DrawIndexedIndirectArgs, FrameWindow, Geometry, Mode};
+#[cfg(not(target_arch = "wasm32"))]
+use trisort_format::Mode;
+use trisort_format::{Baked, DrawIndexedIndirectArgs, FrameWindow, Geometry};
+#[cfg(not(target_arch = "wasm32"))]
 use trisort_gpu::Gpu;
 
+#[cfg(not(target_arch = "wasm32"))]
 use crate::error::PlayerError;
+#[cfg(not(target_arch = "wasm32"))]
 use crate::headless::{HeadlessConfig, HeadlessRenderer};
 
 /// The self-check of one frame.
@@ -109,12 +114,15 @@ fn with_zbuffer_draw(mut b: Baked, scene: Option<&Geometry>) -> Baked {
 }
 
 /// Plays frames of a baked file and of its [`zbuffer_baked`] twin on one device and counts
-/// the pixels where they differ: the holes (see the module documentation).
+/// the pixels where they differ: the holes (see the module documentation). Native only: a
+/// browser plays the twin itself (the web player's `zbuffer` option) and compares the canvas.
+#[cfg(not(target_arch = "wasm32"))]
 pub struct SelfCheck<'g> {
     baked: HeadlessRenderer<'g>,
     zbuffer: HeadlessRenderer<'g>,
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 impl<'g> SelfCheck<'g> {
     /// Sets up the check of `baked` at `size` with `samples` MSAA samples (the recorded
     /// pattern: `(baked.settings.width, baked.settings.height)` and `baked.settings.samples`)

@@ -43,18 +43,28 @@ impl WebPlayer {
     /// Decodes `bytes` (a baked file; `name` names it in errors), sizes `canvas` to the
     /// recorded size, and opens a device on `backend` (`auto`, `webgpu`, `webgl2`) that draws
     /// into it in `mode` (`blend`, `depth`, `saturate`) at the recorded sample count.
+    ///
+    /// With `zbuffer`, it plays the file's z-buffer twin instead
+    /// ([`trisort_player::self_check::zbuffer_baked`]: each frame's window, then every
+    /// triangle of the file): in `depth` mode the twin's frame equals the file's frame
+    /// wherever no triangle the frame leaves out is nearest, so the page's self-check counts
+    /// the pixels where the two differ: the holes on this browser's rasterizer.
     pub async fn open(
         canvas: web_sys::HtmlCanvasElement,
         bytes: Vec<u8>,
         name: String,
         backend: String,
         mode: String,
+        zbuffer: bool,
     ) -> Result<WebPlayer, JsError> {
         let backend: BrowserBackend = backend.parse().map_err(|e: String| JsError::new(&e))?;
         let mode: Mode = mode.parse().map_err(js_error)?;
-        let baked: Baked =
+        let mut baked: Baked =
             trisort_player::baked_from_bytes(&bytes, Path::new(&name)).map_err(js_error)?;
         drop(bytes);
+        if zbuffer {
+            baked = trisort_player::self_check::zbuffer_baked(&baked);
+        }
         let (width, height) = (baked.settings.width.max(1), baked.settings.height.max(1));
         canvas.set_width(width);
         canvas.set_height(height);

@@ -3,18 +3,19 @@
 // and compares each with the native player's PNG of the same frame.
 //
 //   node web/test/browser.mjs --dist web/dist --native DIR --frames 0,12,24 --out DIR
-//        [--backend webgl2] [--mode blend] [--chromium /usr/bin/chromium]
+//        [--backend webgl2] [--mode blend] [--file demo.baked] [--chromium /usr/bin/chromium]
 //
 // Writes the browser's frames as DIR/frame-NNNNN.png (for `trisort verify --frames-dir`) and
-// prints one JSON object: the device, and per frame pixels differing from the native frame
-// and the largest channel difference. Exit 0 when it ran; the caller gates the figures.
+// prints one JSON object: the device; per frame pixels differing from the native frame and
+// the largest channel difference; and the page's self-check per frame (depth mode against the
+// file's z-buffer twin, both drawn here: `holes`). Exit 0 when it ran; the caller gates.
 import { createServer } from "node:http";
 import { readFile, writeFile, mkdir } from "node:fs/promises";
 import { extname, join, normalize } from "node:path";
 import { chromium } from "playwright-core";
 
 function args() {
-  const a = { backend: "webgl2", mode: "blend", chromium: "/usr/bin/chromium" };
+  const a = { backend: "webgl2", mode: "blend", chromium: "/usr/bin/chromium", file: "demo.baked" };
   const argv = process.argv.slice(2);
   for (let i = 0; i < argv.length; i += 2) a[argv[i].replace(/^--/, "")] = argv[i + 1];
   for (const k of ["dist", "native", "frames", "out"]) {
@@ -76,7 +77,7 @@ try {
     page.on("pageerror", (e) => reject(new Error(`page error: ${e.message}\n${logs.join("\n")}`))));
   pageError.catch(() => {});
   const guard = (p) => Promise.race([p, pageError]);
-  await page.goto(`http://127.0.0.1:${port}/index.html?backend=${a.backend}&mode=${a.mode}&test=1`);
+  await page.goto(`http://127.0.0.1:${port}/index.html?file=${a.file}&backend=${a.backend}&mode=${a.mode}&test=1`);
   try {
     await guard(page.waitForFunction(() => window.trisort && window.trisort.ready));
     await guard(page.evaluate(() => window.trisort.ready.then(() => true)));
@@ -140,8 +141,24 @@ try {
     frames.push(r);
     if (process.env.TRISORT_WEB_VERBOSE) console.error(`frame ${frame}: ${r.pixels_differing_native} px differ`);
   }
+  // The on-device self-check: the same frames in depth mode against the file's z-buffer
+  // twin, both drawn by this browser (holes on its rasterizer).
+  const check = await browser.newPage({ viewport: { width: 800, height: 800 }, deviceScaleFactor: 1 });
+  check.setDefaultTimeout(Number(a.timeout || 120) * 1000);
+  check.on("console", (m) => logs.push(`${m.type()}: ${m.text()}`));
+  const checkError = new Promise((_, reject) =>
+    check.on("pageerror", (e) => reject(new Error(`self-check page error: ${e.message}`))));
+  checkError.catch(() => {});
+  const guarded = (p) => Promise.race([p, checkError]);
+  await check.goto(`http://127.0.0.1:${port}/index.html?file=${a.file}&backend=${a.backend}&selfcheck=1&test=1`);
+  await guarded(check.waitForFunction(() => window.trisort && window.trisort.ready));
+  await guarded(check.evaluate(() => window.trisort.ready.then(() => true)));
+  const selfCheck = [];
+  for (const frame of a.frames) {
+    selfCheck.push(await guarded(check.evaluate((f) => window.trisort.selfCheck(f), frame)));
+  }
   const errors = logs.filter((l) => l.startsWith("error") || l.startsWith("pageerror"));
-  console.log(JSON.stringify({ device, frames, console_errors: errors }, null, 1));
+  console.log(JSON.stringify({ device, frames, self_check: selfCheck, console_errors: errors }, null, 1));
 } catch (e) {
   failed = e;
 } finally {

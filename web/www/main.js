@@ -1,17 +1,53 @@
 // trisort's web player page: loads a baked file (?file=, default demo.baked, or a dropped
 // one), plays it on the canvas with the wasm player (pkg/, made by web/build.sh), and shows
 // play/pause, a scrub bar and the frame figures. ?backend=auto|webgpu|webgl2 and
-// ?mode=blend|depth|saturate choose how. window.trisort exposes the player to tests.
+// ?mode=blend|depth|saturate choose how. ?selfcheck=1 plays in depth mode and also draws the
+// file's z-buffer twin on a hidden canvas: pixels where the two differ are holes on this
+// browser (a triangle the frame leaves out is nearest there); the figures show their count.
+// window.trisort exposes the player and the self-check to tests.
 import init, { WebPlayer } from "./pkg/trisort_web.js";
 
 const params = new URLSearchParams(location.search);
 const backend = params.get("backend") || "auto";
-const mode = params.get("mode") || "blend";
+const selfcheck = params.get("selfcheck") === "1";
+const mode = selfcheck ? "depth" : params.get("mode") || "blend";
 const $ = (id) => document.getElementById(id);
 const canvas = $("canvas");
 
-const state = { player: null, frame: 0, playing: false, last: 0, ms: 0 };
-window.trisort = { state, ready: null, renderFrame, open };
+const state = { player: null, twin: null, frame: 0, playing: false, last: 0, ms: 0 };
+window.trisort = { state, ready: null, renderFrame, open, selfCheck };
+
+// The pixels of a canvas, copied in the same task as its draw (while its drawing buffer
+// holds the frame).
+function pixels(c) {
+  const ctx = new OffscreenCanvas(c.width, c.height).getContext("2d", { colorSpace: "srgb" });
+  ctx.drawImage(c, 0, 0);
+  return ctx.getImageData(0, 0, c.width, c.height).data;
+}
+
+// Frame `frame` as played and as the z-buffer twin draws it: the holes (pixels that differ)
+// and their largest channel difference.
+function selfCheck(frame) {
+  if (!state.twin) throw new Error("open the page with ?selfcheck=1");
+  const outer = !state.checking;
+  state.checking = true;
+  try {
+    const ms = renderFrame(frame);
+    const played = pixels($("canvas"));
+    state.twin.render(frame);
+    const zbuffer = pixels($("twin"));
+    let holes = 0, max = 0;
+    for (let i = 0; i < played.length; i += 4) {
+      let d = 0;
+      for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(played[i + c] - zbuffer[i + c]));
+      if (d > 0) { holes++; max = Math.max(max, d); }
+    }
+    if (outer) $("figures").textContent = `${state.player.figures(frame, ms)} · ${holes} holes (self-check)`;
+    return { frame, holes, max_channel_diff: max };
+  } finally {
+    if (outer) state.checking = false;
+  }
+}
 
 function showError(e) {
   $("error").textContent = String(e && e.message ? e.message : e);
@@ -27,6 +63,8 @@ function renderFrame(frame) {
   state.frame = frame;
   $("scrub").value = String(frame);
   $("figures").textContent = p.figures(frame, state.ms);
+  // With ?selfcheck=1 every frame shown is also checked (selfCheck writes the figures).
+  if (state.twin && !state.checking) selfCheck(frame);
   return state.ms;
 }
 
@@ -34,13 +72,16 @@ async function open(bytes, name) {
   $("error").textContent = "";
   if (state.player) {
     // A canvas keeps the context it was first given: a new file gets a fresh canvas.
-    const fresh = canvas.cloneNode();
-    state.player.free();
-    state.player = null;
-    canvas.replaceWith(fresh);
+    for (const [key, id] of [["player", "canvas"], ["twin", "twin"]]) {
+      if (!state[key]) continue;
+      state[key].free();
+      state[key] = null;
+      $(id).replaceWith($(id).cloneNode());
+    }
   }
   const target = $("canvas");
-  const p = await WebPlayer.open(target, bytes, name, backend, mode);
+  const p = await WebPlayer.open(target, bytes, name, backend, mode, false);
+  if (selfcheck) state.twin = await WebPlayer.open($("twin"), bytes, name, backend, mode, true);
   state.player = p;
   state.frame = 0;
   const scrub = $("scrub");
