@@ -113,9 +113,12 @@ fn cons_corner(tri: u32, corner: u32, grow: f32) -> ConsVarying {
     out.bounds = vec4<f32>(lo, hi);
     var q = p[corner];
     if (grow > 0.0) {
-        // A right triangle around the grown box, with a pixel to spare.
-        let a = lo - vec2<f32>(1.0);
-        let size = 2.0 * (hi - lo + vec2<f32>(2.0));
+        // A right triangle around the grown box (twice its area; its corner opposite the
+        // right angle on the hypotenuse), with 1/64 px to spare so no sample of the box lies
+        // on an edge of it.
+        let spare = 1.0 / 64.0;
+        let a = lo - vec2<f32>(spare);
+        let size = 2.0 * (hi - lo + vec2<f32>(2.0 * spare));
         if (corner == 0u) {
             q = a;
         } else if (corner == 1u) {
