@@ -685,3 +685,43 @@ fn a_scene_with_fewer_nodes_than_the_poses_is_named_not_indexed() {
         "recorded from another scene or path",
     );
 }
+
+/// `--path gltf:animation=NAME,camera=NAME` naming what the scene lacks fails before
+/// recording, saying what the scene has.
+#[test]
+fn gltf_path_selection_names_what_the_scene_lacks() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    car_glb(d);
+    for (path, problem) in [
+        (
+            "gltf:animation=drive",
+            "no animation named \"drive\" (its animations: none)",
+        ),
+        (
+            "gltf:camera=top",
+            "no camera named \"top\" (its cameras: none)",
+        ),
+        (
+            "gltf:zoom=2",
+            "unknown parameter (known: animation, camera)",
+        ),
+    ] {
+        fails(
+            d,
+            &[
+                "bake",
+                "car.glb",
+                "--path",
+                path,
+                "-o",
+                "out.baked",
+                "--size",
+                "8x8",
+            ],
+            &[1],
+            path,
+            problem,
+        );
+    }
+}

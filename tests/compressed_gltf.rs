@@ -60,6 +60,9 @@ fn compressed_car_concept_records_like_the_original() {
         };
         let inspect = run_json(d, &["inspect", &file]);
         assert_eq!(inspect["triangles"], triangles, "{name}: {inspect}");
+        // KHR_materials_variants survives both tools; inspect lists the names.
+        let variants = ["Carmine Candy", "Pearly Swirly", "Torched Graphite"];
+        assert_eq!(inspect["variants"], serde_json::json!(variants), "{name}");
         let rec = format!("{name}.rec");
         run(
             d,

@@ -136,7 +136,10 @@ fn cameras(bounds: &Bounds, eyes: &[DVec3], fov_degrees: f64) -> Result<Vec<Fram
 }
 
 /// `key=value` pairs of a generator spec (after the colon), each key at most once.
-fn pairs<'a>(params: &'a str, known: &[&str]) -> Result<Vec<(&'a str, &'a str)>, Problem> {
+pub(crate) fn pairs<'a>(
+    params: &'a str,
+    known: &[&str],
+) -> Result<Vec<(&'a str, &'a str)>, Problem> {
     let mut out: Vec<(&str, &str)> = Vec::new();
     for item in params.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let Some((k, v)) = item.split_once('=') else {

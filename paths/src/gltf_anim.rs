@@ -1,5 +1,6 @@
-//! The `gltf` path: the scene's own node animations and first camera, sampled at a fixed rate
-//! (glTF 2.0 § 3.11 "Animations" and Appendix C "Animation Sampler Interpolation Modes").
+//! The `gltf` path: the scene's own node animations and first camera (or the animation and
+//! camera `gltf:animation=NAME,camera=NAME` names), sampled at a fixed rate (glTF 2.0 § 3.11
+//! "Animations" and Appendix C "Animation Sampler Interpolation Modes").
 
 use glam::{DMat4, DQuat, DVec3, DVec4};
 use trisort_format::{world_transforms, Camera, FrameState};
@@ -11,18 +12,97 @@ use crate::poses::pose_if_moved;
 use crate::view::{check_clip, check_fov_degrees, check_frames, framing_camera, Bounds};
 use crate::Timeline;
 
-/// Samples the scene's animations and camera at `fps`.
-pub(crate) fn sample(scene: &Scene, fps: f64) -> Result<Timeline, PathError> {
-    let at = || Location::whole(format!("gltf path of scene {:?}", scene.name));
+/// What `gltf:animation=NAME,camera=NAME` chooses (`None`: every animation, the first
+/// camera).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Selection {
+    /// Only the animations of this name play.
+    pub animation: Option<String>,
+    /// The camera of this name.
+    pub camera: Option<String>,
+}
+
+/// Parses the parameters of `gltf:…` (after the colon).
+pub(crate) fn parse_selection(params: &str) -> Result<Selection, Problem> {
+    let mut out = Selection::default();
+    for (k, v) in crate::generators::pairs(params, &["animation", "camera"])? {
+        if v.is_empty() {
+            return Err(Problem::BadParameter {
+                name: k.into(),
+                reason: "empty name".into(),
+            });
+        }
+        match k {
+            "animation" => out.animation = Some(v.into()),
+            _ => out.camera = Some(v.into()),
+        }
+    }
+    Ok(out)
+}
+
+/// `name` (or `#index` for an unnamed one) of each item, for messages.
+fn listed<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let all: Vec<String> = names
+        .enumerate()
+        .map(|(i, n)| {
+            if n.is_empty() {
+                format!("#{i} (unnamed)")
+            } else {
+                format!("{n:?}")
+            }
+        })
+        .collect();
+    if all.is_empty() {
+        "none".into()
+    } else {
+        all.join(", ")
+    }
+}
+
+/// Samples the scene's animations and camera (those `select` names) at `fps`.
+pub(crate) fn sample(scene: &Scene, fps: f64, select: &Selection) -> Result<Timeline, PathError> {
+    // The spec is named where it selects something (it is at fault when that is missing).
+    let at = || match (&select.animation, &select.camera) {
+        (None, None) => Location::whole(format!("gltf path of scene {:?}", scene.name)),
+        (animation, camera) => {
+            let mut spec = String::from("gltf:");
+            let parts: Vec<String> = [("animation", animation), ("camera", camera)]
+                .into_iter()
+                .filter_map(|(k, v)| v.as_ref().map(|v| format!("{k}={v}")))
+                .collect();
+            spec.push_str(&parts.join(","));
+            Location::whole(format!("{spec} (gltf path of scene {:?})", scene.name))
+        }
+    };
     let err = |problem| PathError::Invalid { at: at(), problem };
     check_fps(fps).map_err(err)?;
     let nodes = &scene.geometry.nodes;
+    let plays = |name: &str| {
+        select
+            .animation
+            .as_deref()
+            .is_none_or(|wanted| wanted == name)
+    };
+    if let Some(wanted) = &select.animation {
+        if !scene.animations.iter().any(|a| a.name == *wanted) {
+            return Err(err(Problem::BadParameter {
+                name: "animation".into(),
+                reason: format!(
+                    "the scene has no animation named {wanted:?} (its animations: {})",
+                    listed(scene.animations.iter().map(|a| a.name.as_str()))
+                ),
+            }));
+        }
+    }
 
     // The channel that drives each (node, property); later animations and channels override
     // earlier ones.
     let mut driver: Vec<[Option<&Channel>; 3]> = vec![[None; 3]; nodes.len()];
     let mut duration: f64 = 0.0;
     for (a, anim) in scene.animations.iter().enumerate() {
+        if !plays(&anim.name) {
+            continue;
+        }
         for (c, ch) in anim.channels.iter().enumerate() {
             check_channel(ch, nodes.len()).map_err(|reason| {
                 err(Problem::Inconsistent(format!(
@@ -53,7 +133,22 @@ pub(crate) fn sample(scene: &Scene, fps: f64) -> Result<Timeline, PathError> {
         (last + 1e-9).floor() as usize + 1
     };
 
-    let scene_camera = scene.cameras.first();
+    let scene_camera = match &select.camera {
+        None => scene.cameras.first(),
+        Some(wanted) => Some(
+            (scene.cameras.iter())
+                .find(|c| c.name == *wanted)
+                .ok_or_else(|| {
+                    err(Problem::BadParameter {
+                        name: "camera".into(),
+                        reason: format!(
+                            "the scene has no camera named {wanted:?} (its cameras: {})",
+                            listed(scene.cameras.iter().map(|c| c.name.as_str()))
+                        ),
+                    })
+                })?,
+        ),
+    };
     if let Some(c) = scene_camera {
         if c.node as usize >= nodes.len() {
             return Err(err(Problem::Inconsistent(format!(

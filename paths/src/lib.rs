@@ -7,6 +7,7 @@
 //! | spec | path |
 //! |---|---|
 //! | `gltf` | the scene's own animations and first camera ([§ glTF](#the-gltf-path)) |
+//! | `gltf:animation=NAME,camera=NAME` | one animation and/or camera of the scene, by name ([§ glTF](#the-gltf-path)) |
 //! | `orbit:k=v,…` (or `orbit`) | a circle around the scene ([§ generators](#generators)) |
 //! | `dolly:k=v,…` (or `dolly`) | a straight approach to the scene ([§ generators](#generators)) |
 //! | anything else | a TOML keyframe file ([§ TOML](#the-toml-keyframe-format)) |
@@ -98,7 +99,11 @@
 //! `LINEAR` (slerp on the shorter arc for rotations), `STEP`, `CUBICSPLINE` (Hermite with the
 //! stored tangents × the key interval; rotations normalized).
 //!
-//! The camera is the scene's first camera: view = inverse of its node's world transform at
+//! `gltf:animation=NAME,camera=NAME` (both optional, in any order) plays only the animations
+//! named NAME (usually one) and takes the camera named NAME; a name the scene lacks is an error
+//! that lists the scene's animations or cameras. Names cannot contain `,`.
+//!
+//! The camera is the scene's first camera (or the one named): view = inverse of its node's world transform at
 //! that frame with any scale removed; yfov, znear and zfar are the camera's (its aspect ratio
 //! is ignored: the recording size decides). A scene without a camera gets a fixed framing
 //! camera: 45° yfov, looking at the bounding-box centre from the direction (1, 0.5, 2) (front
@@ -200,7 +205,13 @@ pub fn load(spec: &str, scene: &Scene, opts: &PathOptions) -> Result<Timeline, P
         problem,
     };
     if spec == "gltf" {
-        return gltf_anim::sample(scene, opts.fps);
+        return gltf_anim::sample(scene, opts.fps, &Default::default());
+    }
+    if let Some(params) = spec.strip_prefix("gltf:") {
+        if !Path::new(spec).exists() {
+            let select = gltf_anim::parse_selection(params).map_err(invalid)?;
+            return gltf_anim::sample(scene, opts.fps, &select);
+        }
     }
     let (word, params) = spec.split_once(':').unwrap_or((spec, ""));
     let is_generator_word = word.len() >= 2 && word.bytes().all(|b| b.is_ascii_lowercase());

@@ -283,3 +283,88 @@ fn zero_scale_rest_node_can_be_animated() {
     assert_eq!(m.w_axis.truncate(), DVec3::new(0.0, 2.0, 0.0));
     assert_eq!(m.transform_vector3(DVec3::ONE), DVec3::ZERO, "still hidden");
 }
+
+/// `gltf:animation=NAME,camera=NAME` (issue 17, part 3): one animation plays (others keep
+/// their nodes at rest) and its length decides the frames; the named camera views; unknown
+/// names and parameters are errors listing what the scene has.
+#[test]
+fn gltf_path_selects_an_animation_and_a_camera_by_name() {
+    let slide = |name: &str, node, to: f32, seconds: f32| Animation {
+        name: name.into(),
+        channels: vec![Channel {
+            node,
+            property: Property::Translation,
+            interpolation: Interpolation::Linear,
+            times: vec![0.0, seconds],
+            values: vec![0.0, 1.0, 0.0, to, 1.0, 0.0],
+        }],
+    };
+    let mut scene = animated(vec![
+        slide("short", 1, 10.0, 1.0),
+        slide("long", 2, -4.0, 3.0),
+    ]);
+    for (name, node, z) in [("front", 0, 5.0), ("back", 0, -5.0)] {
+        scene.geometry.nodes.push(crate::common::node(
+            name,
+            Some(node),
+            DMat4::from_rotation_translation(
+                DQuat::from_rotation_y(if z > 0.0 { 0.0 } else { 180f64.to_radians() }),
+                DVec3::new(0.0, 0.0, z),
+            ),
+        ));
+        scene.cameras.push(SceneCamera {
+            name: name.into(),
+            node: scene.geometry.nodes.len() as u32 - 1,
+            yfov: 0.8,
+            znear: 0.05,
+            zfar: None,
+            aspect: None,
+        });
+    }
+    let opts = PathOptions { fps: 2.0 };
+    let all = load("gltf", &scene, &opts).unwrap();
+    assert_eq!(all.frames.len(), 7, "both animations: the longer one's 3 s");
+    assert!(all.frames[6].poses.iter().any(|p| p.node == 1));
+    assert!(all.frames[6].poses.iter().any(|p| p.node == 2));
+
+    let short = load("gltf:animation=short", &scene, &opts).unwrap();
+    assert_eq!(short.frames.len(), 3, "1 s at 2 fps");
+    assert!(short
+        .frames
+        .iter()
+        .all(|f| f.poses.iter().all(|p| p.node == 1)));
+    assert_eq!(lid(&short, 2).w_axis.x, 10.0);
+    // The first camera by default, the named one when asked for.
+    assert_eq!(eye_forward(&short, 0).0.z, 5.0);
+    let back = load("gltf:camera=back,animation=long", &scene, &opts).unwrap();
+    assert_eq!(back.frames.len(), 7);
+    let (eye, forward) = eye_forward(&back, 0);
+    assert!((eye.z + 5.0).abs() < 1e-9 && (forward - DVec3::Z).length() < 1e-9);
+    assert!(back
+        .frames
+        .iter()
+        .all(|f| f.poses.iter().all(|p| p.node == 2)));
+
+    for (spec, says) in [
+        (
+            "gltf:animation=drive",
+            "no animation named \"drive\" (its animations: \"short\", \"long\")",
+        ),
+        (
+            "gltf:camera=top",
+            "no camera named \"top\" (its cameras: \"front\", \"back\")",
+        ),
+        (
+            "gltf:speed=3",
+            "unknown parameter (known: animation, camera)",
+        ),
+        ("gltf:camera=front,camera=back", "given twice"),
+        ("gltf:animation=", "empty name"),
+    ] {
+        let (p, _, text) = problem(load(spec, &scene, &opts));
+        assert!(matches!(p, Problem::BadParameter { .. }), "{spec}: {text}");
+        assert!(text.contains(says), "{spec}: {text}");
+    }
+    let (_, _, text) = problem(load("gltf:camera=x", &box_scene(), &opts));
+    assert!(text.contains("(its cameras: none)"), "{text}");
+}

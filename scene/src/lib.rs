@@ -26,6 +26,10 @@ pub struct Scene {
     pub stats: SceneStats,
     /// Warnings and notes from import (skipped primitives, ignored extensions, …).
     pub notes: Vec<String>,
+    /// Names of the file's material variants (`KHR_materials_variants`), in file order; an
+    /// unnamed variant is `""`. Empty without the extension. (Import keeps each primitive's
+    /// default material; the variants are listed, not applied.)
+    pub variants: Vec<String>,
     /// [`Scene::hash`], computed on its first call. Leave it empty (`Default::default()`,
     /// which `..Scene::default()` gives) when building a scene by hand or from another
     /// scene's parts, and change `geometry` after a `hash()` only through

@@ -377,3 +377,38 @@ fn hostile_draco_primitives_are_errors(glb: &[u8], dir: &Path) {
         }
     }
 }
+
+/// `KHR_materials_variants`: the variants' names, in file order (`""` for an unnamed one),
+/// for `inspect`; none without the extension.
+#[test]
+fn material_variant_names_are_listed() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("v.gltf");
+    let gltf = |extension: &str| {
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},{extension}"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}}],
+            "buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}}]}}"#
+        )
+    };
+    std::fs::write(
+        &file,
+        gltf(
+            r#""extensionsUsed":["KHR_materials_variants"],"extensions":{"KHR_materials_variants":
+            {"variants":[{"name":"Red"},{},{"name":"Blue"}]}},"#,
+        ),
+    )
+    .unwrap();
+    assert_eq!(load(&file).unwrap().variants, ["Red", "", "Blue"]);
+    std::fs::write(&file, gltf("")).unwrap();
+    assert!(load(&file).unwrap().variants.is_empty());
+    if let Some(car) = trisort_testkit::scene_path("CarConcept/CarConcept.glb") {
+        let names = load(&car).unwrap().variants;
+        assert_eq!(
+            names,
+            ["Carmine Candy", "Pearly Swirly", "Torched Graphite"]
+        );
+    }
+}

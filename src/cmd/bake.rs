@@ -19,7 +19,8 @@ use crate::common::{load_path, load_scene, print_json, working_scene};
 pub struct BakeArgs {
     /// Scene (.glb/.gltf, or `demo[:TRIANGLES]`).
     scene: String,
-    /// Path: TOML file, `gltf`, `orbit:…`, `dolly:…` or `demo`.
+    /// Path: TOML file, `gltf` (or `gltf:animation=NAME,camera=NAME`), `orbit:…`, `dolly:…`
+    /// or `demo`.
     #[arg(long)]
     path: String,
     /// Output baked file. The recording is kept beside it as `BAKED.rec` (verify uses it).

@@ -30,7 +30,8 @@ use crate::common::{
 pub struct BenchArgs {
     /// Scene (.glb/.gltf, or `demo[:TRIANGLES]`).
     scene: String,
-    /// Path: TOML file, `gltf`, `orbit:…`, `dolly:…` or `demo`.
+    /// Path: TOML file, `gltf` (or `gltf:animation=NAME,camera=NAME`), `orbit:…`, `dolly:…`
+    /// or `demo`.
     #[arg(long)]
     path: String,
     /// Recording and playback size, WIDTHxHEIGHT.

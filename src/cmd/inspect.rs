@@ -132,7 +132,8 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// `inspect` of a scene: counts, materials by alpha mode, animated nodes, bounds, notes.
+/// `inspect` of a scene: counts, materials by alpha mode, animated nodes, bounds, material
+/// variants, notes.
 fn inspect_scene(a: &InspectArgs) -> Result<ExitCode> {
     if a.matrix.is_some() {
         anyhow::bail!("{}: --matrix needs a baked file", a.file);
@@ -183,6 +184,7 @@ fn inspect_scene(a: &InspectArgs) -> Result<ExitCode> {
         "animated_nodes": animated,
         "bounds": bounds,
         "notes": scene.notes,
+        "variants": scene.variants,
         "intersections_split": split.pairs_split,
         "triangles_added": split.triangles_added,
         "intersections_left": split.pairs_skipped_sliver,
@@ -218,6 +220,9 @@ fn inspect_scene(a: &InspectArgs) -> Result<ExitCode> {
         );
         if let Some((lo, hi)) = scene.bounds() {
             println!("  bounds {:.3?} .. {:.3?}", lo.to_array(), hi.to_array());
+        }
+        if !scene.variants.is_empty() {
+            println!("  material variants: {}", scene.variants.join(", "));
         }
         for n in &scene.notes {
             println!("  note: {n}");

@@ -35,7 +35,8 @@ pub enum PhaseArg {
 pub struct RecordArgs {
     /// Scene (.glb/.gltf, or `demo[:TRIANGLES]`).
     scene: String,
-    /// Path: TOML file, `gltf`, `orbit:…`, `dolly:…` or `demo`.
+    /// Path: TOML file, `gltf` (or `gltf:animation=NAME,camera=NAME`), `orbit:…`, `dolly:…`
+    /// or `demo`.
     #[arg(long)]
     path: String,
     /// Output recording.

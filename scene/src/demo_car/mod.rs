@@ -250,6 +250,7 @@ fn build(parts: &[Surface]) -> Scene {
         cameras: Vec::new(),
         stats,
         notes: Vec::new(),
+        variants: Vec::new(),
         hash_cache: Default::default(),
     }
 }

@@ -22,6 +22,24 @@ const HANDLED_EXTENSIONS: &[&str] = &[
     draco::EXTENSION,
 ];
 
+/// The material variants extension, whose names `inspect` lists.
+const VARIANTS: &str = "KHR_materials_variants";
+
+/// The names of the document's material variants (`extensions.KHR_materials_variants.variants[].name`),
+/// `""` for an unnamed one (or one whose name is not a string).
+fn variant_names(root: &serde_json::Value) -> Vec<String> {
+    let list = (root.get("extensions"))
+        .and_then(|e| e.get(VARIANTS))
+        .and_then(|v| v.get("variants"))
+        .and_then(serde_json::Value::as_array);
+    (list.into_iter().flatten())
+        .map(|v| {
+            let name = v.get("name").and_then(serde_json::Value::as_str);
+            name.unwrap_or_default().to_string()
+        })
+        .collect()
+}
+
 /// A parsed file: its glTF document, for GLB its binary chunk, and its meshopt-compressed
 /// buffer views.
 pub(super) struct Parsed<'a> {
@@ -36,6 +54,8 @@ pub(super) struct Parsed<'a> {
     /// Accessors of Draco primitives that have no data of their own (their buffer view is a
     /// placeholder in `doc`).
     pub placeholders: BTreeSet<usize>,
+    /// Names of the `KHR_materials_variants` variants.
+    pub variants: Vec<String>,
 }
 
 /// Parses a file into its glTF document and, for GLB, its binary chunk. A required extension
@@ -61,21 +81,22 @@ pub(super) fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>, Scen
     root.extensions_required
         .retain(|e| gltf::json::extensions::ENABLED_EXTENSIONS.contains(&e.as_str()));
     let uses = |names: &[&str]| (root.extensions_used.iter()).any(|e| names.contains(&e.as_str()));
-    let (compression, draco) = if uses(&meshopt::EXTENSIONS) || uses(&[draco::EXTENSION]) {
-        // The `gltf` crate drops extension objects it does not know: read them from the JSON.
-        let raw: serde_json::Value =
-            serde_json::from_slice(json).map_err(|e| SceneError::Malformed {
+    let (compression, draco, variants) =
+        if uses(&meshopt::EXTENSIONS) || uses(&[draco::EXTENSION, VARIANTS]) {
+            // The `gltf` crate drops extension objects it does not know: read them from the JSON.
+            let raw: serde_json::Value =
+                serde_json::from_slice(json).map_err(|e| SceneError::Malformed {
+                    file: file.to_path_buf(),
+                    problem: format!("invalid JSON: {e}"),
+                })?;
+            let draco = draco::read(&raw).map_err(|problem| SceneError::Malformed {
                 file: file.to_path_buf(),
-                problem: format!("invalid JSON: {e}"),
+                problem,
             })?;
-        let draco = draco::read(&raw).map_err(|problem| SceneError::Malformed {
-            file: file.to_path_buf(),
-            problem,
-        })?;
-        (meshopt::read(&raw, file)?, draco)
-    } else {
-        Default::default()
-    };
+            (meshopt::read(&raw, file)?, draco, variant_names(&raw))
+        } else {
+            Default::default()
+        };
     // A Draco primitive's accessors have no data of their own, which the `gltf` crate's
     // validation refuses: point them at the primitive's bitstream view for validation's sake.
     // They are never read from there ([`Importer::read_floats`] takes the decoded values).
@@ -125,6 +146,7 @@ pub(super) fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>, Scen
         compression,
         draco,
         placeholders,
+        variants,
     })
 }
 
@@ -368,7 +390,9 @@ impl Importer<'_> {
                     "KHR_texture_transform" => {
                         "textures are sampled with untransformed coordinates"
                     }
-                    "KHR_materials_variants" => "each primitive keeps its default material",
+                    "KHR_materials_variants" => {
+                        "each primitive keeps its default material (inspect lists the variants)"
+                    }
                     "KHR_materials_volume" => "glass thickness and attenuation are not modelled",
                     _ => "not supported",
                 };

@@ -142,6 +142,7 @@ pub fn load_slice_with_sources(
         compression,
         draco,
         placeholders,
+        variants,
     } = container::parse(bytes, file)?;
     let mut importer = Importer {
         file: file.to_path_buf(),
@@ -154,6 +155,7 @@ pub fn load_slice_with_sources(
         draco_floats: Default::default(),
         draco_indices: Default::default(),
         draco_placeholders: placeholders,
+        variants,
         notes: Vec::new(),
         sources: Vec::new(),
     };
@@ -200,6 +202,8 @@ struct Importer<'d> {
     draco_indices: std::collections::HashMap<usize, Vec<u32>>,
     /// Accessors of Draco primitives without data of their own (see `container::Parsed`).
     draco_placeholders: std::collections::BTreeSet<usize>,
+    /// Names of the file's material variants.
+    variants: Vec<String>,
     /// Warnings and notes for [`Scene::notes`].
     notes: Vec<String>,
     /// Per imported triangle, where it comes from.
@@ -247,6 +251,7 @@ impl<'d> Importer<'d> {
             cameras,
             stats,
             notes: self.notes,
+            variants: self.variants,
             hash_cache: Default::default(),
         };
         Ok((scene, self.sources))
