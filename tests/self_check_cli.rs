@@ -187,8 +187,7 @@ fn self_check_holes(dir: &std::path::Path, baked: &str, offset: &str) -> (u64, b
 fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
     let Some(dir) = gpu_tempdir() else { return };
     let d = dir.path();
-    let bake =
-        format!("bake {SCENE} --path orbit:frames=2,degrees=40 --size 64x64 --samples 4");
+    let bake = format!("bake {SCENE} --path orbit:frames=2,degrees=40 --size 64x64 --samples 4");
     let plain = run_json(d, &[args(&bake), vec!["-o", "plain.baked"]].concat());
     let robust = run_json(
         d,
