@@ -3,6 +3,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/ensure-lavapipe.sh
+# GL through EGL (Mesa llvmpipe): the player's `--backend gl` tests.
+bash scripts/ensure-gl.sh
+# The C host example and FORMAT.md's Python reader (tests/c_host.rs, tests/format_reader.rs):
+# gcc, EGL/GLES headers, python3-zstandard (seconds when present).
+bash scripts/ensure-c-host.sh
+# gltfpack and gltf-pipeline (npm) make meshopt-, Draco-compressed and quantized copies of
+# CarConcept at test time (scene's import_compressed, tests/compressed_gltf.rs).
+bash scripts/ensure-gltf-tools.sh
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp/xdg-runtime-$(id -u)}"
 mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 export TRISORT_SCENES="${TRISORT_SCENES:-$(pwd)/../shared/scenes}"
