@@ -21,6 +21,7 @@ mod record_cli;
 mod self_check_cli;
 mod shard_cli;
 mod verify_cli;
+mod variants_cli;
 mod verify_forged;
 mod verify_images;
 mod webgl2_cli;

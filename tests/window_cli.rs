@@ -217,7 +217,25 @@ fn window_plays_frames_under_xvfb() {
             samples != "4",
             "warnings: {stderr}"
         );
+        assert_eq!(v["fps"], 60.0, "{v}");
     }
+}
+
+/// Without `--fps` the viewer plays at the path's rate, stored in the baked file.
+#[test]
+fn window_plays_at_the_baked_fps() {
+    if tools_missing(&["xvfb-run"]) {
+        return;
+    }
+    let Some(dir) = gpu_tempdir() else { return };
+    let bake = "bake demo:3000 --path orbit:frames=2 --size 32x24 --fps 12 -o f.baked";
+    run(dir.path(), &args(bake), true);
+    let play = args("play f.baked --window --window-frames 1 --json");
+    let (code, stdout, stderr) = under_xvfb(dir.path(), &play, Duration::from_secs(120));
+    assert_eq!(code, Some(0), "{stdout}\n--- stderr\n{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(v["fps"], 12.0, "{v}");
+    assert_eq!(v["variant"], serde_json::Value::Null, "{v}");
 }
 
 /// An `xwd` dump (X Window Dump, version 7, ZPixmap, 24/32-bit TrueColor) as RGB rows.

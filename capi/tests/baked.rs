@@ -61,6 +61,7 @@ fn sample() -> Baked {
             frame_at(DVec3::new(0.5, 0.0, 2.0)),
         ],
         removed_edges: vec![vec![], vec![]],
+        fps: None,
     }
 }
 

@@ -137,6 +137,21 @@ pub struct Baked {
     /// Per frame: the intra-frame cycle edges the merger removed (G-local ids). Their total
     /// weight is `stats.unordered_samples`.
     pub removed_edges: Vec<Vec<Edge>>,
+    /// Frames per second of the path (what a player plays at by default; [`Recording::fps`]),
+    /// `None` where the recordings did not know it.
+    ///
+    /// [`Recording::fps`]: crate::Recording::fps
+    pub fps: Option<f64>,
+}
+
+/// Checks a stored frame rate: absent, or finite and positive (a player divides by it).
+pub(crate) fn check_fps(fps: Option<f64>) -> Result<(), String> {
+    match fps {
+        Some(fps) if !(fps.is_finite() && fps > 0.0) => {
+            Err(format!("frame rate {fps} is not a positive number"))
+        }
+        _ => Ok(()),
+    }
 }
 
 impl Baked {
@@ -203,6 +218,6 @@ impl Baked {
         for (f, s) in self.frame_states.iter().enumerate() {
             crate::camera::check_frame_state(f, s, Some(g.nodes.len()))?;
         }
-        Ok(())
+        check_fps(self.fps)
     }
 }

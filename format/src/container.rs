@@ -31,7 +31,10 @@ use serde::Serialize;
 ///
 /// History: 1, the first; 2, [`crate::MergeInfo`] stores its options as enums
 /// ([`crate::options`]) instead of strings; 3, [`crate::RecordSettings`] stores how robust
-/// the recording is ([`crate::Robust`]).
+/// the recording is ([`crate::Robust`]), and (before any release of 3) [`crate::Geometry`]
+/// its material variants and [`crate::Recording`] and [`crate::Baked`] the path's fps. Files
+/// of version 3 written before those two fields fail to decode with a "record or merge it
+/// again" message (the checksum matches, the layout does not).
 pub const FORMAT_VERSION: u32 = 3;
 
 /// Decompressed payloads larger than this are refused (16 GiB).
@@ -221,14 +224,21 @@ fn decode_with<T: DeserializeOwned>(
             reason: format!("decompressed to {} bytes, header says {raw_len}", raw.len()),
         });
     }
+    // The checksum matched, so a payload that does not decode was most likely written by
+    // another build whose types differ at the same version (postcard is not self-describing:
+    // a field added before a release shifts everything after it).
+    let rewrite = format!(
+        "the checksum matches, so another trisort build of format version {FORMAT_VERSION} with a \
+         different layout probably wrote it: record or merge it again with this trisort"
+    );
     let (value, rest) = postcard::take_from_bytes::<T>(&raw).map_err(|e| FormatError::Payload {
         path: p(),
-        reason: format!("decoding failed: {e}"),
+        reason: format!("decoding failed: {e}; {rewrite}"),
     })?;
     if !rest.is_empty() {
         return Err(FormatError::Payload {
             path: p(),
-            reason: format!("{} trailing bytes", rest.len()),
+            reason: format!("{} trailing bytes; {rewrite}", rest.len()),
         });
     }
     Ok(value)
@@ -406,6 +416,41 @@ mod tests {
         let n = big.len() as u64;
         assert_eq!(decompress(&packed, n, true).unwrap(), big);
         assert_eq!(decompress(&packed, n, false).unwrap(), big);
+    }
+
+    /// A file of this version written by a build whose types had fewer fields (here: a
+    /// struct that later gained a trailing field) is refused, saying what to do.
+    #[test]
+    fn an_older_layout_of_the_same_version_is_refused_with_what_to_do() {
+        #[derive(serde::Serialize)]
+        struct Before {
+            a: u32,
+            b: Vec<u8>,
+        }
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct After {
+            a: u32,
+            b: Vec<u8>,
+            fps: Option<f64>,
+        }
+        let bytes = encode(
+            FileKind::Baked,
+            &Before {
+                a: 7,
+                b: vec![1, 2, 3],
+            },
+        );
+        let err = decode::<After>(FileKind::Baked, &bytes, Path::new("early.baked")).unwrap_err();
+        let text = err.to_string();
+        assert!(
+            text.starts_with("early.baked: corrupted payload: decoding failed"),
+            "{text}"
+        );
+        assert!(
+            text.ends_with("record or merge it again with this trisort"),
+            "{text}"
+        );
     }
 
     #[test]

@@ -24,7 +24,9 @@ pub use camera::{world_transforms, Camera, FrameState, NodePose};
 #[cfg(not(target_arch = "wasm32"))]
 pub use container::write_file_atomic;
 pub use container::{read_file, FileKind, FormatError, FORMAT_VERSION};
-pub use geometry::{AlphaMode, Geometry, Material, Node, Texture, Vertex};
+pub use geometry::{
+    AlphaMode, Geometry, Material, MaterialVariant, Node, Texture, VariantError, Vertex,
+};
 pub use options::{
     Bridge, Choice, Choosable, DeviceBackend, DeviceLimits, Layout, Mode, OptionValue,
     ParseOptionError, Seeding, Strategy,

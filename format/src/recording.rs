@@ -294,6 +294,9 @@ pub struct Recording {
     /// Geometry of G (triangle k is scene triangle `unique_visible[k]`); empty for a
     /// `Visibility` recording.
     pub geometry: Geometry,
+    /// Frames per second of the path (TOML `fps`, a generator's `--fps`, the glTF sampling
+    /// rate), carried into the baked file; `None` where the writer did not know it.
+    pub fps: Option<f64>,
 }
 
 impl Recording {
@@ -414,7 +417,7 @@ impl Recording {
         for (f, st) in self.frame_states.iter().enumerate() {
             crate::camera::check_frame_state(f, st, nodes)?;
         }
-        Ok(())
+        crate::baked::check_fps(self.fps)
     }
 
     /// The half-open range of recorded frames.
@@ -459,6 +462,7 @@ mod tests {
             frames: vec![frame(1, vec![2, 5]), frame(2, vec![5, 9])],
             unique_visible: vec![2, 5, 9],
             geometry: Geometry::default(),
+            fps: Some(30.0),
         }
     }
 
@@ -466,7 +470,8 @@ mod tests {
     fn check_structure_accepts_a_valid_recording_and_names_each_fault() {
         visibility().check_structure().unwrap();
         type Edit = fn(&mut Recording);
-        let faults: [(Edit, &str); 8] = [
+        let faults: [(Edit, &str); 9] = [
+            (|r| r.fps = Some(f64::INFINITY), "frame rate inf"),
             (|r| r.unique_visible.push(10), "but the scene has 10"),
             (|r| r.unique_visible.swap(0, 1), "not strictly ascending"),
             (|r| r.frames[1].frame = 3, "contiguous"),

@@ -55,7 +55,7 @@ fn data_texture(
     queue: &wgpu::Queue,
     label: &str,
     bytes: &[u8],
-) -> wgpu::TextureView {
+) -> (wgpu::Texture, wgpu::TextureView) {
     let row = DATA_WIDTH as usize * 16;
     let rows = bytes.len().div_ceil(row).max(1);
     let mut padded = bytes.to_vec();
@@ -73,13 +73,38 @@ fn data_texture(
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            // COPY_DST: material variants rewrite the material texels.
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         },
         wgpu::util::TextureDataOrder::LayerMajor,
         &padded,
     );
-    texture.create_view(&Default::default())
+    let view = texture.create_view(&Default::default());
+    (texture, view)
+}
+
+/// Rewrites the first texels of a data texture made by `data_texture` with `bytes` (a whole
+/// number of 16-byte texels, no more than it holds), the last row padded with zeros.
+pub(crate) fn write_data_texture(queue: &wgpu::Queue, texture: &wgpu::Texture, bytes: &[u8]) {
+    let row = DATA_WIDTH as usize * 16;
+    let rows = bytes.len().div_ceil(row).max(1);
+    let mut padded = bytes.to_vec();
+    padded.resize(rows * row, 0);
+    queue.write_texture(
+        texture.as_image_copy(),
+        &padded,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(row as u32),
+            rows_per_image: Some(rows as u32),
+        },
+        wgpu::Extent3d {
+            width: DATA_WIDTH,
+            height: rows as u32,
+            depth_or_array_layers: 1,
+        },
+    );
 }
 
 /// The texture tier's layout and bind group, and the stride of its per-frame node uniform
@@ -91,7 +116,12 @@ pub(crate) fn bind_group(
     data: &FrameData,
     material_bytes: &[u8],
     frames: usize,
-) -> (wgpu::BindGroupLayout, wgpu::BindGroup, u64) {
+) -> (
+    wgpu::BindGroupLayout,
+    wgpu::BindGroup,
+    u64,
+    crate::scene_gpu::MaterialStore,
+) {
     debug_assert_eq!(data.node_stride, data.node_count * 64);
     let stride = data.frame_stride as usize;
     let mut base = vec![0u8; stride * frames.max(1)];
@@ -104,8 +134,9 @@ pub(crate) fn bind_group(
         contents: &base,
         usage: wgpu::BufferUsages::UNIFORM,
     });
-    let materials = data_texture(device, queue, "material texels", material_bytes);
-    let nodes = data_texture(device, queue, "node matrix texels", &data.node_bytes);
+    let (material_texture, materials) =
+        data_texture(device, queue, "material texels", material_bytes);
+    let (_, nodes) = data_texture(device, queue, "node matrix texels", &data.node_bytes);
     let layout = texture_tier_layout(device);
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("trisort scene (data textures)"),
@@ -125,5 +156,10 @@ pub(crate) fn bind_group(
             },
         ],
     });
-    (layout, bind_group, data.frame_stride)
+    (
+        layout,
+        bind_group,
+        data.frame_stride,
+        crate::scene_gpu::MaterialStore::Texture(material_texture),
+    )
 }

@@ -76,6 +76,20 @@ pub struct SceneGpu {
     /// Per frame: the uniform as uploaded with no offset, and its projection in f64.
     uniforms: Vec<(FrameUniform, glam::DMat4)>,
     view: View,
+    /// Where the material table lives (rewritten by [`SceneGpu::set_materials`]).
+    material_store: MaterialStore,
+    /// Per texture, its uv scale in the array (for rewriting the material table).
+    uv_scales: Vec<[f32; 2]>,
+    /// Number of materials uploaded.
+    material_count: usize,
+}
+
+/// The material table on the GPU: a storage buffer, or the texture tier's data texture.
+pub(crate) enum MaterialStore {
+    /// Storage tier: binding 2.
+    Buffer(wgpu::Buffer),
+    /// Texture tier: the Rgba32Float texture of binding 2, [`DATA_WIDTH`] texels a row.
+    Texture(wgpu::Texture),
 }
 
 fn align(x: u64, a: u64) -> u64 {
@@ -397,7 +411,7 @@ impl SceneGpu {
                 resource: wgpu::BindingResource::Sampler(&sampler),
             },
         };
-        let (layout, bind_group, node_stride) = match bindings {
+        let (layout, bind_group, node_stride, material_store) = match bindings {
             Bindings::Storage => storage_bind_group(device, shared, &data, &materials),
             Bindings::Textures => crate::data_textures::bind_group(
                 device,
@@ -422,6 +436,33 @@ impl SceneGpu {
                 .collect(),
             frame_buffer,
             view,
+            material_store,
+            uv_scales,
+            material_count: geometry.materials.len(),
+        }
+    }
+
+    /// Rewrites the material table with `materials` in place of the uploaded ones (a material
+    /// variant: slot k draws as `materials[k]`; textures are those uploaded, named by index).
+    /// Takes effect for commands submitted after it. Panics unless `materials` has as many
+    /// entries as the geometry uploaded.
+    pub fn set_materials(&self, queue: &wgpu::Queue, materials: &[trisort_format::Material]) {
+        assert_eq!(
+            materials.len(),
+            self.material_count,
+            "a material table replaces one of the same length"
+        );
+        let geometry = Geometry {
+            materials: materials.to_vec(),
+            ..Geometry::default()
+        };
+        let table = material_table(&geometry, &self.uv_scales);
+        let bytes: &[u8] = bytemuck::cast_slice(&table);
+        match &self.material_store {
+            MaterialStore::Buffer(buffer) => queue.write_buffer(buffer, 0, bytes),
+            MaterialStore::Texture(texture) => {
+                crate::data_textures::write_data_texture(queue, texture, bytes)
+            }
         }
     }
 
@@ -647,11 +688,12 @@ fn storage_bind_group(
     shared: SharedBindings<'_>,
     data: &FrameData,
     materials: &[MaterialGpu],
-) -> (wgpu::BindGroupLayout, wgpu::BindGroup, u64) {
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup, u64, MaterialStore) {
     let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("materials"),
         contents: bytemuck::cast_slice(materials),
-        usage: wgpu::BufferUsages::STORAGE,
+        // COPY_DST: material variants rewrite it (`SceneGpu::set_materials`).
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
     });
     let node_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("node matrices"),
@@ -673,7 +715,12 @@ fn storage_bind_group(
             shared.sampler,
         ],
     });
-    (layout, bind_group, data.node_stride)
+    (
+        layout,
+        bind_group,
+        data.node_stride,
+        MaterialStore::Buffer(materials),
+    )
 }
 
 /// Computes [`FrameData`]: camera-relative node matrices in f64, cast once.

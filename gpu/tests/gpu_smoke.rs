@@ -34,6 +34,7 @@ fn one_triangle_renders_and_reads_back() {
             parent: None,
             rest: DMat4::IDENTITY.to_cols_array(),
         }],
+        variants: vec![],
     };
     // Orthographic-like framing: camera 2 units back, fov chosen so y ∈ [-1, 1] fills the view.
     let fov = 2.0 * (0.5f64).atan();

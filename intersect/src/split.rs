@@ -464,6 +464,7 @@ fn assemble(
         materials: geometry.materials.clone(),
         textures: geometry.textures.clone(),
         nodes: geometry.nodes.clone(),
+        variants: geometry.variants.clone(),
     };
     (out, origin, split)
 }

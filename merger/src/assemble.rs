@@ -101,6 +101,7 @@ impl Assembled {
             frames: self.windows,
             frame_states: first.frame_states.clone(),
             removed_edges,
+            fps: first.fps,
         }
     }
 }

@@ -95,6 +95,7 @@ pub fn recording_from_frames(scene_triangles: u32, frames: &[FrameSpec]) -> Reco
             parent: None,
             rest: identity(),
         }],
+        variants: vec![],
     };
     let frame_states = (0..frames.len())
         .map(|_| FrameState {
@@ -131,6 +132,7 @@ pub fn recording_from_frames(scene_triangles: u32, frames: &[FrameSpec]) -> Reco
         frames: records,
         unique_visible: g,
         geometry,
+        fps: None,
     }
 }
 

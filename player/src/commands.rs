@@ -176,6 +176,7 @@ mod tests {
             frames: vec![],
             frame_states: vec![],
             removed_edges: vec![],
+            fps: None,
         }
     }
 

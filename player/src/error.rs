@@ -37,6 +37,10 @@ pub enum PlayerError {
     /// wgpu refused to create a resource or run a command.
     #[error("wgpu: {0}")]
     Wgpu(String),
+    /// A material variant that does not exist or cannot be played exactly
+    /// ([`Player::set_variant`](crate::Player::set_variant)).
+    #[error(transparent)]
+    Variant(#[from] trisort_format::VariantError),
     /// The device was lost or a readback failed.
     #[error("GPU readback failed: {0}")]
     Readback(String),

@@ -139,6 +139,12 @@ impl<'g> HeadlessRenderer<'g> {
         self.player.set_subpixel_offset(&self.gpu.queue, offset);
     }
 
+    /// Plays material variant `name` (`None`: the default materials); see
+    /// [`Player::set_variant`].
+    pub fn set_variant(&self, name: Option<&str>) -> Result<(), PlayerError> {
+        self.player.set_variant(&self.gpu.queue, name)
+    }
+
     /// The player.
     pub fn player(&self) -> &Player {
         &self.player

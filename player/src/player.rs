@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use trisort_format::{Baked, DrawIndexedIndirectArgs, FileKind, FrameWindow};
+use trisort_format::{Baked, DrawIndexedIndirectArgs, FileKind, FrameWindow, Material};
 use trisort_gpu::scene_gpu::{vertex_layout, Bindings, SceneGpu, View};
 use wgpu::util::DeviceExt;
 
@@ -55,6 +55,10 @@ pub struct Player {
     windows: Vec<FrameWindow>,
     config: PlayerConfig,
     warnings: Vec<String>,
+    /// The default material table, and each variant's by name (or why it cannot be played),
+    /// worked out once from the file's geometry.
+    materials: Vec<Material>,
+    variants: Vec<(String, Result<Vec<Material>, trisort_format::VariantError>)>,
 }
 
 impl Player {
@@ -172,7 +176,49 @@ impl Player {
             windows,
             config,
             warnings,
+            materials: baked.geometry.materials.clone(),
+            variants: (baked.geometry.variants.iter())
+                .map(|v| {
+                    let table = baked.geometry.variant_materials(Some(&v.name));
+                    (v.name.clone(), table)
+                })
+                .collect(),
         })
+    }
+
+    /// Draws the file's materials as material variant `name` has them (`None`: the default
+    /// materials), by rewriting the material table: colours, emissive and base-colour texture
+    /// indices change, the sorted order and every buffer stay. Takes effect for commands
+    /// submitted after it.
+    ///
+    /// Errors, leaving the table as it was: [`trisort_format::VariantError::Unknown`] (listing
+    /// the file's variants) when the file has no variant of that name (the first of that name
+    /// counts), and [`trisort_format::VariantError::ChangesVisibility`] when the variant
+    /// changes what decides coverage or opacity (alpha mode, alpha, cutoff, transmission,
+    /// double-sidedness; see [`trisort_format::Geometry::variant_materials`]): the baked order
+    /// would not be exact.
+    pub fn set_variant(&self, queue: &wgpu::Queue, name: Option<&str>) -> Result<(), PlayerError> {
+        let table = match name {
+            None => &self.materials,
+            Some(name) => match self.variants.iter().find(|(n, _)| n == name) {
+                Some((_, Ok(table))) => table,
+                Some((_, Err(e))) => return Err(e.clone().into()),
+                None => {
+                    return Err(trisort_format::VariantError::Unknown {
+                        name: name.to_string(),
+                        available: self.variant_names(),
+                    }
+                    .into())
+                }
+            },
+        };
+        self.scene.set_materials(queue, table);
+        Ok(())
+    }
+
+    /// The names of the file's material variants, in file order.
+    pub fn variant_names(&self) -> Vec<String> {
+        self.variants.iter().map(|(n, _)| n.clone()).collect()
     }
 
     /// Draws frame `frame` into `pass`: binds the pipeline, the frame's uniforms and node

@@ -432,6 +432,8 @@ pub fn record(
         frames,
         unique_visible: g,
         geometry,
+        // The job knows frames, not the path's rate: the CLI sets it from the timeline.
+        fps: None,
     })
 }
 

@@ -259,6 +259,7 @@ pub fn whole_scene_baked(
             .collect(),
         frame_states: frames.to_vec(),
         removed_edges: vec![vec![]; frames.len()],
+        fps: None,
     }
 }
 

@@ -27,8 +27,8 @@ pub struct Scene {
     /// Warnings and notes from import (skipped primitives, ignored extensions, …).
     pub notes: Vec<String>,
     /// Names of the file's material variants (`KHR_materials_variants`), in file order; an
-    /// unnamed variant is `""`. Empty without the extension. (Import keeps each primitive's
-    /// default material; the variants are listed, not applied.)
+    /// unnamed variant is `""`. Empty without the extension. Their material tables are
+    /// [`Geometry::variants`](trisort_format::Geometry::variants), which players apply.
     pub variants: Vec<String>,
     /// [`Scene::hash`], computed on its first call. Leave it empty (`Default::default()`,
     /// which `..Scene::default()` gives) when building a scene by hand or from another

@@ -9,3 +9,4 @@ mod import;
 mod import_bad_input;
 mod import_built;
 mod import_compressed;
+mod import_variants;

@@ -102,6 +102,14 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         "exact_components": s.exact_components, "heuristic_components": s.heuristic_components,
         "heuristic_unordered_samples": s.heuristic_unordered_samples,
         "frames": baked.frames.len(),
+        // The path's frame rate (null where the recordings did not store one); the material
+        // variants' names (as for a scene), and why `play --variant` refuses any of them.
+        "fps": baked.fps,
+        "variants": baked.geometry.variants.iter().map(|v| &v.name).collect::<Vec<_>>(),
+        "variants_refused": baked.geometry.variants.iter().filter_map(|v| {
+            let e = baked.geometry.variant_materials(Some(&v.name)).err()?;
+            Some((v.name.clone(), serde_json::Value::from(e.to_string())))
+        }).collect::<serde_json::Map<_, _>>(),
         "split_intersections": baked.settings.split_intersections,
         // The recording device; `mixed: …` (each device with its frames) when the recordings
         // were merged with `merge --allow-mixed-devices`.

@@ -42,9 +42,16 @@ pub struct PlayArgs {
     /// button or 0-9 to scrub, Escape/Q quit.
     #[arg(long)]
     window: bool,
-    /// With --window: playback rate in frames per second (baked files store none).
-    #[arg(long, default_value_t = 30.0, requires = "window")]
-    fps: f64,
+    /// With --window: playback rate in frames per second (default: the path's, stored in the
+    /// baked file; 30 for files that store none).
+    #[arg(long, requires = "window")]
+    fps: Option<f64>,
+    /// Play the file's materials as material variant NAME (glTF KHR_materials_variants;
+    /// `inspect` lists them): colours and textures change, the sorted order stays. Refused when
+    /// the variant changes what decides visibility (alpha mode, alpha, cutoff, transmission,
+    /// double-sidedness).
+    #[arg(long, value_name = "NAME")]
+    variant: Option<String>,
     /// With --window, for tests and automation: quit after presenting N frames and print how
     /// many were presented.
     #[arg(long, value_name = "N", requires = "window")]
@@ -153,11 +160,12 @@ pub fn play_frames(
     frames: std::ops::Range<u32>,
     out_dir: Option<&Path>,
 ) -> Result<Vec<RenderedFrame>> {
-    Ok(play_frames_on_path(gpu, baked, config, frames, out_dir, [0.0, 0.0])?.0)
+    Ok(play_frames_on_path(gpu, baked, config, frames, out_dir, [0.0, 0.0], None)?.0)
 }
 
-/// [`play_frames`] with the projection shifted by `offset` pixels, also saying which binding
-/// tier and draw path played.
+/// [`play_frames`] with the projection shifted by `offset` pixels and the materials of
+/// material variant `variant` (`None`: the default ones), also saying which binding tier and
+/// draw path played.
 pub fn play_frames_on_path(
     gpu: &Gpu,
     baked: &Baked,
@@ -165,9 +173,11 @@ pub fn play_frames_on_path(
     frames: std::ops::Range<u32>,
     out_dir: Option<&Path>,
     offset: [f64; 2],
+    variant: Option<&str>,
 ) -> Result<(Vec<RenderedFrame>, PlayedPath)> {
     let renderer = HeadlessRenderer::new(gpu, baked, config)?;
     renderer.set_subpixel_offset(offset);
+    renderer.set_variant(variant)?;
     let path = PlayedPath {
         bindings: renderer.player().bindings().name(),
         draw_path: renderer.player().config().draw_path.name(),
@@ -223,6 +233,7 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
             mode: a.mode,
             glass_opacity: a.glass_opacity,
             fps: a.fps,
+            variant: a.variant.clone(),
             exit_after: a.window_frames,
             json: a.json,
         });
@@ -260,7 +271,9 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
         range.clone(),
         a.out_dir.as_deref(),
         offset,
-    )?;
+        a.variant.as_deref(),
+    )
+    .with_context(|| format!("playing {}", a.baked.display()))?;
     let checks = if a.self_check {
         let check = SelfCheck::new(&gpu, &baked, config.size, config.samples)?;
         check.set_subpixel_offset(offset);
@@ -295,6 +308,7 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
             "bindings": path.bindings,
             "draw_path": path.draw_path,
             "mode": a.mode.name(),
+            "variant": a.variant,
             "subpixel_offset": offset,
             "frames": list,
         });

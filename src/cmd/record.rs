@@ -146,7 +146,7 @@ pub fn record_to_file(
         );
     }
     let bar = progress_bar(0, "record");
-    let rec = record(gpu, &job, Some(&partial), |p| {
+    let mut rec = record(gpu, &job, Some(&partial), |p| {
         if bar.length() != Some(p.total as u64) || bar.prefix() != format!("phase {}", p.phase) {
             bar.set_prefix(format!("phase {}", p.phase));
             bar.set_length(p.total as u64);
@@ -156,6 +156,8 @@ pub fn record_to_file(
     })
     .with_context(|| format!("recording {}", output.display()))?;
     bar.finish_and_clear();
+    // The path's rate travels with the recording into the baked file (players default to it).
+    rec.fps = Some(timeline.fps);
     trisort_format::write_file_atomic(FileKind::Recording, output, &rec)?;
     partial.remove()?;
     Ok(rec)

@@ -73,6 +73,10 @@ pub struct VerifyArgs {
     /// the checked size. Needs `--scene`.
     #[arg(long, value_name = "DIR", requires = "scene")]
     frames_dir: Option<PathBuf>,
+    /// Check material variant NAME (as `play --variant NAME` plays it): the player and the
+    /// exact reference both draw the variant's materials. Needs `--scene`.
+    #[arg(long, value_name = "NAME", requires = "scene")]
+    variant: Option<String>,
     /// Shift the projection of the player and of the exact reference by X,Y pixels (x right,
     /// y down; decimals or fractions such as `1/16,0`): a test aid standing for another GPU's
     /// vertex snapping. Off the recorded pattern: measured, failing only above --max-error.
@@ -322,6 +326,22 @@ fn image_check(
             );
         }
     }
+    // A variant: the file and the scene both with the variant's material table (after the
+    // hash checks, which are of the default materials).
+    let with_variant;
+    let baked = match &a.variant {
+        None => baked,
+        Some(name) => {
+            let mut b = baked.clone();
+            b.geometry.materials = (b.geometry.variant_materials(Some(name)))
+                .with_context(|| format!("verifying {}", a.baked.display()))?;
+            let table = (scene.geometry.variant_materials(Some(name)))
+                .with_context(|| format!("scene {spec}"))?;
+            scene.geometry_mut().materials = table;
+            with_variant = b;
+            &with_variant
+        }
+    };
     let n = baked.frames.len() as u32;
     let range = match a.frames {
         Some(r) => r.resolve(n)?,

@@ -31,6 +31,7 @@ fn geometry(n: u32) -> Geometry {
                 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.,
             ],
         }],
+        variants: vec![],
     }
 }
 
@@ -90,6 +91,7 @@ fn recording() -> Recording {
         ],
         unique_visible: vec![A, H, B],
         geometry: geometry(3),
+        fps: None,
     }
 }
 
@@ -140,6 +142,7 @@ fn baked(
         frames,
         frame_states: rec.frame_states.clone(),
         removed_edges: vec![vec![], vec![]],
+        fps: rec.fps,
     };
     restat(&mut b, rec);
     b

@@ -102,6 +102,7 @@ pub fn quads() -> Baked {
         ],
         frame_states: vec![frame_state(); frames],
         removed_edges: vec![vec![]; frames],
+        fps: None,
     }
 }
 

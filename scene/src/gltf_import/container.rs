@@ -20,6 +20,8 @@ const HANDLED_EXTENSIONS: &[&str] = &[
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
     draco::EXTENSION,
+    // Each variant's material table is stored with the geometry (`Geometry::variants`).
+    VARIANTS,
 ];
 
 /// The material variants extension, whose names `inspect` lists.
@@ -40,6 +42,64 @@ fn variant_names(root: &serde_json::Value) -> Vec<String> {
         .collect()
 }
 
+/// Per primitive `(mesh, primitive)`: for each variant, the material it shows under that
+/// variant (`None`: its default material).
+pub(super) type VariantMaps = BTreeMap<(usize, usize), Vec<Option<u32>>>;
+
+/// The primitives' `KHR_materials_variants` mappings, for `variants` variants over
+/// `materials` materials, and a note per mapping left out (a material or variant index
+/// outside the file's, a variant mapped twice in one primitive: the first mapping counts).
+fn variant_maps(
+    root: &serde_json::Value,
+    variants: usize,
+    materials: usize,
+) -> (VariantMaps, Vec<String>) {
+    let mut maps = VariantMaps::new();
+    let mut notes = Vec::new();
+    if variants == 0 {
+        return (maps, notes);
+    }
+    let meshes = root.get("meshes").and_then(serde_json::Value::as_array);
+    for (m, mesh) in meshes.into_iter().flatten().enumerate() {
+        let prims = mesh.get("primitives").and_then(serde_json::Value::as_array);
+        for (p, prim) in prims.into_iter().flatten().enumerate() {
+            let mappings = (prim.get("extensions"))
+                .and_then(|e| e.get(VARIANTS))
+                .and_then(|v| v.get("mappings"))
+                .and_then(serde_json::Value::as_array);
+            let Some(mappings) = mappings else { continue };
+            let mut map = vec![None; variants];
+            for mapping in mappings {
+                let material = mapping.get("material").and_then(serde_json::Value::as_u64);
+                let list = mapping
+                    .get("variants")
+                    .and_then(serde_json::Value::as_array);
+                let Some(material) = material.filter(|&i| (i as usize) < materials) else {
+                    notes.push(format!(
+                        "mesh {m} primitive {p}: a {VARIANTS} mapping names no material of the \
+                         file's {materials}; left out"
+                    ));
+                    continue;
+                };
+                for v in list.into_iter().flatten() {
+                    match v.as_u64().map(|v| v as usize) {
+                        Some(v) if v < variants && map[v].is_none() => {
+                            map[v] = Some(material as u32)
+                        }
+                        _ => notes.push(format!(
+                            "mesh {m} primitive {p}: {VARIANTS} mapping of material {material} \
+                             names variant {v}, which is not one of the file's {variants} or is \
+                             mapped already; left out"
+                        )),
+                    }
+                }
+            }
+            maps.insert((m, p), map);
+        }
+    }
+    (maps, notes)
+}
+
 /// A parsed file: its glTF document, for GLB its binary chunk, and its meshopt-compressed
 /// buffer views.
 pub(super) struct Parsed<'a> {
@@ -56,6 +116,10 @@ pub(super) struct Parsed<'a> {
     pub placeholders: BTreeSet<usize>,
     /// Names of the `KHR_materials_variants` variants.
     pub variants: Vec<String>,
+    /// The primitives' variant mappings.
+    pub variant_maps: VariantMaps,
+    /// Notes on mappings left out.
+    pub variant_notes: Vec<String>,
 }
 
 /// Parses a file into its glTF document and, for GLB, its binary chunk. A required extension
@@ -81,7 +145,7 @@ pub(super) fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>, Scen
     root.extensions_required
         .retain(|e| gltf::json::extensions::ENABLED_EXTENSIONS.contains(&e.as_str()));
     let uses = |names: &[&str]| (root.extensions_used.iter()).any(|e| names.contains(&e.as_str()));
-    let (compression, draco, variants) =
+    let (compression, draco, variants, (variant_maps, variant_notes)) =
         if uses(&meshopt::EXTENSIONS) || uses(&[draco::EXTENSION, VARIANTS]) {
             // The `gltf` crate drops extension objects it does not know: read them from the JSON.
             let raw: serde_json::Value =
@@ -93,7 +157,9 @@ pub(super) fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>, Scen
                 file: file.to_path_buf(),
                 problem,
             })?;
-            (meshopt::read(&raw, file)?, draco, variant_names(&raw))
+            let names = variant_names(&raw);
+            let maps = variant_maps(&raw, names.len(), root.materials.len());
+            (meshopt::read(&raw, file)?, draco, names, maps)
         } else {
             Default::default()
         };
@@ -147,6 +213,8 @@ pub(super) fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>, Scen
         draco,
         placeholders,
         variants,
+        variant_maps,
+        variant_notes,
     })
 }
 
@@ -389,9 +457,6 @@ impl Importer<'_> {
                 let what = match ext {
                     "KHR_texture_transform" => {
                         "textures are sampled with untransformed coordinates"
-                    }
-                    "KHR_materials_variants" => {
-                        "each primitive keeps its default material (inspect lists the variants)"
                     }
                     "KHR_materials_volume" => "glass thickness and attenuation are not modelled",
                     _ => "not supported",

@@ -3,7 +3,7 @@
 use std::borrow::Cow;
 use std::collections::HashMap;
 
-use trisort_format::{AlphaMode, Material, Texture};
+use trisort_format::{AlphaMode, Material, MaterialVariant, Texture};
 
 use super::container::read_uri;
 use super::{label, Importer};
@@ -21,6 +21,10 @@ pub(super) struct Materials {
     pub(super) uv_set: Vec<Option<u32>>,
     /// Index of the default material once appended.
     default: Option<u32>,
+    /// Per slot of `list`, once a primitive uses it: the material each variant shows there.
+    targets: Vec<Option<Vec<u32>>>,
+    /// Slots added for a material that primitives map differently: `(material, targets)`.
+    copies: HashMap<(u32, Vec<u32>), u32>,
 }
 
 impl Materials {
@@ -41,6 +45,51 @@ impl Materials {
     }
 }
 
+impl Materials {
+    /// The slot a primitive with material `material` draws with, given the material each
+    /// variant shows on it (`targets`, one per variant): `material` itself for the first such
+    /// primitive and every one mapped alike; a copy of it, in a slot of its own, for a
+    /// primitive mapped differently.
+    pub(super) fn slot(&mut self, material: u32, targets: Vec<u32>) -> u32 {
+        self.targets.resize(self.list.len(), None);
+        match &self.targets[material as usize] {
+            None => {
+                self.targets[material as usize] = Some(targets);
+                material
+            }
+            Some(t) if *t == targets => material,
+            Some(_) => {
+                if let Some(&slot) = self.copies.get(&(material, targets.clone())) {
+                    return slot;
+                }
+                self.list.push(self.list[material as usize].clone());
+                self.uv_set.push(self.uv_set[material as usize]);
+                let slot = (self.list.len() - 1) as u32;
+                self.targets.push(Some(targets.clone()));
+                self.copies.insert((material, targets), slot);
+                slot
+            }
+        }
+    }
+
+    /// One table per variant (named by `names`): per slot, the material the variant shows
+    /// there (the slot itself where no primitive maps it).
+    pub(super) fn variant_tables(&self, names: &[String]) -> Vec<MaterialVariant> {
+        let slots = self.list.len();
+        (names.iter().enumerate())
+            .map(|(v, name)| MaterialVariant {
+                name: name.clone(),
+                materials: (0..slots)
+                    .map(|s| match self.targets.get(s) {
+                        Some(Some(t)) => t[v],
+                        _ => s as u32,
+                    })
+                    .collect(),
+            })
+            .collect()
+    }
+}
+
 impl Importer<'_> {
     /// Converts every material of the file, decoding its base-colour texture.
     pub(super) fn materials(&mut self) -> Result<Materials, SceneError> {
@@ -49,6 +98,8 @@ impl Importer<'_> {
             textures: Vec::new(),
             uv_set: Vec::new(),
             default: None,
+            targets: Vec::new(),
+            copies: HashMap::new(),
         };
         let mut texture_of_image: HashMap<usize, u32> = HashMap::new();
         for m in self.doc.materials() {

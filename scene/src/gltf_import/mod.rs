@@ -21,6 +21,11 @@
 //!   (glTF's defaults) when some primitive has none: base colour factor and texture, alpha mode
 //!   and cutoff, double-sidedness, emissive × `KHR_materials_emissive_strength`, and the
 //!   `KHR_materials_transmission` factor. Other extensions are ignored with one note each.
+//! - **Material variants** (`KHR_materials_variants`): per variant, the material each
+//!   material slot shows ([`Geometry::variants`](trisort_format::Geometry::variants)). glTF
+//!   maps variants per primitive; where primitives sharing a material map it differently, a
+//!   primitive gets a copy of its material in a slot of its own (appended after the default
+//!   material, in order of first use), so one table per variant says it all.
 //! - **Textures**: only base-colour textures, decoded (PNG or JPEG) to RGBA8, one per image
 //!   (two textures sharing an image share one [`Texture`](trisort_format::Texture)), in order
 //!   of first use by the materials. [`Vertex::uv`](trisort_format::Vertex::uv) holds the
@@ -143,6 +148,8 @@ pub fn load_slice_with_sources(
         draco,
         placeholders,
         variants,
+        variant_maps,
+        variant_notes,
     } = container::parse(bytes, file)?;
     let mut importer = Importer {
         file: file.to_path_buf(),
@@ -156,7 +163,8 @@ pub fn load_slice_with_sources(
         draco_indices: Default::default(),
         draco_placeholders: placeholders,
         variants,
-        notes: Vec::new(),
+        variant_maps,
+        notes: variant_notes,
         sources: Vec::new(),
     };
     importer.load_buffers(bin)?;
@@ -204,6 +212,8 @@ struct Importer<'d> {
     draco_placeholders: std::collections::BTreeSet<usize>,
     /// Names of the file's material variants.
     variants: Vec<String>,
+    /// Per primitive, the material each variant gives it.
+    variant_maps: container::VariantMaps,
     /// Warnings and notes for [`Scene::notes`].
     notes: Vec<String>,
     /// Per imported triangle, where it comes from.

@@ -92,6 +92,7 @@ impl Importer<'_> {
             }
         }
         self.note_skipped(&skipped);
+        geometry.variants = materials.variant_tables(&self.variants);
         geometry.materials = materials.list;
         geometry.textures = materials.textures;
         Ok((geometry, zero_area_triangles))
@@ -119,8 +120,17 @@ impl Importer<'_> {
             ));
             return Ok(None);
         }
-        let material = materials.of(prim);
-        self.primitive(mesh, prim, material, materials.uv_set[material as usize])
+        let default = materials.of(prim);
+        let targets: Vec<u32> = match self.variant_maps.get(&(mesh.index(), prim.index())) {
+            Some(map) => map.iter().map(|t| t.unwrap_or(default)).collect(),
+            None => vec![default; self.variants.len()],
+        };
+        // Texture coordinates for the default material's texture, or else for the first
+        // textured material a variant puts here (an untextured default reads none).
+        let uv_set = (std::iter::once(default).chain(targets.iter().copied()))
+            .find_map(|m| materials.uv_set[m as usize]);
+        let material = materials.slot(default, targets);
+        self.primitive(mesh, prim, material, uv_set)
     }
 
     /// One note per kind of skipped primitive, naming the first few.

@@ -14,8 +14,10 @@
 //!
 //! Controls: Space play/pause; Right/Left step one frame; Home/End first/last frame; drag with
 //! the left mouse button, or the keys 0–9, to scrub (0–9 jump to tenths of the range);
-//! Escape or Q quit. Playback loops over the frame range at `--fps` (baked files store no
-//! frame rate; 30 by default). The title shows the frame index.
+//! Escape or Q quit. Playback loops over the frame range at `--fps`, by default the path's
+//! rate stored in the baked file (30 for a file that stores none). `--variant` plays a
+//! material variant, applied again whenever the player is rebuilt. The title shows the frame
+//! index.
 
 use std::collections::HashSet;
 use std::ops::Range;
@@ -62,8 +64,10 @@ pub struct WindowArgs<'a> {
     pub mode: Mode,
     /// Glass opacity (default: the recorded one).
     pub glass_opacity: Option<f32>,
-    /// Playback rate in frames per second.
-    pub fps: f64,
+    /// Playback rate in frames per second (default: the file's, else 30).
+    pub fps: Option<f64>,
+    /// Material variant to play (default: the file's default materials).
+    pub variant: Option<String>,
     /// For tests and automation: quit after presenting this many frames.
     pub exit_after: Option<u64>,
     /// Print the summary as JSON.
@@ -95,10 +99,16 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
     if !display_named() {
         bail!("{NO_DISPLAY}");
     }
-    if !(a.fps.is_finite() && a.fps > 0.0) {
-        bail!("--fps must be a positive number, not {}", a.fps);
+    if let Some(fps) = a.fps.filter(|f| !(f.is_finite() && *f > 0.0)) {
+        bail!("--fps must be a positive number, not {fps}");
     }
     let baked = trisort_player::open_baked(a.baked)?;
+    // Checked once here (the file's structure check holds its fps finite and positive).
+    let fps = a.fps.or(baked.fps).unwrap_or(30.0);
+    baked
+        .geometry
+        .variant_materials(a.variant.as_deref())
+        .with_context(|| format!("playing {}", a.baked.display()))?;
     let n = baked.frames.len() as u32;
     let range = match &a.frames {
         Some(r) => r.resolve(n)?,
@@ -117,7 +127,8 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
         samples: a.samples.unwrap_or(baked.settings.samples).max(1),
         mode: a.mode,
         glass_opacity: a.glass_opacity,
-        period: Duration::from_secs_f64(1.0 / a.fps),
+        period: Duration::from_secs_f64(1.0 / fps),
+        variant: a.variant,
         exit_after: a.exit_after,
         path: a.baked.to_path_buf(),
         name,
@@ -152,6 +163,8 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
         print_json(&json!({
             "device": device,
             "mode": viewer.mode.name(),
+            "variant": viewer.variant,
+            "fps": fps,
             "presented_frames": viewer.presented,
             "last_frame": viewer.frame,
         }));
@@ -174,6 +187,8 @@ struct Viewer {
     mode: Mode,
     glass_opacity: Option<f32>,
     period: Duration,
+    /// Material variant, applied to every player built.
+    variant: Option<String>,
     exit_after: Option<u64>,
     path: PathBuf,
     name: String,
@@ -409,6 +424,7 @@ impl Viewer {
         };
         let gfx = Gfx::open(window, event_loop.owned_display_handle(), &self.baked, play)
             .with_context(|| format!("playing {}", self.path.display()))?;
+        (gfx.targets.player()).set_variant(&gfx.gpu.queue, self.variant.as_deref())?;
         self.print_warnings(gfx.targets.player().warnings());
         Ok(gfx)
     }
@@ -417,6 +433,7 @@ impl Viewer {
     fn rebuild(&mut self, size: (u32, u32)) -> Result<()> {
         let g = self.gfx.as_mut().expect("rebuild after open");
         g.rebuild(&self.baked, size)?;
+        (g.targets.player()).set_variant(&g.gpu.queue, self.variant.as_deref())?;
         let warnings = g.targets.player().warnings().to_vec();
         self.print_warnings(&warnings);
         Ok(())
