@@ -12,7 +12,8 @@ import json
 import struct
 import sys
 
-# Versions this reader understands (FORMAT.md § Compatibility): 3, and 2 (no `robust`).
+# Versions this reader understands (FORMAT.md § Compatibility): 3, and 2 (no `robust`, no
+# `Geometry.variants`, no `fps`).
 FORMAT_VERSIONS = (2, 3)
 ORDER_VERSION = 1
 
@@ -141,6 +142,8 @@ def read_baked(p, version):
                                    "rgba8": p.bytes()})
     g["nodes"] = p.seq(lambda: {"name": p.string(), "parent": p.option(p.u32),
                                 "rest": p.array(p.f64, 16)})
+    if version >= 3:
+        g["variants"] = p.seq(lambda: {"name": p.string(), "materials": p.seq(p.u32)})
     b["geometry"] = g
     b["scene_ids"] = p.seq(p.u32)
     b["copies"] = p.seq(p.u32)
@@ -151,6 +154,7 @@ def read_baked(p, version):
     b["frame_states"] = p.seq(lambda: {"camera": camera(),
                                        "poses": p.seq(lambda: (p.u32(), p.array(p.f64, 16)))})
     b["removed_edges"] = p.seq(lambda: p.seq(lambda: (p.u32(), p.u32(), p.u32())))
+    b["fps"] = p.option(p.f64) if version >= 3 else None
     return b
 
 
@@ -194,6 +198,8 @@ def baked_summary(data):
         "materials": len(g["materials"]),
         "textures": len(g["textures"]),
         "nodes": len(g["nodes"]),
+        "variants": [v["name"] for v in g.get("variants", [])],
+        "fps": b["fps"],
         "draws": len(b["draws"]),
         "draws_per_frame_max": max((w[1] for w in b["frames"]), default=0),
         "stats_index_triangles": b["stats"]["index_triangles"],

@@ -65,6 +65,9 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
     assert_eq!(ours["stats_index_triangles"], inspect["index_triangles"]);
     assert_eq!(ours["triangles"], ours["unique_visible"]);
     assert_eq!(ours["textures"], 1, "the demo car's licence plate");
+    assert_eq!(ours["fps"], inspect["fps"]);
+    assert_eq!(ours["fps"], 30.0, "the generators' default rate");
+    assert_eq!(ours["variants"], serde_json::json!([]));
     assert_eq!(
         (ours["width"].as_u64(), ours["samples"].as_u64()),
         (Some(64), Some(4))

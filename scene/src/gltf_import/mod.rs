@@ -30,7 +30,8 @@
 //!   (two textures sharing an image share one [`Texture`](trisort_format::Texture)), in order
 //!   of first use by the materials. [`Vertex::uv`](trisort_format::Vertex::uv) holds the
 //!   texture coordinate set the material's base-colour texture names (`TEXCOORD_0` almost
-//!   always; another set is noted) and is zero for untextured materials.
+//!   always; another set is noted), or for an untextured material the set of the first
+//!   textured material a variant maps it to, and is zero otherwise.
 //! - **Animations**: translation, rotation and scale channels with their times and flattened
 //!   values (LINEAR, STEP, CUBICSPLINE); morph-weight channels are skipped with a note.
 //! - **Cameras**: perspective cameras on nodes of the scene; orthographic ones are noted and
