@@ -1,20 +1,25 @@
 //! Recorder benchmark (numbers for BENCHMARKS.md, not a test).
 //!
 //! ```sh
-//! cargo run --release -p trisort-recorder --example bench_record -- SCENE PATH SIZE SAMPLES STRIDE
+//! cargo run --release -p trisort-recorder --example bench_record -- SCENE PATH SIZE SAMPLES STRIDE [compare]
 //! ```
 //!
 //! Records every STRIDE-th frame of the path (a sample of its frames: G then comes from those
-//! frames only), and prints seconds per frame of each phase, peel passes per frame, peak
-//! memory, and a peel pass's cost relative to a plain pass over the same triangles, measured
-//! in the same run.
+//! frames only), and prints seconds per frame of each phase, peel passes per frame, bytes
+//! read back per frame, peak memory, and a peel pass's cost relative to a plain pass over the
+//! same triangles, measured in the same run. With `compare`, first the same with the former
+//! interleaved readback (`with_interleaved_readback`), then the current one, in one process,
+//! and checks that both recordings are identical.
 
 use std::time::Instant;
 
+use trisort_format::Recording;
 use trisort_format::{Phase, RecordSettings};
 use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
-use trisort_recorder::{bench::pass_cost, record, RecordJob};
+use trisort_recorder::{
+    bench::pass_cost, readback_counters, record, with_interleaved_readback, RecordJob,
+};
 
 fn peak_rss_mib() -> f64 {
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
@@ -25,10 +30,28 @@ fn peak_rss_mib() -> f64 {
         .map_or(f64::NAN, |kb| kb / 1024.0)
 }
 
+/// CPU seconds (user + system, every thread: llvmpipe renders on worker threads) of this
+/// process so far; less sensitive than wall time to other processes sharing the cores.
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // After the command name (which may hold spaces): utime and stime are the 12th and 13th
+    // fields, in clock ticks (100 a second on Linux).
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .map(|v| v.parse().unwrap_or(f64::NAN))
+        .collect();
+    if f.len() < 13 {
+        return f64::NAN;
+    }
+    (f[11] + f[12]) / 100.0
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() != 6 {
-        eprintln!("usage: bench_record SCENE PATH SIZE SAMPLES STRIDE");
+    let compare = args.len() == 7 && args[6] == "compare";
+    if args.len() != 6 && !compare {
+        eprintln!("usage: bench_record SCENE PATH SIZE SAMPLES STRIDE [compare]");
         std::process::exit(2);
     }
     let scene = trisort_scene::load(std::path::Path::new(&args[1])).expect("scene");
@@ -54,62 +77,99 @@ fn main() {
         phase: Phase::Graphs,
         known_visible: None,
     };
-    let mut last = Instant::now();
-    let (mut p1, mut p2) = (vec![], vec![]);
-    let t0 = Instant::now();
-    let rec = record(&gpu, &job, None, |p| {
-        let dt = last.elapsed().as_secs_f64();
-        last = Instant::now();
-        if p.phase == 1 {
-            p1.push(dt)
-        } else {
-            p2.push(dt)
-        }
-    })
-    .expect("record");
-    let total = t0.elapsed().as_secs_f64();
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-    let max = |v: &[f64]| v.iter().cloned().fold(0.0, f64::max);
-    let l1: Vec<f64> = rec.frames.iter().map(|f| f.layers[0] as f64).collect();
-    let l2: Vec<f64> = rec.frames.iter().map(|f| f.layers[1] as f64).collect();
-    let vis: Vec<f64> = rec.frames.iter().map(|f| f.visible.len() as f64).collect();
     println!("device: {}", gpu.describe());
     println!("scene: {} ({} triangles), path {} ({} frames, every {stride}th: {} recorded), {size}x{size} at {samples}x", scene.name, scene.geometry.triangles.len(), args[2], timeline.frames.len(), frames.len());
-    println!("| phase | s/frame mean | s/frame max | peel passes/frame mean | max |");
-    println!("|---|---|---|---|---|");
-    println!(
-        "| 1 visibility (all triangles, until saturated) | {:.3} | {:.3} | {:.1} | {} |",
-        mean(&p1),
-        max(&p1),
-        mean(&l1),
-        max(&l1)
-    );
-    println!(
-        "| 2 graphs (G only, complete) | {:.3} | {:.3} | {:.1} | {} |",
-        mean(&p2),
-        max(&p2),
-        mean(&l2),
-        max(&l2)
-    );
-    println!(
-        "total {:.1} s; |G| = {} ({:.1} % of the scene); |V_f| mean {:.0}; peak RSS {:.0} MiB",
-        total,
-        rec.unique_visible.len(),
-        100.0 * rec.unique_visible.len() as f64 / scene.geometry.triangles.len() as f64,
-        mean(&vis),
-        peak_rss_mib()
-    );
     let view = View {
         width: size,
         height: size,
         samples,
         glass_opacity: 0.0,
     };
-    for f in [0u32, (frames.len() / 2) as u32] {
-        let c = pass_cost(&gpu, &scene.geometry, &frames, view, f, 5).expect("pass cost");
+    let run = || {
+        let mut last = (Instant::now(), readback_counters(), cpu_seconds());
+        // Per frame of each phase: wall seconds, layers peeled (including the last, empty,
+        // one), bytes read back, CPU seconds.
+        let (mut p1, mut p2) = (vec![], vec![]);
+        let t0 = Instant::now();
+        let rec = record(&gpu, &job, None, |p| {
+            let now = (Instant::now(), readback_counters(), cpu_seconds());
+            let d = (
+                (now.0 - last.0).as_secs_f64(),
+                (now.1 .0 - last.1 .0) as f64,
+                (now.1 .1 - last.1 .1) as f64,
+                now.2 - last.2,
+            );
+            last = now;
+            if p.phase == 1 {
+                p1.push(d)
+            } else {
+                p2.push(d)
+            }
+        })
+        .expect("record");
+        let total = t0.elapsed().as_secs_f64();
+        report(&rec, &p1, &p2, total, scene.geometry.triangles.len());
+        for f in [0u32, (frames.len() / 2) as u32] {
+            let c = pass_cost(&gpu, &scene.geometry, &frames, view, f, 5).expect("pass cost");
+            println!(
+                "frame {f}: peel layer {:.1} ms (render {:.1} ms + gather/readback), plain pass {:.1} ms: render ratio {:.2}x, with readback {:.2}x",
+                c.peel_ms, c.peel_render_ms, c.plain_ms, c.peel_render_ms / c.plain_ms, c.peel_ms / c.plain_ms
+            );
+        }
+        rec
+    };
+    if compare {
+        println!("\nbefore: interleaved readback (16 bytes a sample, all fields)");
+        let before = with_interleaved_readback(run);
+        println!("\nafter: compact readback");
+        let after = run();
+        let bytes = |r: &Recording| postcard::to_stdvec(r).expect("serialises");
+        let same = bytes(&before) == bytes(&after);
+        println!("\nrecordings identical: {same}");
+        if !same {
+            std::process::exit(1);
+        }
+    } else {
+        run();
+    }
+    println!("peak RSS {:.0} MiB", peak_rss_mib());
+}
+
+/// One frame: wall seconds, layers peeled, bytes read back, CPU seconds.
+type FrameCost = (f64, f64, f64, f64);
+
+/// Prints the per-phase table: `p1`, `p2` hold one [`FrameCost`] per frame.
+fn report(rec: &Recording, p1: &[FrameCost], p2: &[FrameCost], total: f64, tris: usize) {
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let max = |v: &[f64]| v.iter().cloned().fold(0.0, f64::max);
+    let col = |v: &[FrameCost], k: usize| -> Vec<f64> {
+        v.iter().map(|d| [d.0, d.1, d.2, d.3][k]).collect()
+    };
+    let l1: Vec<f64> = rec.frames.iter().map(|f| f.layers[0] as f64).collect();
+    let l2: Vec<f64> = rec.frames.iter().map(|f| f.layers[1] as f64).collect();
+    let vis: Vec<f64> = rec.frames.iter().map(|f| f.visible.len() as f64).collect();
+    println!("| phase | s/frame mean | s/frame max | CPU s/frame mean | peel passes/frame mean | max | layers read back/frame | MiB read back/frame |");
+    println!("|---|---|---|---|---|---|---|---|");
+    for (name, p, l) in [
+        ("1 visibility (all triangles, until saturated)", p1, &l1),
+        ("2 graphs (G only, complete)", p2, &l2),
+    ] {
         println!(
-            "frame {f}: peel layer {:.1} ms (render {:.1} ms + gather/readback), plain pass {:.1} ms: render ratio {:.2}x, with readback {:.2}x",
-            c.peel_ms, c.peel_render_ms, c.plain_ms, c.peel_render_ms / c.plain_ms, c.peel_ms / c.plain_ms
+            "| {name} | {:.3} | {:.3} | {:.3} | {:.1} | {} | {:.1} | {:.1} |",
+            mean(&col(p, 0)),
+            max(&col(p, 0)),
+            mean(&col(p, 3)),
+            mean(l),
+            max(l),
+            mean(&col(p, 1)),
+            mean(&col(p, 2)) / (1 << 20) as f64
         );
     }
+    println!(
+        "total {:.1} s; |G| = {} ({:.1} % of the scene); |V_f| mean {:.0}",
+        total,
+        rec.unique_visible.len(),
+        100.0 * rec.unique_visible.len() as f64 / tris as f64,
+        mean(&vis),
+    );
 }

@@ -189,7 +189,8 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
     let slots = (SIZE * SIZE * 4) as u64;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: None,
-        size: slots * 16,
+        // Three arrays of one word a sample: ids, alpha, depth (gather.wgsl).
+        size: slots * 12,
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
@@ -241,9 +242,9 @@ fn independent_render(gpu: &Gpu, g: &Geometry, frames: &[FrameState], view: View
         pass.dispatch_workgroups(SIZE.div_ceil(8), SIZE.div_ceil(8), 1);
     }
     gpu.queue.submit([enc.finish()]);
-    let bytes = gpu.read_buffer(&out, 0, slots * 16);
-    let words: &[u32] = bytemuck::cast_slice(&bytes);
-    words.chunks_exact(4).map(|s| s[0]).collect()
+    // The ids are the first array.
+    let bytes = gpu.read_buffer(&out, 0, slots * 4);
+    bytemuck::cast_slice(&bytes).to_vec()
 }
 
 #[test]

@@ -34,6 +34,8 @@ use trisort_gpu::Gpu;
 
 pub use conservative::Conservative;
 use partial::{Graph, Visibility};
+#[doc(hidden)]
+pub use peeler::{readback_counters, with_interleaved_readback};
 pub use peeler::{Layer, Peeler};
 
 /// Errors while recording.
@@ -128,6 +130,10 @@ fn visibility_frame(
 ) -> Result<Visibility, RecordError> {
     let slots = peeler.slots();
     let mut visible = vec![];
+    // Per drawn triangle (phase 1 draws every scene triangle, in id order): reached before
+    // saturation. One flag a triangle instead of one entry a sample and layer to sort.
+    let interleaved = peeler::interleaved();
+    let mut reached = vec![false; if interleaved { 0 } else { peeler.triangles() }];
     let residual = 1.0 - s.saturation;
     let (mut layers, mut truncated) = (0, false);
     let offsets = s.robust.offsets();
@@ -143,7 +149,11 @@ fn visibility_frame(
                     continue;
                 }
                 // Reached before saturation: visible (its own opacity does not matter).
-                visible.push(id - 1);
+                if interleaved {
+                    visible.push(id - 1);
+                } else {
+                    reached[(id - 1) as usize] = true;
+                }
                 transmittance[i] *= 1.0 - layer.alpha[i];
                 if transmittance[i] <= residual {
                     done[i] = 1;
@@ -157,6 +167,13 @@ fn visibility_frame(
     if offsets.len() > 1 {
         peeler.set_subpixel_offset([0.0, 0.0]);
     }
+    visible.extend(
+        reached
+            .iter()
+            .enumerate()
+            .filter(|(_, &r)| r)
+            .map(|(t, _)| t as u32),
+    );
     if let Some(c) = conservative {
         visible.extend(c.visible(frame)?);
     }
@@ -309,7 +326,9 @@ pub fn record(
         let total = phase1_range.len() as u32;
         let mut done = total - todo.len() as u32;
         if !todo.is_empty() {
-            let peeler = Peeler::new(gpu, job.geometry, &all_ids, job.frames, view)?;
+            // Phase 1 needs ids and alpha, not depth.
+            let peeler = Peeler::new(gpu, job.geometry, &all_ids, job.frames, view)?
+                .with_readback(true, false);
             let conservative = if s.robust.conservative {
                 Some(Conservative::new(
                     gpu,
@@ -380,17 +399,24 @@ pub fn record(
                 Some(r) => r,
                 None => {
                     if peeler.is_none() {
-                        peeler = Some(Peeler::new(gpu, job.geometry, &g, job.frames, view)?);
+                        // Phase 2 needs ids and depth (ties), not alpha.
+                        peeler = Some(
+                            Peeler::new(gpu, job.geometry, &g, job.frames, view)?
+                                .with_readback(false, true),
+                        );
                     }
                     if s.robust.conservative && grown.is_none() {
-                        grown = Some(Peeler::grown(
-                            gpu,
-                            job.geometry,
-                            &g,
-                            job.frames,
-                            view,
-                            s.robust.tolerance,
-                        )?);
+                        grown = Some(
+                            Peeler::grown(
+                                gpu,
+                                job.geometry,
+                                &g,
+                                job.frames,
+                                view,
+                                s.robust.tolerance,
+                            )?
+                            .with_readback(false, true),
+                        );
                     }
                     let r = graph_frame(peeler.as_ref().unwrap(), grown.as_ref(), f, &g, &s)?;
                     if let Some(p) = partial {

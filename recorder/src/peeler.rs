@@ -20,10 +20,47 @@ use crate::RecordError;
 pub struct Layer {
     /// Per sample: drawn position + 1, 0 where the layer has no fragment.
     pub ids: Vec<u32>,
-    /// Per sample: the fragment's opacity.
+    /// Per sample: the fragment's opacity; empty unless read back ([`Peeler::with_readback`]).
     pub alpha: Vec<f32>,
-    /// Per sample: the fragment's depth.
+    /// Per sample: the fragment's depth; empty unless read back ([`Peeler::with_readback`]).
     pub depth: Vec<f32>,
+}
+
+thread_local! {
+    /// See [`with_interleaved_readback`].
+    static INTERLEAVED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f` with the recorder's former readback on this thread: peelers built inside gather
+/// every layer interleaved (16 bytes a sample, all fields read back and unpacked sample by
+/// sample), and phase 1 lists visible triangles sample by sample. Kept only so that tests and
+/// the benchmark can compare the compact readback against it in one process: both give the
+/// same recordings.
+#[doc(hidden)]
+pub fn with_interleaved_readback<R>(f: impl FnOnce() -> R) -> R {
+    let before = INTERLEAVED.with(|c| c.replace(true));
+    let r = f();
+    INTERLEAVED.with(|c| c.set(before));
+    r
+}
+
+/// Layers peeled and bytes read back by every peeler of the process (benchmarks).
+static COUNTERS: [std::sync::atomic::AtomicU64; 2] = [
+    std::sync::atomic::AtomicU64::new(0),
+    std::sync::atomic::AtomicU64::new(0),
+];
+
+/// Benchmarks: layers peeled (render, gather and readback each) and bytes read back from the
+/// device, by every peeler of this process so far.
+#[doc(hidden)]
+pub fn readback_counters() -> (u64, u64) {
+    let get = |k: usize| COUNTERS[k].load(std::sync::atomic::Ordering::Relaxed);
+    (get(0), get(1))
+}
+
+/// Whether this thread records the former way ([`with_interleaved_readback`]).
+pub(crate) fn interleaved() -> bool {
+    INTERLEAVED.with(|c| c.get())
 }
 
 /// Most triangles drawn by one draw call (keeps single draws and primitive ids modest).
@@ -51,6 +88,11 @@ pub struct Peeler<'g> {
     plain: wgpu::RenderPipeline,
     /// The grown peel's triangle storage (group 2), for [`Peeler::grown`].
     grown: Option<wgpu::BindGroup>,
+    /// Read back the alpha and depth arrays ([`Peeler::with_readback`]).
+    read_alpha: bool,
+    read_depth: bool,
+    /// The former interleaved gather ([`with_interleaved_readback`]).
+    interleaved: bool,
 }
 
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
@@ -82,11 +124,13 @@ fn check_device(gpu: &Gpu, view: View) -> Result<(), RecordError> {
     Ok(())
 }
 
-/// The compute pass that gathers a peel layer per sample (ids and depth in, one 16-byte slot
-/// per sample out), and its bind group layout.
+/// The compute pass that gathers a peel layer per sample (ids and depth in; out three arrays
+/// of one word a sample, or with `interleaved` one 16-byte slot a sample), and its bind group
+/// layout.
 fn gather_pipeline(
     device: &wgpu::Device,
     samples: u32,
+    interleaved: bool,
 ) -> (wgpu::BindGroupLayout, wgpu::ComputePipeline) {
     let ms = samples > 1;
     let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
@@ -139,7 +183,11 @@ fn gather_pipeline(
         label: Some("gather"),
         layout: Some(&gather_pl),
         module: &gather_module,
-        entry_point: Some("gather"),
+        entry_point: Some(if interleaved {
+            "gather_interleaved"
+        } else {
+            "gather"
+        }),
         compilation_options: Default::default(),
         cache: None,
     });
@@ -152,9 +200,10 @@ fn gather_pipeline(
 fn gather_buffers(
     device: &wgpu::Device,
     view: View,
+    interleaved: bool,
 ) -> Result<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer), RecordError> {
     let slots = view.width as u64 * view.height as u64 * view.samples as u64;
-    let out_size = slots * 16;
+    let out_size = slots * if interleaved { 16 } else { 12 };
     let max_binding = device.limits().max_storage_buffer_binding_size;
     if out_size > max_binding {
         return Err(RecordError::Unsupported(format!(
@@ -291,7 +340,8 @@ impl<'g> Peeler<'g> {
             }
         };
 
-        let (gather_layout, gather_pipeline) = gather_pipeline(device, view.samples);
+        let interleaved = interleaved();
+        let (gather_layout, gather_pipeline) = gather_pipeline(device, view.samples, interleaved);
 
         let mut index_data: Vec<u32> = Vec::with_capacity(triangles.len() * 3);
         for &t in triangles {
@@ -315,7 +365,7 @@ impl<'g> Peeler<'g> {
                 wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             )
         };
-        let (done, out, staging) = gather_buffers(device, view)?;
+        let (done, out, staging) = gather_buffers(device, view, interleaved)?;
         let chunks = (triangles.len() as u64)
             .div_ceil(CHUNK_TRIANGLES as u64)
             .max(1)
@@ -372,7 +422,30 @@ impl<'g> Peeler<'g> {
             dims,
             view,
             grown,
+            read_alpha: true,
+            read_depth: true,
+            interleaved,
         })
+    }
+
+    /// Reads back only the per-sample fields asked for (besides the ids, always read back):
+    /// `alpha` (phase 1's saturation) and `depth` (phase 2's ties). [`Layer`]'s other fields
+    /// stay empty. A new peeler reads back both.
+    pub fn with_readback(mut self, alpha: bool, depth: bool) -> Self {
+        self.read_alpha = alpha;
+        self.read_depth = depth;
+        self
+    }
+
+    /// Bytes read back from the device per layer: one word a sample for the ids and for each
+    /// field read back (16 a sample with [`with_interleaved_readback`]).
+    pub fn readback_bytes(&self) -> u64 {
+        let words = if self.interleaved {
+            4
+        } else {
+            1 + self.read_alpha as u64 + self.read_depth as u64
+        };
+        self.slots() as u64 * 4 * words
     }
 
     /// Shifts every frame's projection by `offset` pixels (x right, y down): later layers
@@ -381,6 +454,11 @@ impl<'g> Peeler<'g> {
     /// recorded pattern.
     pub fn set_subpixel_offset(&self, offset: [f64; 2]) {
         self.scene.set_subpixel_offset(&self.gpu.queue, offset);
+    }
+
+    /// Number of triangles drawn (ids in a [`Layer`] are positions in this list, plus 1).
+    pub fn triangles(&self) -> usize {
+        self.triangles as usize
     }
 
     /// Number of samples in one layer.
@@ -620,29 +698,63 @@ impl<'g> Peeler<'g> {
             pass.set_bind_group(0, &gather_bg, &[]);
             pass.dispatch_workgroups(self.view.width.div_ceil(8), self.view.height.div_ceil(8), 1);
         }
-        enc.copy_buffer_to_buffer(&self.out, 0, &self.staging, 0, self.out.size());
+        let slots = self.slots();
+        let array = slots as u64 * 4;
+        if self.interleaved {
+            enc.copy_buffer_to_buffer(&self.out, 0, &self.staging, 0, self.out.size());
+        } else {
+            // The ids, then only the arrays asked for, each to its own offset.
+            enc.copy_buffer_to_buffer(&self.out, 0, &self.staging, 0, array);
+            for (k, wanted) in [(1u64, self.read_alpha), (2, self.read_depth)] {
+                if wanted {
+                    enc.copy_buffer_to_buffer(
+                        &self.out,
+                        k * array,
+                        &self.staging,
+                        k * array,
+                        array,
+                    );
+                }
+            }
+        }
         self.gpu.queue.submit([enc.finish()]);
+        COUNTERS[0].fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        COUNTERS[1].fetch_add(self.readback_bytes(), std::sync::atomic::Ordering::Relaxed);
         let slice = self.staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |_| {});
         self.gpu
             .device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| RecordError::Device(e.to_string()))?;
-        let slots = self.slots();
         let mut layer = Layer {
-            ids: Vec::with_capacity(slots),
-            alpha: Vec::with_capacity(slots),
-            depth: Vec::with_capacity(slots),
+            ids: Vec::new(),
+            alpha: Vec::new(),
+            depth: Vec::new(),
         };
         {
             let data = slice
                 .get_mapped_range()
                 .map_err(|e| RecordError::Device(e.to_string()))?;
-            let words: &[u32] = bytemuck::cast_slice(&data);
-            for s in words.chunks_exact(4) {
-                layer.ids.push(s[0]);
-                layer.alpha.push(f32::from_bits(s[1]));
-                layer.depth.push(f32::from_bits(s[2]));
+            if self.interleaved {
+                layer.ids.reserve(slots);
+                layer.alpha.reserve(slots);
+                layer.depth.reserve(slots);
+                let words: &[u32] = bytemuck::cast_slice(&data);
+                for s in words.chunks_exact(4) {
+                    layer.ids.push(s[0]);
+                    layer.alpha.push(f32::from_bits(s[1]));
+                    layer.depth.push(f32::from_bits(s[2]));
+                }
+            } else {
+                let words: &[u32] = bytemuck::cast_slice(&data);
+                let array = |k: usize| &words[k * slots..(k + 1) * slots];
+                layer.ids = array(0).to_vec();
+                if self.read_alpha {
+                    layer.alpha = bytemuck::cast_slice(array(1)).to_vec();
+                }
+                if self.read_depth {
+                    layer.depth = bytemuck::cast_slice(array(2)).to_vec();
+                }
             }
         }
         self.staging.unmap();

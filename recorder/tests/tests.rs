@@ -1,6 +1,8 @@
 //! The recorder's integration tests, one binary: known answers on scenes built here
-//! (`known_answers`), robust recording (`robust`) and a 5-million-triangle scene (`scale`).
+//! (`known_answers`), robust recording (`robust`), a 5-million-triangle scene (`scale`) and
+//! the compact readback against the former one (`compact_readback`).
 
+mod compact_readback;
 mod known_answers;
 mod robust;
 mod scale;
