@@ -7,3 +7,4 @@ mod baked_file;
 mod play;
 mod self_check;
 mod tiers;
+mod variants;
