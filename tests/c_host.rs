@@ -49,7 +49,16 @@ pub fn build_host(dir: &Path) -> PathBuf {
         .arg(root.join("capi/include"))
         .arg(root.join("examples/c-gles/host.c"))
         .arg(static_library())
-        .args(["-lEGL", "-lGLESv2", "-lpthread", "-ldl", "-lm", "-o"])
+        // -lstdc++: the scene importer links meshoptimizer (C++) through the meshopt crate.
+        .args([
+            "-lEGL",
+            "-lGLESv2",
+            "-lstdc++",
+            "-lpthread",
+            "-ldl",
+            "-lm",
+            "-o",
+        ])
         .arg(&exe)
         .output()
         .expect("run gcc");
