@@ -30,6 +30,7 @@ pub struct WebPlayer {
     blit: Blit,
     on_screen: OnScreen,
     backend: &'static str,
+    fps: Option<f64>,
     warnings: Vec<String>,
     uncaptured: Arc<Mutex<Option<String>>>,
 }
@@ -96,6 +97,7 @@ impl WebPlayer {
         let on_screen =
             OnScreen::new(&gpu, &baked, &blit, (width, height), settings).map_err(js_error)?;
         let warnings = on_screen.player().warnings().to_vec();
+        let fps = baked.fps;
         Ok(WebPlayer {
             gpu,
             surface,
@@ -104,6 +106,7 @@ impl WebPlayer {
             blit,
             on_screen,
             backend: backend_name,
+            fps,
             warnings,
             uncaptured,
         })
@@ -196,6 +199,28 @@ impl WebPlayer {
             ms,
         }
         .to_string()
+    }
+
+    /// The path's frame rate as baked (`undefined` for files that do not say).
+    pub fn fps(&self) -> Option<f64> {
+        self.fps
+    }
+
+    /// The material variants of the file (KHR_materials_variants), including those this bake
+    /// refuses ([`WebPlayer::set_variant`] says why).
+    pub fn variants(&self) -> Vec<String> {
+        self.on_screen.player().variant_names()
+    }
+
+    /// Plays the materials of variant `name` from the next frame on (an empty name: the
+    /// default materials). Refused, with the reason, for a variant that would change what is
+    /// visible (alpha mode, opacity, transmission, sidedness); the materials stay as they were.
+    pub fn set_variant(&self, name: &str) -> Result<(), JsError> {
+        let name = (!name.is_empty()).then_some(name);
+        self.on_screen
+            .player()
+            .set_variant(&self.gpu.queue, name)
+            .map_err(js_error)
     }
 
     /// `WebGPU` or `WebGL2`.

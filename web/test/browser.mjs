@@ -3,7 +3,9 @@
 // and compares each with the native player's PNG of the same frame.
 //
 //   node web/test/browser.mjs --dist web/dist --native DIR --frames 0,12,24 --out DIR
-//        [--backend webgl2] [--mode blend] [--file demo.baked] [--chromium /usr/bin/chromium]
+//        [--backend webgl2] [--mode blend] [--file demo.baked] [--bad-file NAME]
+//        [--variant-file NAME --variant VARIANT]
+//        [--chromium /usr/bin/chromium]
 //
 // Writes the browser's frames as DIR/frame-NNNNN.png (for `trisort verify --frames-dir`) and
 // prints one JSON object: the device; per frame pixels differing from the native frame and
@@ -158,7 +160,53 @@ try {
     selfCheck.push(await guarded(check.evaluate((f) => window.trisort.selfCheck(f), frame)));
   }
   const errors = logs.filter((l) => l.startsWith("error") || l.startsWith("pageerror"));
-  console.log(JSON.stringify({ device, frames, self_check: selfCheck, console_errors: errors }, null, 1));
+  // Bad input: a damaged file is refused on the page with a message naming it, no panic.
+  let badFile = null;
+  if (a["bad-file"]) {
+    const bad = await browser.newPage();
+    const badErrors = [];
+    bad.on("pageerror", (e) => badErrors.push(e.message));
+    await bad.goto(`http://127.0.0.1:${port}/index.html?file=${a["bad-file"]}&backend=${a.backend}&test=1`);
+    await bad.waitForFunction(() => document.getElementById("error").textContent.length > 0);
+    const message = await bad.evaluate(() => document.getElementById("error").textContent);
+    const panicked = badErrors.some((m) => /unreachable|panicked/.test(m));
+    badFile = { file: a["bad-file"], message, panicked };
+  }
+  // Material variants (KHR_materials_variants) chosen on the page: colours change.
+  let variant = null;
+  if (a["variant-file"]) {
+    const vp = await browser.newPage();
+    vp.setDefaultTimeout(Number(a.timeout || 120) * 1000);
+    await vp.goto(`http://127.0.0.1:${port}/index.html?file=${a["variant-file"]}&backend=${a.backend}&test=1`);
+    await vp.waitForFunction(() => window.trisort && window.trisort.ready);
+    await vp.evaluate(() => window.trisort.ready.then(() => true));
+    variant = await vp.evaluate((name) => {
+      const grab = () => {
+        const c = document.getElementById("canvas");
+        const o = new OffscreenCanvas(c.width, c.height).getContext("2d");
+        o.drawImage(c, 0, 0);
+        return o.getImageData(0, 0, c.width, c.height).data;
+      };
+      const p = window.trisort.state.player;
+      window.trisort.renderFrame(0);
+      const before = grab();
+      const select = document.getElementById("variant");
+      select.value = name;
+      select.dispatchEvent(new Event("change"));
+      const after = grab();
+      let changed = 0;
+      for (let i = 0; i < before.length; i += 4) {
+        if (before[i] !== after[i] || before[i + 1] !== after[i + 1] || before[i + 2] !== after[i + 2]) changed++;
+      }
+      let unknown = "";
+      try { p.set_variant("no such variant"); } catch (e) { unknown = e.message; }
+      return {
+        name, variants: p.variants(), shown: !document.getElementById("variant-box").hidden,
+        pixels_changed: changed, error: document.getElementById("error").textContent, unknown,
+      };
+    }, a.variant);
+  }
+  console.log(JSON.stringify({ device, frames, self_check: selfCheck, bad_file: badFile, variant, console_errors: errors }, null, 1));
 } catch (e) {
   failed = e;
 } finally {

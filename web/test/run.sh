@@ -25,8 +25,15 @@ frames=$("$trisort" inspect "$baked" --json | node -e \
   'let s="";process.stdin.on("data",d=>s+=d).on("end",()=>console.log(JSON.parse(s).frames))')
 list=$(node -e "console.log([...Array($frames).keys()].join(','))")
 "$trisort" play "$baked" --out-dir "$out/native" >/dev/null
+# A damaged copy (cut short) that the page must refuse with a message naming it.
+head -c 4000 "$baked" > web/dist/truncated.baked
+# CarConcept's material variants switched on the page (a 2-frame bake at 64², ≈ 15 s).
+scenes="${TRISORT_SCENES:-$(pwd)/../shared/scenes}"
+"$trisort" bake "$scenes/CarConcept/CarConcept.glb" --path orbit:frames=2 --size 64x64 \
+  -o web/dist/variants.baked >/dev/null 2>"$out/variants-bake.log"
 node web/test/browser.mjs --dist web/dist --native "$out/native" --frames "$list" \
-  --out "$out/browser" --backend webgl2 > "$out/browser.json"
+  --out "$out/browser" --backend webgl2 --bad-file truncated.baked \
+  --variant-file variants.baked --variant "Torched Graphite" > "$out/browser.json"
 # Exit 3 means "verified and some frame failed the recorded pattern's tolerance": expected on
 # another rasterizer; the gate below reads the figures instead.
 "$trisort" verify "$baked" --scene demo --frames-dir "$out/browser" --json \
@@ -78,6 +85,18 @@ if (b.device.bindings !== "textures" || b.device.draw_path !== "direct") {
 if (b.self_check.length !== n) bad.push(`the self-check ran ${b.self_check.length} frames of ${n}`);
 if (holes.worst > Number(maxHoles) * px) {
   bad.push(`a frame has ${holes.worst} holes in the browser's self-check (limit ${100 * maxHoles} % of its pixels)`);
+}
+if (!b.bad_file || !b.bad_file.message.includes("truncated.baked") || b.bad_file.panicked) {
+  bad.push(`a truncated file was not refused with a message naming it: ${JSON.stringify(b.bad_file)}`);
+} else {
+  console.log(`  a truncated file is refused: ${b.bad_file.message}`);
+}
+const va = b.variant;
+if (!va || !va.shown || va.variants.length !== 3 || va.pixels_changed === 0 || va.error ||
+    !va.unknown.includes("Torched Graphite")) {
+  bad.push(`CarConcept's variants did not play as expected: ${JSON.stringify(va)}`);
+} else {
+  console.log(`  variant "${va.name}" on CarConcept: ${va.pixels_changed} pixels change colour`);
 }
 if (v.frames.length !== n) bad.push(`verify checked ${v.frames.length} frames, the browser drew ${n}`);
 if (b.console_errors.length) bad.push(`console errors: ${b.console_errors.join("; ")}`);

@@ -92,6 +92,16 @@ async function open(bytes, name) {
     `${name} · ${p.width()}×${p.height()} · ${p.backend()} on ${p.adapter()} · ` +
     `${p.bindings()} bindings, ${p.draw_path()} draws · ${mode} mode`;
   for (const w of p.warnings()) console.warn("trisort:", w);
+  // The path's frame rate as baked, where the file says.
+  if (p.fps()) $("fps").value = String(Math.round(p.fps()));
+  const variants = p.variants();
+  $("variant").replaceChildren(...["", ...variants].map((name) => {
+    const o = document.createElement("option");
+    o.value = name;
+    o.textContent = name || "(default materials)";
+    return o;
+  }));
+  $("variant-box").hidden = variants.length === 0;
   renderFrame(0);
   return p;
 }
@@ -120,6 +130,16 @@ function setPlaying(on) {
 }
 
 $("play").addEventListener("click", () => setPlaying(!state.playing));
+// A material variant: colours change, visibility does not (the player refuses variants that
+// would change it, and the previous materials stay).
+$("variant").addEventListener("change", (e) => {
+  $("error").textContent = "";
+  try {
+    state.player.set_variant(e.target.value);
+    if (state.twin) state.twin.set_variant(e.target.value);
+    renderFrame(state.frame);
+  } catch (err) { showError(err); }
+});
 $("scrub").addEventListener("input", (e) => {
   setPlaying(false);
   try { renderFrame(Number(e.target.value)); } catch (err) { showError(err); }
