@@ -133,16 +133,7 @@ impl<'g> SelfCheck<'g> {
         size: (u32, u32),
         samples: u32,
     ) -> Result<SelfCheck<'g>, PlayerError> {
-        let config = HeadlessConfig {
-            size,
-            samples,
-            mode: Mode::Depth,
-            ..HeadlessConfig::recorded(baked)
-        };
-        Ok(SelfCheck {
-            baked: HeadlessRenderer::new(gpu, baked, &config)?,
-            zbuffer: HeadlessRenderer::new(gpu, &zbuffer_baked(baked), &config)?,
-        })
+        Self::with_twin(gpu, baked, &zbuffer_baked(baked), size, samples)
     }
 
     /// [`SelfCheck::new`] against the z-buffer of every triangle of `scene`, the full scene
@@ -155,16 +146,27 @@ impl<'g> SelfCheck<'g> {
         size: (u32, u32),
         samples: u32,
     ) -> Result<SelfCheck<'g>, PlayerError> {
+        let twin = zbuffer_baked_with_scene(baked, scene);
+        Self::with_twin(gpu, baked, &twin, size, samples)
+    }
+
+    /// The depth renders of `baked` and of its z-buffer `twin`, with one configuration.
+    fn with_twin(
+        gpu: &'g Gpu,
+        baked: &Baked,
+        twin: &Baked,
+        size: (u32, u32),
+        samples: u32,
+    ) -> Result<SelfCheck<'g>, PlayerError> {
         let config = HeadlessConfig {
             size,
             samples,
             mode: Mode::Depth,
             ..HeadlessConfig::recorded(baked)
         };
-        let twin = zbuffer_baked_with_scene(baked, scene);
         Ok(SelfCheck {
             baked: HeadlessRenderer::new(gpu, baked, &config)?,
-            zbuffer: HeadlessRenderer::new(gpu, &twin, &config)?,
+            zbuffer: HeadlessRenderer::new(gpu, twin, &config)?,
         })
     }
 
