@@ -318,15 +318,8 @@ impl<'g> Conservative<'g> {
             entries: &mark_layout_entries,
         });
         let texture = |label, format| {
-            trisort_gpu::pipeline::texture_2d(
-                device,
-                label,
-                (view.width, view.height),
-                view.samples,
-                format,
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            )
-            .create_view(&Default::default())
+            crate::peeler::view_texture(device, &view, label, format)
+                .create_view(&Default::default())
         };
         let surface = texture("conservative surface", SURFACE_FORMAT);
         let occluder = texture("conservative occluders", OCCLUDER_FORMAT);

@@ -63,6 +63,23 @@ pub(crate) fn interleaved() -> bool {
     INTERLEAVED.with(|c| c.get())
 }
 
+/// A texture of `view`'s size and samples that passes both render into and read from.
+pub(crate) fn view_texture(
+    device: &wgpu::Device,
+    view: &View,
+    label: &str,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    trisort_gpu::pipeline::texture_2d(
+        device,
+        label,
+        (view.width, view.height),
+        view.samples,
+        format,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+    )
+}
+
 /// Most triangles drawn by one draw call (keeps single draws and primitive ids modest).
 const CHUNK_TRIANGLES: u32 = 1 << 22;
 
@@ -355,16 +372,7 @@ impl<'g> Peeler<'g> {
             contents: bytemuck::cast_slice(&index_data),
             usage: wgpu::BufferUsages::INDEX,
         });
-        let target = |label, format| {
-            trisort_gpu::pipeline::texture_2d(
-                device,
-                label,
-                (view.width, view.height),
-                view.samples,
-                format,
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            )
-        };
+        let target = |label, format| view_texture(device, &view, label, format);
         let (done, out, staging) = gather_buffers(device, view, interleaved)?;
         let chunks = (triangles.len() as u64)
             .div_ceil(CHUNK_TRIANGLES as u64)
