@@ -44,50 +44,38 @@ pub fn device_differences(a: &DeviceInfo, b: &DeviceInfo) -> Vec<Difference> {
 }
 
 /// How settings `t` differ from `s`: size, samples, saturation, glass opacity, max layers,
-/// intersection splitting, and any other setting as both whole settings.
+/// intersection splitting and robust recording. Every field is named by an exhaustive
+/// destructure, so a field added to [`RecordSettings`] fails to compile here until it is
+/// compared too.
 pub fn settings_differences(s: &RecordSettings, t: &RecordSettings) -> Vec<Difference> {
-    let size = |s: &RecordSettings| format!("{}x{}", s.width, s.height);
-    let mut out = differing(vec![
-        (false, "size", size(s), size(t)),
-        (
-            false,
-            "samples",
-            s.samples.to_string(),
-            t.samples.to_string(),
-        ),
-        (
-            false,
-            "saturation",
-            s.saturation.to_string(),
-            t.saturation.to_string(),
-        ),
-        (
-            false,
-            "glass opacity",
-            s.glass_opacity.to_string(),
-            t.glass_opacity.to_string(),
-        ),
-        (
-            false,
-            "max layers",
-            s.max_layers.to_string(),
-            t.max_layers.to_string(),
-        ),
-        (
-            false,
-            "intersection splitting",
-            s.split_intersections.to_string(),
-            t.split_intersections.to_string(),
-        ),
-    ]);
-    // Settings not named above (fields added later) are still compared.
-    if s != t && out.is_empty() {
-        out.push(Difference {
-            device: false,
-            what: format!("settings {s:?} vs {t:?}"),
-        });
-    }
-    out
+    let fields = |r: &RecordSettings| {
+        let RecordSettings {
+            width,
+            height,
+            samples,
+            saturation,
+            glass_opacity,
+            max_layers,
+            split_intersections,
+            robust,
+        } = *r;
+        [
+            ("size", format!("{width}x{height}")),
+            ("samples", samples.to_string()),
+            ("saturation", saturation.to_string()),
+            ("glass opacity", glass_opacity.to_string()),
+            ("max layers", max_layers.to_string()),
+            ("intersection splitting", split_intersections.to_string()),
+            ("robust", format!("{robust:?}")),
+        ]
+    };
+    differing(
+        fields(s)
+            .into_iter()
+            .zip(fields(t))
+            .map(|((what, x), (_, y))| (false, what, x, y))
+            .collect(),
+    )
 }
 
 /// Everything in which recording `b` differs from `a` that makes them parts of different

@@ -61,6 +61,15 @@ fn every_difference_is_named_with_both_values() {
     let driver = format!("driver {:?} vs \"another driver\"", parts[0].device.driver);
     assert!(d.contains(&driver), "{d:?}");
     assert_eq!(differences(&parts[0], &parts[2]), vec![]);
+    // Robust recording is a setting too, named like the others.
+    let mut robust = parts[2].clone();
+    robust.settings.robust.patterns += 1;
+    let d = differences(&parts[0], &robust);
+    assert_eq!(d.len(), 1, "{d:?}");
+    assert!(
+        d[0].what.starts_with("robust ") && d[0].what.contains("patterns"),
+        "{d:?}"
+    );
 }
 
 #[test]
