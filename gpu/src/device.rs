@@ -260,3 +260,27 @@ impl Gpu {
         out
     }
 }
+
+/// The first wgpu error that no error scope caught, kept for the caller to report: a viewer
+/// (the window, a browser canvas) checks it after each frame instead of letting wgpu's default
+/// handler panic.
+#[derive(Clone, Default)]
+pub struct UncapturedError(std::sync::Arc<std::sync::Mutex<Option<String>>>);
+
+impl UncapturedError {
+    /// Installs the slot as `device`'s uncaptured-error handler.
+    pub fn install(device: &wgpu::Device) -> UncapturedError {
+        let slot = UncapturedError::default();
+        let inner = slot.0.clone();
+        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+            let mut first = inner.lock().unwrap_or_else(|p| p.into_inner());
+            first.get_or_insert_with(|| e.to_string());
+        }));
+        slot
+    }
+
+    /// The first error since the last call, if any.
+    pub fn take(&self) -> Option<String> {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).take()
+    }
+}

@@ -21,6 +21,7 @@ mod timer;
 
 pub use device::{
     device_info, wanted_features, DeviceBackend, DeviceLimits, Gpu, GpuError, GpuOptions,
+    UncapturedError,
 };
 #[cfg(not(target_arch = "wasm32"))]
 pub use readback::map_read_all;

@@ -101,6 +101,30 @@ impl OnScreen {
         Ok(())
     }
 
+    /// Draws frame `frame` into `surface`'s texture through a view in `view_format` (the format
+    /// `blit` was made for) and submits it; the caller checks for errors and presents.
+    pub fn submit(
+        &self,
+        gpu: &Gpu,
+        blit: &Blit,
+        surface: &wgpu::SurfaceTexture,
+        view_format: wgpu::TextureFormat,
+        frame: u32,
+    ) -> Result<(), PlayerError> {
+        let view = surface.texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(view_format),
+            ..Default::default()
+        });
+        let mut enc = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("trisort on-screen frame"),
+            });
+        self.encode(&mut enc, blit, &view, frame)?;
+        gpu.queue.submit([enc.finish()]);
+        Ok(())
+    }
+
     /// The size of the off-screen frame.
     pub fn size(&self) -> (u32, u32) {
         self.size

@@ -1,11 +1,10 @@
 //! The wasm side: [`WebPlayer`], exported to the page with wasm-bindgen.
 
 use std::path::Path;
-use std::sync::{Arc, Mutex};
 
 use trisort_format::{Baked, DeviceLimits, Mode};
 use trisort_gpu::present::{configure_surface, Blit};
-use trisort_gpu::Gpu;
+use trisort_gpu::{Gpu, UncapturedError};
 use trisort_player::{OnScreen, OnScreenSettings};
 use wasm_bindgen::prelude::*;
 
@@ -32,7 +31,7 @@ pub struct WebPlayer {
     backend: &'static str,
     fps: Option<f64>,
     warnings: Vec<String>,
-    uncaptured: Arc<Mutex<Option<String>>>,
+    uncaptured: UncapturedError,
 }
 
 fn js_error(e: impl std::fmt::Display) -> JsError {
@@ -82,15 +81,7 @@ impl WebPlayer {
         )
         .await
         .map_err(js_error)?;
-        let uncaptured = Arc::new(Mutex::new(None::<String>));
-        {
-            let slot = uncaptured.clone();
-            gpu.device
-                .on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-                    let mut slot = slot.lock().unwrap_or_else(|p| p.into_inner());
-                    slot.get_or_insert_with(|| e.to_string());
-                }));
-        }
+        let uncaptured = UncapturedError::install(&gpu.device);
         let setup = configure_surface(&gpu, &surface, (width, height)).map_err(js_error)?;
         let blit = Blit::new(&gpu.device, setup.view_format, mode);
         let settings = OnScreenSettings::recorded(&baked, mode);
@@ -133,25 +124,14 @@ impl WebPlayer {
             wgpu::CurrentSurfaceTexture::Validation => {
                 return Err(js_error(format!(
                     "wgpu: {}",
-                    self.take_uncaptured().unwrap_or_default()
+                    self.uncaptured.take().unwrap_or_default()
                 )))
             }
         };
-        let view = texture.texture.create_view(&wgpu::TextureViewDescriptor {
-            format: Some(self.view_format),
-            ..Default::default()
-        });
-        let mut enc = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("trisort web frame"),
-            });
         self.on_screen
-            .encode(&mut enc, &self.blit, &view, frame)
+            .submit(&self.gpu, &self.blit, &texture, self.view_format, frame)
             .map_err(js_error)?;
-        self.gpu.queue.submit([enc.finish()]);
-        if let Some(e) = self.take_uncaptured() {
+        if let Some(e) = self.uncaptured.take() {
             return Err(js_error(format!("wgpu: {e}")));
         }
         self.gpu.queue.present(texture);
@@ -251,13 +231,6 @@ impl WebPlayer {
     /// What makes this playback inexact (another device than the recording's, …).
     pub fn warnings(&self) -> Vec<String> {
         self.warnings.clone()
-    }
-
-    fn take_uncaptured(&self) -> Option<String> {
-        self.uncaptured
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .take()
     }
 }
 

@@ -2,12 +2,12 @@
 //! target ([`trisort_player::OnScreen`]), and the blit that presents the target ([`trisort_gpu::present`]). The event loop
 //! (`mod.rs`) decides what to show; this draws it.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
 use trisort_format::Baked;
 use trisort_gpu::present::{configure_surface, Blit};
-use trisort_gpu::Gpu;
+use trisort_gpu::{Gpu, UncapturedError};
 use trisort_player::{OnScreen, OnScreenSettings};
 use winit::event_loop::OwnedDisplayHandle;
 use winit::window::Window;
@@ -26,7 +26,7 @@ pub(super) struct Gfx {
     blit: Blit,
     play: PlaySettings,
     /// The first wgpu error no error scope caught.
-    uncaptured: Arc<Mutex<Option<String>>>,
+    uncaptured: UncapturedError,
     pub targets: OnScreen,
 }
 
@@ -48,15 +48,7 @@ impl Gfx {
             .context("creating a wgpu surface for the window")?;
         let gpu = Gpu::for_surface(&instance, &surface)
             .context("opening a GPU device that can present to this window")?;
-        let uncaptured = Arc::new(Mutex::new(None::<String>));
-        {
-            let slot = uncaptured.clone();
-            gpu.device
-                .on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-                    let mut slot = slot.lock().unwrap_or_else(|p| p.into_inner());
-                    slot.get_or_insert_with(|| e.to_string());
-                }));
-        }
+        let uncaptured = UncapturedError::install(&gpu.device);
         let inner = window.inner_size();
         let (width, height) = (inner.width.max(1), inner.height.max(1));
         let setup = configure_surface(&gpu, &surface, (width, height))?;
@@ -131,36 +123,21 @@ impl Gfx {
             }
             wgpu::CurrentSurfaceTexture::Lost => bail!("the window's surface was lost"),
             wgpu::CurrentSurfaceTexture::Validation => {
-                bail!("wgpu: {}", self.take_uncaptured().unwrap_or_default())
+                bail!("wgpu: {}", self.uncaptured.take().unwrap_or_default())
             }
         };
-        let surface_view = surface_texture
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor {
-                format: Some(self.view_format),
-                ..Default::default()
-            });
-        let mut enc = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("trisort window frame"),
-            });
-        self.targets
-            .encode(&mut enc, &self.blit, &surface_view, frame)?;
-        self.gpu.queue.submit([enc.finish()]);
-        if let Some(e) = self.take_uncaptured() {
+        self.targets.submit(
+            &self.gpu,
+            &self.blit,
+            &surface_texture,
+            self.view_format,
+            frame,
+        )?;
+        if let Some(e) = self.uncaptured.take() {
             bail!("wgpu: {e}");
         }
         self.window.pre_present_notify();
         self.gpu.queue.present(surface_texture);
         Ok(true)
-    }
-
-    fn take_uncaptured(&self) -> Option<String> {
-        self.uncaptured
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .take()
     }
 }
