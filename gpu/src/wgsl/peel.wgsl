@@ -41,6 +41,23 @@ struct PeelOut {
     @builtin(frag_depth) depth: f32,
 }
 
+// Whether `sample` of the pixel at `coord` is saturated or has no fragment left.
+fn peel_done(coord: vec2<i32>, sample: u32) -> bool {
+    let slot = (u32(coord.y) * peel.width + u32(coord.x)) * peel.samples + sample;
+    return done[slot] != 0u;
+}
+
+// Whether the key (z, id) is not greater than the previous layer's at `sample` of `coord`
+// (always false on the first layer): the fragment belongs to an earlier layer.
+fn peeled_before(coord: vec2<i32>, sample: u32, z: f32, id: u32) -> bool {
+    if (peel.first_layer != 0u) {
+        return false;
+    }
+    let pd = LOAD_PREV_DEPTH;
+    let pid = LOAD_PREV_IDS.x;
+    return z < pd || (z == pd && id + 1u <= pid);
+}
+
 @fragment
 fn fs_peel(
     in: PeelVarying,
@@ -49,8 +66,7 @@ fn fs_peel(
     @builtin(primitive_index) primitive: u32,
 ) -> PeelOut {
     let coord = vec2<i32>(in.position.xy);
-    let slot = (u32(coord.y) * peel.width + u32(coord.x)) * peel.samples + sample;
-    if (done[slot] != 0u) {
+    if (peel_done(coord, sample)) {
         discard;
     }
     if (culled(in.material, front_facing)) {
@@ -62,12 +78,8 @@ fn fs_peel(
     }
     let id = peel.base_id + primitive;
     let z = in.position.z;
-    if (peel.first_layer == 0u) {
-        let pd = LOAD_PREV_DEPTH;
-        let pid = LOAD_PREV_IDS.x;
-        if (z < pd || (z == pd && id + 1u <= pid)) {
-            discard;
-        }
+    if (peeled_before(coord, sample, z, id)) {
+        discard;
     }
     var out: PeelOut;
     out.ids = vec2<u32>(id + 1u, bitcast<u32>(clamp(base.a, 0.0, 1.0)));

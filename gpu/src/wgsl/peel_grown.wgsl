@@ -18,8 +18,7 @@ fn fs_peel_grown(
     @builtin(sample_index) sample: u32,
 ) -> PeelOut {
     let coord = vec2<i32>(in.position.xy);
-    let slot = (u32(coord.y) * peel.width + u32(coord.x)) * peel.samples + sample;
-    if (done[slot] != 0u) {
+    if (peel_done(coord, sample)) {
         discard;
     }
     if (culled(in.material, front_facing)) {
@@ -33,12 +32,8 @@ fn fs_peel_grown(
         z = clamp(cons_plane_depth(in), 0.0, 1.0);
     }
     let id = in.tri;
-    if (peel.first_layer == 0u) {
-        let pd = LOAD_PREV_DEPTH;
-        let pid = LOAD_PREV_IDS.x;
-        if (z < pd || (z == pd && id + 1u <= pid)) {
-            discard;
-        }
+    if (peeled_before(coord, sample, z, id)) {
+        discard;
     }
     var out: PeelOut;
     out.ids = vec2<u32>(id + 1u, bitcast<u32>(1.0));
