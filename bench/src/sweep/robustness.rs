@@ -116,21 +116,25 @@ pub(super) fn measure(
     references: &[Vec<Vec<u8>>],
 ) -> Result<Vec<ConditionError>, BenchError> {
     let mut out = Vec::new();
+    // The check and the player at the current size: the offset conditions share one size, so
+    // they share the renderers (only the projection's offset changes between them).
+    let mut at: Option<((u32, u32), SelfCheck, HeadlessRenderer)> = None;
     for (c, reference) in conditions(config.size).iter().zip(references) {
-        let check = SelfCheck::against_scene(gpu, baked, scene, c.size, config.samples)?;
+        if at.as_ref().is_none_or(|(size, _, _)| *size != c.size) {
+            let check = SelfCheck::against_scene(gpu, baked, scene, c.size, config.samples)?;
+            let player = HeadlessRenderer::new(
+                gpu,
+                baked,
+                &HeadlessConfig {
+                    size: c.size,
+                    samples: config.samples,
+                    ..HeadlessConfig::recorded(baked)
+                },
+            )?;
+            at = Some((c.size, check, player));
+        }
+        let (_, check, player) = at.as_ref().expect("set above");
         check.set_subpixel_offset(c.offset);
-        let player = HeadlessRenderer::new(
-            gpu,
-            baked,
-            &HeadlessConfig {
-                size: c.size,
-                samples: config.samples,
-                mode: Mode::Blend,
-                glass_opacity: Some(baked.settings.glass_opacity),
-                draw_path: None,
-                force_u32: false,
-            },
-        )?;
         player.set_subpixel_offset(c.offset);
         let mut e = ConditionError {
             condition: c.name.clone(),
