@@ -234,7 +234,9 @@ impl From<crate::OrderError> for Failure {
         use crate::OrderError as E;
         let status = match &e {
             E::Io { .. } | E::Format(trisort_format::FormatError::Io { .. }) => TrisortStatus::Io,
-            E::Malformed { .. } | E::Format(_) | E::Scene(_) => TrisortStatus::Format,
+            E::Malformed { .. } | E::MalformedBaked { .. } | E::Format(_) | E::Scene(_) => {
+                TrisortStatus::Format
+            }
             E::WrongScene { .. } => TrisortStatus::Unsupported,
         };
         Failure(status, e.to_string())
@@ -837,9 +839,7 @@ pub unsafe extern "C" fn trisort_export_order(
         let baked_path = c_path(baked_path, "baked_path")?;
         let scene_path = c_path(scene_path, "scene_path")?;
         let out_path = c_path(out_path, "out_path")?;
-        let baked: Baked = trisort_format::read_file(FileKind::Baked, &baked_path)?;
-        let order = Order::from_baked(&baked, &baked_path, &scene_path)?;
-        order.write(&out_path)?;
+        Order::export(&baked_path, &scene_path, &out_path)?;
         Ok(())
     })
 }

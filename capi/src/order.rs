@@ -92,6 +92,14 @@ pub enum OrderError {
     /// The baked file could not be read.
     #[error(transparent)]
     Format(#[from] trisort_format::FormatError),
+    /// The baked file decodes but its parts do not fit together.
+    #[error("{path}: malformed baked file: {problem}")]
+    MalformedBaked {
+        /// The baked file.
+        path: PathBuf,
+        /// What is wrong.
+        problem: String,
+    },
     /// The glTF scene could not be imported.
     #[error(transparent)]
     Scene(#[from] trisort_scene::SceneError),
@@ -113,6 +121,22 @@ pub enum OrderError {
 }
 
 impl Order {
+    /// Reads the baked file at `baked_path`, checks its structure, builds its order over the
+    /// glTF file `scene` ([`Order::from_baked`]) and writes it to `out` atomically: what
+    /// `trisort export-order` and the C API's `trisort_export_order` both do.
+    pub fn export(baked_path: &Path, scene: &Path, out: &Path) -> Result<Order, OrderError> {
+        let baked: Baked = trisort_format::read_file(trisort_format::FileKind::Baked, baked_path)?;
+        baked
+            .check_structure()
+            .map_err(|problem| OrderError::MalformedBaked {
+                path: baked_path.to_path_buf(),
+                problem,
+            })?;
+        let order = Order::from_baked(&baked, baked_path, scene)?;
+        order.write(out)?;
+        Ok(order)
+    }
+
     /// The order of `baked`, whose scene is the glTF file `scene`: imports it with the source
     /// of every triangle, splits it as the recording did when the bake split intersections,
     /// checks its hash against the baked file's, and names each index-buffer triangle by the

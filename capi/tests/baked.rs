@@ -256,3 +256,25 @@ fn a_structurally_broken_file_is_refused_with_its_problem() {
     let n = unsafe { trisort_last_error(msg.as_mut_ptr().cast(), msg.len()) };
     assert!(String::from_utf8_lossy(&msg[..n]).contains("draw 0"));
 }
+
+#[test]
+fn export_order_refuses_a_structurally_broken_baked_file_before_reading_the_scene() {
+    let mut b = sample();
+    b.draws[0].index_count = 999;
+    let dir = tempfile::tempdir().unwrap();
+    let baked = dir.path().join("broken.baked");
+    let out = dir.path().join("broken.order");
+    std::fs::write(&baked, encode(FileKind::Baked, &b)).unwrap();
+    let c = |p: &std::path::Path| std::ffi::CString::new(p.to_str().unwrap()).unwrap();
+    let (baked_c, scene_c, out_c) = (c(&baked), c(&dir.path().join("none.glb")), c(&out));
+    let s = unsafe { trisort_export_order(baked_c.as_ptr(), scene_c.as_ptr(), out_c.as_ptr()) };
+    assert_eq!(s, TrisortStatus::Format);
+    let mut msg = [0u8; 256];
+    let n = unsafe { trisort_last_error(msg.as_mut_ptr().cast(), msg.len()) };
+    let msg = String::from_utf8_lossy(&msg[..n]);
+    assert!(
+        msg.contains("broken.baked") && msg.contains("draw 0"),
+        "{msg}"
+    );
+    assert!(!out.exists(), "no output on failure");
+}

@@ -14,7 +14,6 @@ use anyhow::{bail, Result};
 use clap::Args;
 use serde_json::json;
 use trisort_capi::Order;
-use trisort_format::{Baked, FileKind};
 
 use crate::common::print_json;
 
@@ -44,12 +43,7 @@ pub fn run(a: ExportOrderArgs) -> Result<ExitCode> {
             a.scene.display()
         );
     }
-    let baked: Baked = trisort_format::read_file(FileKind::Baked, &a.baked)?;
-    baked
-        .check_structure()
-        .map_err(|e| anyhow::anyhow!("{}: malformed baked file: {e}", a.baked.display()))?;
-    let order = Order::from_baked(&baked, &a.baked, &a.scene)?;
-    order.write(&a.output)?;
+    let order = Order::export(&a.baked, &a.scene, &a.output)?;
     let repeated = order.triangles.windows(2).filter(|w| w[0] == w[1]).count();
     if a.json {
         print_json(&json!({
