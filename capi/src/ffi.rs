@@ -344,17 +344,47 @@ unsafe fn store<T>(out: *mut T, value: T, what: &str) -> Result<(), Failure> {
     Ok(())
 }
 
-fn frame_index(baked: &Baked, frame: u32) -> Result<usize, Failure> {
-    if (frame as usize) < baked.frames.len() {
+/// `frame` as an index into `frames` frames, or an out-of-range failure.
+fn frame_index(frames: usize, frame: u32) -> Result<usize, Failure> {
+    if (frame as usize) < frames {
         Ok(frame as usize)
     } else {
         Err(Failure(
             TrisortStatus::OutOfRange,
-            format!(
-                "frame {frame} is out of range ({} frames)",
-                baked.frames.len()
-            ),
+            format!("frame {frame} is out of range ({frames} frames)"),
         ))
+    }
+}
+
+/// The bytes of the file at the C string `path`, and the path (for messages).
+///
+/// # Safety
+/// `path` is null or a NUL-terminated string.
+unsafe fn read_path(path: *const c_char) -> Result<(Vec<u8>, PathBuf), Failure> {
+    let path = c_path(path, "path")?;
+    let bytes = std::fs::read(&path)
+        .map_err(|source| Failure(TrisortStatus::Io, format!("{}: {source}", path.display())))?;
+    Ok((bytes, path))
+}
+
+/// The bytes the host passed, or a null-argument failure.
+///
+/// # Safety
+/// `data` is null or valid for `len` byte reads.
+unsafe fn host_bytes<'a>(data: *const u8, len: usize) -> Result<&'a [u8], Failure> {
+    if data.is_null() {
+        return Err(null("data"));
+    }
+    Ok(std::slice::from_raw_parts(data, len))
+}
+
+/// Frees a handle made by `Box::into_raw` (null is ignored), with panics caught.
+///
+/// # Safety
+/// `h` is null or such a handle, not freed before.
+unsafe fn close_handle<T>(h: *mut T) {
+    if !h.is_null() {
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(h))));
     }
 }
 
@@ -408,10 +438,7 @@ pub unsafe extern "C" fn trisort_open_path(
     out: *mut *mut TrisortBaked,
 ) -> TrisortStatus {
     guard(|| {
-        let path = c_path(path, "path")?;
-        let bytes = std::fs::read(&path).map_err(|source| {
-            Failure(TrisortStatus::Io, format!("{}: {source}", path.display()))
-        })?;
+        let (bytes, path) = read_path(path)?;
         let h = open_baked(&bytes, &path)?;
         store(out, Box::into_raw(h), "out")
     })
@@ -429,10 +456,7 @@ pub unsafe extern "C" fn trisort_open_bytes(
     out: *mut *mut TrisortBaked,
 ) -> TrisortStatus {
     guard(|| {
-        if data.is_null() {
-            return Err(null("data"));
-        }
-        let bytes = std::slice::from_raw_parts(data, len);
+        let bytes = host_bytes(data, len)?;
         let h = open_baked(bytes, Path::new("<bytes>"))?;
         store(out, Box::into_raw(h), "out")
     })
@@ -444,9 +468,7 @@ pub unsafe extern "C" fn trisort_open_bytes(
 /// `h` is null or a handle not closed before.
 #[no_mangle]
 pub unsafe extern "C" fn trisort_close(h: *mut TrisortBaked) {
-    if !h.is_null() {
-        let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(h))));
-    }
+    close_handle(h)
 }
 
 /// Stores the file's figures in `*out`.
@@ -589,7 +611,7 @@ pub unsafe extern "C" fn trisort_frame_ranges(
 ) -> TrisortStatus {
     guard(|| {
         let b = &handle(h, "handle")?.baked;
-        let f = frame_index(b, frame)?;
+        let f = frame_index(b.frames.len(), frame)?;
         copy_out(&frame_ranges(b, f, back_to_front), out, cap, len)
     })
 }
@@ -610,7 +632,7 @@ pub unsafe extern "C" fn trisort_frame_draws(
 ) -> TrisortStatus {
     guard(|| {
         let b = &handle(h, "handle")?.baked;
-        let f = frame_index(b, frame)?;
+        let f = frame_index(b.frames.len(), frame)?;
         let draws: Vec<TrisortDrawIndexedIndirectArgs> = frame_ranges(b, f, back_to_front)
             .iter()
             .map(|r| TrisortDrawIndexedIndirectArgs {
@@ -677,7 +699,7 @@ pub unsafe extern "C" fn trisort_frame_view(
 ) -> TrisortStatus {
     guard(|| {
         let b = &handle(h, "handle")?.baked;
-        let f = frame_index(b, frame)?;
+        let f = frame_index(b.frames.len(), frame)?;
         write_matrix(b.frame_states[f].camera.view_matrix(), out)
     })
 }
@@ -698,7 +720,7 @@ pub unsafe extern "C" fn trisort_frame_projection(
 ) -> TrisortStatus {
     guard(|| {
         let b = &handle(h, "handle")?.baked;
-        let f = frame_index(b, frame)?;
+        let f = frame_index(b.frames.len(), frame)?;
         if !(aspect.is_finite() && aspect > 0.0) {
             return Err(Failure(
                 TrisortStatus::OutOfRange,
@@ -736,7 +758,7 @@ pub unsafe extern "C" fn trisort_frame_node_matrices(
 ) -> TrisortStatus {
     guard(|| {
         let b = &handle(h, "handle")?.baked;
-        let f = frame_index(b, frame)?;
+        let f = frame_index(b.frames.len(), frame)?;
         let state = &b.frame_states[f];
         let view = if view_relative {
             state.camera.view_matrix()
@@ -859,10 +881,7 @@ pub unsafe extern "C" fn trisort_order_open_path(
     out: *mut *mut TrisortOrder,
 ) -> TrisortStatus {
     guard(|| {
-        let path = c_path(path, "path")?;
-        let bytes = std::fs::read(&path).map_err(|source| {
-            Failure(TrisortStatus::Io, format!("{}: {source}", path.display()))
-        })?;
+        let (bytes, path) = read_path(path)?;
         store(out, open_order(&bytes, &path)?, "out")
     })
 }
@@ -878,10 +897,7 @@ pub unsafe extern "C" fn trisort_order_open_bytes(
     out: *mut *mut TrisortOrder,
 ) -> TrisortStatus {
     guard(|| {
-        if data.is_null() {
-            return Err(null("data"));
-        }
-        let bytes = std::slice::from_raw_parts(data, len);
+        let bytes = host_bytes(data, len)?;
         store(out, open_order(bytes, Path::new("<bytes>"))?, "out")
     })
 }
@@ -892,9 +908,7 @@ pub unsafe extern "C" fn trisort_order_open_bytes(
 /// `h` is null or a handle not closed before.
 #[no_mangle]
 pub unsafe extern "C" fn trisort_order_close(h: *mut TrisortOrder) {
-    if !h.is_null() {
-        let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(h))));
-    }
+    close_handle(h)
 }
 
 /// Stores the ORDER file's figures in `*out`.
@@ -932,13 +946,8 @@ pub unsafe extern "C" fn trisort_order_frame_ranges(
 ) -> TrisortStatus {
     guard(|| {
         let o = &handle(h, "handle")?.order;
-        if frame as usize >= o.frames.len() {
-            return Err(Failure(
-                TrisortStatus::OutOfRange,
-                format!("frame {frame} is out of range ({} frames)", o.frames.len()),
-            ));
-        }
-        copy_out(o.frame_ranges(frame as usize), out, cap, len)
+        let f = frame_index(o.frames.len(), frame)?;
+        copy_out(o.frame_ranges(f), out, cap, len)
     })
 }
 
