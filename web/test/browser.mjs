@@ -67,25 +67,30 @@ const browser = await chromium.launch({
   ],
 });
 let failed = null;
-try {
+const logs = [];
+// Opens the page with `query` and waits until it has opened its file. `guard(p)` races `p`
+// against the page's first error: a panic in the wasm player leaves its promises unsettled.
+async function openPlayer(query, label) {
   const page = await browser.newPage({ viewport: { width: 800, height: 800 }, deviceScaleFactor: 1 });
   // A hung page (a GPU process that never answers) fails the test instead of stalling CI.
   page.setDefaultTimeout(Number(a.timeout || 120) * 1000);
-  const logs = [];
   page.on("console", (m) => logs.push(`${m.type()}: ${m.text()}`));
   page.on("pageerror", (e) => logs.push(`pageerror: ${e.message}`));
-  // A panic in the wasm player leaves its promises unsettled: fail at the first page error.
   const pageError = new Promise((_, reject) =>
-    page.on("pageerror", (e) => reject(new Error(`page error: ${e.message}\n${logs.join("\n")}`))));
+    page.on("pageerror", (e) => reject(new Error(`${label}: page error: ${e.message}\n${logs.join("\n")}`))));
   pageError.catch(() => {});
   const guard = (p) => Promise.race([p, pageError]);
-  await page.goto(`http://127.0.0.1:${port}/index.html?file=${a.file}&backend=${a.backend}&mode=${a.mode}&test=1`);
+  await page.goto(`http://127.0.0.1:${port}/index.html?${query}&backend=${a.backend}&test=1`);
   try {
     await guard(page.waitForFunction(() => window.trisort && window.trisort.ready));
     await guard(page.evaluate(() => window.trisort.ready.then(() => true)));
   } catch (e) {
-    throw new Error(`the page did not open the bake: ${e.message}\n${logs.join("\n")}`);
+    throw new Error(`${label}: the page did not open the bake: ${e.message}\n${logs.join("\n")}`);
   }
+  return { page, guard };
+}
+try {
+  const { page, guard } = await openPlayer(`file=${a.file}&mode=${a.mode}`, "frames");
   const device = await page.evaluate(() => {
     const p = window.trisort.state.player;
     return {
@@ -101,40 +106,23 @@ try {
       const name = `frame-${String(frame).padStart(5, "0")}.png`;
       const t = window.trisort;
       const ms = t.renderFrame(frame);
-      // Copy the canvas in the same task as the draw, while its drawing buffer holds the frame.
-      const gl = document.getElementById("canvas");
-      const w = gl.width, h = gl.height;
-      const got = new OffscreenCanvas(w, h).getContext("2d", { colorSpace: "srgb" });
-      got.drawImage(gl, 0, 0);
-      const ours = got.getImageData(0, 0, w, h).data;
+      const ours = t.pixels(document.getElementById("canvas"));
       const resp = await fetch(`/native/${name}`);
       if (!resp.ok) throw new Error(`native frame ${name}: HTTP ${resp.status}`);
       const bmp = await createImageBitmap(await resp.blob(), {
         colorSpaceConversion: "none", premultiplyAlpha: "none",
       });
-      if (bmp.width !== w || bmp.height !== h) {
-        throw new Error(`native ${name} is ${bmp.width}x${bmp.height}, the canvas ${w}x${h}`);
+      if (bmp.width !== ours.canvas.width || bmp.height !== ours.canvas.height) {
+        throw new Error(`native ${name} is ${bmp.width}x${bmp.height}, the canvas ${ours.canvas.width}x${ours.canvas.height}`);
       }
-      const ref = new OffscreenCanvas(w, h).getContext("2d", { colorSpace: "srgb" });
-      ref.drawImage(bmp, 0, 0);
-      const theirs = ref.getImageData(0, 0, w, h).data;
-      // Any difference, and differences above 1/255 (the GPU's sRGB encoding at the copy to
-      // the canvas rounds where the native player's CPU quantisation may round the other way).
-      let differing = 0, over1 = 0, maxDiff = 0;
-      for (let i = 0; i < ours.length; i += 4) {
-        let d = 0;
-        for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(ours[i + c] - theirs[i + c]));
-        if (d > 0) differing++;
-        if (d > 1) over1++;
-        maxDiff = Math.max(maxDiff, d);
-      }
-      const blob = await got.canvas.convertToBlob({ type: "image/png" });
+      const diff = t.compare(ours.data, t.pixels(bmp).data);
+      const blob = await ours.canvas.convertToBlob({ type: "image/png" });
       const png = Array.from(new Uint8Array(await blob.arrayBuffer()));
       return {
         frame, ms, triangles: t.state.player.frame_triangles(frame),
-        draws: t.state.player.frame_draws(frame), pixels: w * h,
-        pixels_differing_native: differing, pixels_over_1_native: over1,
-        max_channel_diff_native: maxDiff, png, name,
+        draws: t.state.player.frame_draws(frame), pixels: ours.data.length / 4,
+        pixels_differing_native: diff.differing, pixels_over_1_native: diff.over1,
+        max_channel_diff_native: diff.max, png, name,
       };
     }, frame));
     await writeFile(join(a.out, r.name), Buffer.from(r.png));
@@ -145,16 +133,7 @@ try {
   }
   // The on-device self-check: the same frames in depth mode against the file's z-buffer
   // twin, both drawn by this browser (holes on its rasterizer).
-  const check = await browser.newPage({ viewport: { width: 800, height: 800 }, deviceScaleFactor: 1 });
-  check.setDefaultTimeout(Number(a.timeout || 120) * 1000);
-  check.on("console", (m) => logs.push(`${m.type()}: ${m.text()}`));
-  const checkError = new Promise((_, reject) =>
-    check.on("pageerror", (e) => reject(new Error(`self-check page error: ${e.message}`))));
-  checkError.catch(() => {});
-  const guarded = (p) => Promise.race([p, checkError]);
-  await check.goto(`http://127.0.0.1:${port}/index.html?file=${a.file}&backend=${a.backend}&selfcheck=1&test=1`);
-  await guarded(check.waitForFunction(() => window.trisort && window.trisort.ready));
-  await guarded(check.evaluate(() => window.trisort.ready.then(() => true)));
+  const { page: check, guard: guarded } = await openPlayer(`file=${a.file}&selfcheck=1`, "self-check");
   const selfCheck = [];
   for (const frame of a.frames) {
     selfCheck.push(await guarded(check.evaluate((f) => window.trisort.selfCheck(f), frame)));
@@ -175,29 +154,17 @@ try {
   // Material variants (KHR_materials_variants) chosen on the page: colours change.
   let variant = null;
   if (a["variant-file"]) {
-    const vp = await browser.newPage();
-    vp.setDefaultTimeout(Number(a.timeout || 120) * 1000);
-    await vp.goto(`http://127.0.0.1:${port}/index.html?file=${a["variant-file"]}&backend=${a.backend}&test=1`);
-    await vp.waitForFunction(() => window.trisort && window.trisort.ready);
-    await vp.evaluate(() => window.trisort.ready.then(() => true));
+    const { page: vp } = await openPlayer(`file=${a["variant-file"]}`, "variants");
     variant = await vp.evaluate((name) => {
-      const grab = () => {
-        const c = document.getElementById("canvas");
-        const o = new OffscreenCanvas(c.width, c.height).getContext("2d");
-        o.drawImage(c, 0, 0);
-        return o.getImageData(0, 0, c.width, c.height).data;
-      };
-      const p = window.trisort.state.player;
-      window.trisort.renderFrame(0);
-      const before = grab();
+      const t = window.trisort;
+      const p = t.state.player;
+      const canvas = document.getElementById("canvas");
+      t.renderFrame(0);
+      const before = t.pixels(canvas).data;
       const select = document.getElementById("variant");
       select.value = name;
       select.dispatchEvent(new Event("change"));
-      const after = grab();
-      let changed = 0;
-      for (let i = 0; i < before.length; i += 4) {
-        if (before[i] !== after[i] || before[i + 1] !== after[i + 1] || before[i + 2] !== after[i + 2]) changed++;
-      }
+      const changed = t.compare(before, t.pixels(canvas).data).differing;
       let unknown = "";
       try { p.set_variant("no such variant"); } catch (e) { unknown = e.message; }
       return {

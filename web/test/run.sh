@@ -41,8 +41,7 @@ node web/test/browser.mjs --dist web/dist --native "$out/native" --frames "$list
 
 # Gates (BENCHMARKS § Web player has the measured figures): per frame, at most 0.5 % of the
 # pixels more than 1/255 from the native player (SwiftShader rasterizes some edge samples
-# differently from lavapipe; the GPU's sRGB encoding at the copy to the canvas rounds 1/255
-# differently from the CPU's), at most 2.5 % differing at all from the exact reference, and at
+# differently from lavapipe, and most of its other differences are 1/255), at most 2.5 % differing at all from the exact reference, and at
 # most 0.25 % holes in the page's own self-check (measured: 0.13 % at worst; the bake is exact
 # only on the rasterizer that recorded it).
 MAX_OVER1_NATIVE="${TRISORT_WEB_MAX_OVER1_NATIVE:-0.005}"

@@ -15,14 +15,28 @@ const $ = (id) => document.getElementById(id);
 const canvas = $("canvas");
 
 const state = { player: null, twin: null, frame: 0, playing: false, last: 0, ms: 0 };
-window.trisort = { state, ready: null, renderFrame, open, selfCheck };
+window.trisort = { state, ready: null, renderFrame, open, selfCheck, pixels, compare };
 
-// The pixels of a canvas, copied in the same task as its draw (while its drawing buffer
-// holds the frame).
-function pixels(c) {
-  const ctx = new OffscreenCanvas(c.width, c.height).getContext("2d", { colorSpace: "srgb" });
-  ctx.drawImage(c, 0, 0);
-  return ctx.getImageData(0, 0, c.width, c.height).data;
+// The RGBA pixels of a canvas or image (a canvas copied in the same task as its draw, while
+// its drawing buffer holds the frame), and the 2D canvas holding the copy.
+function pixels(source) {
+  const ctx = new OffscreenCanvas(source.width, source.height).getContext("2d", { colorSpace: "srgb" });
+  ctx.drawImage(source, 0, 0);
+  return { data: ctx.getImageData(0, 0, source.width, source.height).data, canvas: ctx.canvas };
+}
+
+// Two same-sized RGBA arrays compared on colour: pixels differing at all, pixels differing by
+// more than 1/255, and the largest channel difference.
+function compare(a, b) {
+  let differing = 0, over1 = 0, max = 0;
+  for (let i = 0; i < a.length; i += 4) {
+    let d = 0;
+    for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(a[i + c] - b[i + c]));
+    if (d > 0) differing++;
+    if (d > 1) over1++;
+    max = Math.max(max, d);
+  }
+  return { differing, over1, max };
 }
 
 // Frame `frame` as played and as the z-buffer twin draws it: the holes (pixels that differ)
@@ -33,15 +47,9 @@ function selfCheck(frame) {
   state.checking = true;
   try {
     const ms = renderFrame(frame);
-    const played = pixels($("canvas"));
+    const played = pixels($("canvas")).data;
     state.twin.render(frame);
-    const zbuffer = pixels($("twin"));
-    let holes = 0, max = 0;
-    for (let i = 0; i < played.length; i += 4) {
-      let d = 0;
-      for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(played[i + c] - zbuffer[i + c]));
-      if (d > 0) { holes++; max = Math.max(max, d); }
-    }
+    const { differing: holes, max } = compare(played, pixels($("twin")).data);
     if (outer) $("figures").textContent = `${state.player.figures(frame, ms)} · ${holes} holes (self-check)`;
     return { frame, holes, max_channel_diff: max };
   } finally {
