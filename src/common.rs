@@ -205,6 +205,26 @@ pub fn open_gpu_with(options: trisort_gpu::GpuOptions) -> Result<trisort_gpu::Gp
     Ok(gpu)
 }
 
+/// The scene `scene_spec` and the path `path_spec` over it (at `fps`), with the scene made the
+/// one a recording with `settings` is made of ([`working_scene`]): what `record` and `bake`
+/// start from. Returns the scene, the path's timeline and the split report.
+pub fn load_working(
+    scene_spec: &str,
+    path_spec: &str,
+    fps: f64,
+    settings: &RecordSettings,
+) -> Result<(
+    Scene,
+    trisort_paths::Timeline,
+    Option<trisort_intersect::SplitReport>,
+)> {
+    let mut scene = load_scene(scene_spec)?;
+    let timeline = load_path(path_spec, &scene, fps)?;
+    let from = format!("path {path_spec}");
+    let split = working_scene(&mut scene, scene_spec, &timeline.frames, &from, settings)?;
+    Ok((scene, timeline, split))
+}
+
 /// Makes `scene` the scene a recording with `settings` is made of: with
 /// `settings.split_intersections`, its triangles that pass through each other within a rigid
 /// group are split along their intersection (`trisort_intersect::working_geometry`), which

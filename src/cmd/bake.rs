@@ -12,7 +12,7 @@ use trisort_gpu::Gpu;
 use crate::cmd::merge::{baked_json, merge_to_file, print_summary, MergeOpts};
 use crate::cmd::record::{add_split_json, record_to_file, recording_json};
 use crate::cmd::RecordOpts;
-use crate::common::{load_path, load_scene, print_json, working_scene};
+use crate::common::{load_working, print_json};
 
 /// Arguments of `bake`.
 #[derive(Args, Debug)]
@@ -66,16 +66,8 @@ pub fn bake(
 }
 
 pub fn run(a: BakeArgs) -> Result<ExitCode> {
-    let mut scene = load_scene(&a.scene)?;
-    let timeline = load_path(&a.path, &scene, a.record.fps)?;
-    let from = format!("path {}", a.path);
-    let split = working_scene(
-        &mut scene,
-        &a.scene,
-        &timeline.frames,
-        &from,
-        &a.record.settings(),
-    )?;
+    let (scene, timeline, split) =
+        load_working(&a.scene, &a.path, a.record.fps, &a.record.settings())?;
     let gpu = crate::common::open_gpu()?;
     let (rec, baked, record_s, merge_s) =
         bake(&gpu, &scene, &timeline, &a.record, &a.merge, &a.output)?;

@@ -13,7 +13,7 @@ use trisort_recorder::partial::{partial_path, PartialDir};
 use trisort_recorder::{record, RecordJob};
 
 use crate::cmd::RecordOpts;
-use crate::common::{load_path, load_scene, print_json, progress_bar, working_scene, FrameRange};
+use crate::common::{load_working, print_json, progress_bar, FrameRange};
 
 /// Which phases to run.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -165,16 +165,7 @@ pub fn record_to_file(
 
 pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
-    let mut scene = load_scene(&a.scene)?;
-    let timeline = load_path(&a.path, &scene, a.opts.fps)?;
-    let from = format!("path {}", a.path);
-    let split = working_scene(
-        &mut scene,
-        &a.scene,
-        &timeline.frames,
-        &from,
-        &a.opts.settings(),
-    )?;
+    let (scene, timeline, split) = load_working(&a.scene, &a.path, a.opts.fps, &a.opts.settings())?;
     if let Some(shard) = a.shard {
         let (i, n) = shard.resolve(&|k| std::env::var(k).ok())?;
         let range = shard_range(i, n, timeline.frames.len() as u32)?;
