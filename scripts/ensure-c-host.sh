@@ -21,9 +21,5 @@ have_zstandard() {
 have_zstandard || missing+=(python3 python3-zstandard)
 if [ ${#missing[@]} -gt 0 ]; then
   echo "trisort: installing ${missing[*]} (C host example, format reader)" >&2
-  SUDO=""
-  if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  bash "$(dirname "$0")/apt-install.sh" --no-install-recommends "${missing[@]}"
 fi

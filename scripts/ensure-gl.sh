@@ -12,9 +12,5 @@ have_gl() {
 }
 if ! have_gl; then
   echo "trisort: no Mesa EGL found; installing libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri" >&2
-  SUDO=""
-  if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri >/dev/null
+  bash "$(dirname "$0")/apt-install.sh" libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri
 fi

@@ -11,10 +11,7 @@ cd "$(dirname "$0")/.."
 need_npm() {
   if ! command -v npm >/dev/null || ! command -v node >/dev/null; then
     echo "trisort: installing nodejs npm (for the glTF tools)" >&2
-    SUDO=""; if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
-    export DEBIAN_FRONTEND=noninteractive
-    $SUDO apt-get update -qq
-    $SUDO apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
+    bash scripts/apt-install.sh --no-install-recommends nodejs npm
   fi
 }
 # install PACKAGE VERSION: npm install into target/tools/PACKAGE unless that version is there.

@@ -12,9 +12,5 @@ have_icd() {
 }
 if ! have_icd; then
   echo "trisort: no Vulkan driver found; installing Mesa's lavapipe (mesa-vulkan-drivers)" >&2
-  SUDO=""
-  if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >/dev/null
+  bash "$(dirname "$0")/apt-install.sh" mesa-vulkan-drivers libvulkan1
 fi

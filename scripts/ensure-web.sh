@@ -20,10 +20,7 @@ if [ "${1:-}" = "--browser" ]; then
   command -v npm >/dev/null || missing+=(npm)
   if [ ${#missing[@]} -gt 0 ]; then
     echo "trisort: installing ${missing[*]}" >&2
-    SUDO=""; if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
-    export DEBIAN_FRONTEND=noninteractive
-    $SUDO apt-get update -qq
-    $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+    bash scripts/apt-install.sh --no-install-recommends "${missing[@]}"
   fi
   if [ ! -d web/test/node_modules/playwright-core ]; then
     echo "trisort: installing playwright-core (npm) into web/test/node_modules" >&2
