@@ -402,6 +402,54 @@ impl<'g> Conservative<'g> {
             triangles: count,
         })
     }
+    /// Records one pass of frame `frame`: `vertices` of `pipeline` with `group` in group 1,
+    /// into the color target `color` (view, clear color, store) or, without one, into
+    /// `surface`'s depth cleared to 1 and stored.
+    #[allow(clippy::too_many_arguments)]
+    fn pass(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        frame: u32,
+        label: &str,
+        color: Option<(&wgpu::TextureView, wgpu::Color, wgpu::StoreOp)>,
+        pipeline: &wgpu::RenderPipeline,
+        group: &wgpu::BindGroup,
+        vertices: std::ops::Range<u32>,
+    ) {
+        let color = color.map(|(view, clear, store)| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store,
+                },
+            })
+        });
+        let depth = color
+            .is_none()
+            .then_some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.surface,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            });
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            // No color slot at all for the depth-only pass (its pipeline has no target).
+            color_attachments: color.as_slice(),
+            depth_stencil_attachment: depth,
+            ..Default::default()
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+        pass.set_bind_group(1, group, &[]);
+        pass.draw(vertices, 0..1);
+    }
+
     /// The triangles (indices into the geometry) that may win a sample of frame `frame` when
     /// the pattern moves within the tolerance, ascending.
     pub fn visible(&self, frame: u32) -> Result<Vec<u32>, RecordError> {
@@ -413,71 +461,41 @@ impl<'g> Conservative<'g> {
             label: Some("conservative"),
         });
         enc.clear_buffer(&self.flags, 0, None);
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("conservative occluders"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &self.surface,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.occlude);
-            pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
-            pass.set_bind_group(1, &self.occlude_group, &[]);
-            pass.draw(0..3 * self.triangles, 0..1);
-        }
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("conservative spread"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &self.occluder,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.spread);
-            pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
-            pass.set_bind_group(1, &self.spread_group, &[]);
-            pass.draw(0..3, 0..1);
-        }
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("conservative mark"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &self.target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Discard,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.mark);
-            pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
-            pass.set_bind_group(1, &self.mark_group, &[]);
-            pass.draw(0..3 * self.triangles, 0..1);
-        }
+        let triangles = 0..3 * self.triangles;
+        // The occluders' depth, then spread over the tolerance, then the marks (flags only).
+        self.pass(
+            &mut enc,
+            frame,
+            "conservative occluders",
+            None,
+            &self.occlude,
+            &self.occlude_group,
+            triangles.clone(),
+        );
+        let spread = (&self.occluder, wgpu::Color::WHITE, wgpu::StoreOp::Store);
+        self.pass(
+            &mut enc,
+            frame,
+            "conservative spread",
+            Some(spread),
+            &self.spread,
+            &self.spread_group,
+            0..3,
+        );
+        let mark = (
+            &self.target,
+            wgpu::Color::TRANSPARENT,
+            wgpu::StoreOp::Discard,
+        );
+        self.pass(
+            &mut enc,
+            frame,
+            "conservative mark",
+            Some(mark),
+            &self.mark,
+            &self.mark_group,
+            triangles,
+        );
         enc.copy_buffer_to_buffer(&self.flags, 0, &self.staging, 0, self.flags.size());
         self.gpu.queue.submit([enc.finish()]);
         let slice = self.staging.slice(..);
