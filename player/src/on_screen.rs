@@ -85,7 +85,7 @@ impl OnScreen {
 
     /// Records frame `frame` into the off-screen target and its copy to `surface_view`
     /// (a view of the surface texture in the format `blit` was made for).
-    pub fn encode(
+    fn encode(
         &self,
         enc: &mut wgpu::CommandEncoder,
         blit: &Blit,

@@ -1,6 +1,6 @@
 //! The viewer's GPU side: the window's surface and device, the player and its offscreen
-//! target ([`trisort_player::OnScreen`]), and the blit that presents the target ([`trisort_gpu::present`]). The event loop
-//! (`mod.rs`) decides what to show; this draws it.
+//! target ([`trisort_player::OnScreen`]), and the blit that presents the target
+//! ([`trisort_gpu::present`]). The event loop (`mod.rs`) decides what to show; this draws it.
 
 use std::sync::Arc;
 
