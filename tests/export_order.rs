@@ -10,12 +10,27 @@
 
 use std::collections::HashMap;
 use std::path::Path;
+use std::process::Output;
 
 use glam::Vec3;
 use trisort_capi::Order;
 use trisort_format::{Baked, FileKind, Vertex};
 
 use crate::support::{args, gpu_tempdir, run, run_json, scene};
+
+/// Runs `trisort export-order BAKED --scene SCENE -o OUT` in `dir`, expecting success or not.
+pub fn export_order(dir: &Path, baked: &str, scene: &str, out: &str, ok: bool) -> Output {
+    run(
+        dir,
+        &["export-order", baked, "--scene", scene, "-o", out],
+        ok,
+    )
+}
+
+/// [`export_order`] with `--json`, expecting success: its figures.
+pub fn export_order_json(dir: &Path, baked: &str, scene: &str, out: &str) -> serde_json::Value {
+    run_json(dir, &["export-order", baked, "--scene", scene, "-o", out])
+}
 
 /// The vertex a host builds from glTF primitive data: position, unit normal (as the file's,
 /// scaled to unit length), uv (zero for untextured materials, whose shading ignores it).
@@ -117,17 +132,7 @@ fn rebuilding_the_order_from_the_gltf_reproduces_the_players_frames() {
     );
     bake.insert(1, &truck);
     run(d, &bake, true);
-    let v = run_json(
-        d,
-        &[
-            "export-order",
-            "truck.baked",
-            "--scene",
-            &truck,
-            "-o",
-            "truck.order",
-        ],
-    );
+    let v = export_order_json(d, "truck.baked", &truck, "truck.order");
     let info = run_json(d, &["inspect", "truck.baked"]);
     assert_eq!(v["triangles"], info["index_triangles"]);
     assert_eq!(v["frames"], info["frames"]);
@@ -187,17 +192,7 @@ fn split_bakes_map_every_piece_to_its_source_and_wrong_scenes_are_refused() {
     let mut bake = args("bake --path gltf --fps 4 --size 64x48 --samples 4 -o split.baked");
     bake.insert(1, &truck);
     run(d, &bake, true);
-    let v = run_json(
-        d,
-        &[
-            "export-order",
-            "split.baked",
-            "--scene",
-            &truck,
-            "-o",
-            "split.order",
-        ],
-    );
+    let v = export_order_json(d, "split.baked", &truck, "split.order");
     assert_eq!(v["split"], true);
     let baked: Baked = trisort_format::read_file(FileKind::Baked, &d.join("split.baked")).unwrap();
     let order = Order::read(&d.join("split.order")).unwrap();
@@ -217,49 +212,16 @@ fn split_bakes_map_every_piece_to_its_source_and_wrong_scenes_are_refused() {
         assert!((s.triangle as usize) < count, "{s:?}");
     }
 
-    let out = run(
-        d,
-        &[
-            "export-order",
-            "split.baked",
-            "--scene",
-            &bunny,
-            "-o",
-            "wrong.order",
-        ],
-        false,
-    );
+    let out = export_order(d, "split.baked", &bunny, "wrong.order", false);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("not the scene") && err.contains("split.baked"),
         "{err}"
     );
     assert!(!d.join("wrong.order").exists(), "no output on failure");
-    let out = run(
-        d,
-        &[
-            "export-order",
-            "split.baked",
-            "--scene",
-            "demo",
-            "-o",
-            "wrong.order",
-        ],
-        false,
-    );
+    let out = export_order(d, "split.baked", "demo", "wrong.order", false);
     assert!(String::from_utf8_lossy(&out.stderr).contains(".glb/.gltf"));
     std::fs::write(d.join("junk.baked"), b"TRISBAK\0junk").unwrap();
-    let out = run(
-        d,
-        &[
-            "export-order",
-            "junk.baked",
-            "--scene",
-            &truck,
-            "-o",
-            "wrong.order",
-        ],
-        false,
-    );
+    let out = export_order(d, "junk.baked", &truck, "wrong.order", false);
     assert!(String::from_utf8_lossy(&out.stderr).contains("junk.baked"));
 }

@@ -3,8 +3,9 @@
 //! `inspect --json`'s and `export-order --json`'s.
 
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Output};
 
+use crate::export_order::export_order_json;
 use crate::support::{args, gpu_tempdir, run, run_json, scene};
 
 /// A Python 3 with the `zstandard` module (Debian's python3-zstandard lives under
@@ -26,9 +27,15 @@ fn python() -> Option<&'static str> {
     found
 }
 
-fn read(python: &str, file: &Path) -> serde_json::Value {
+/// Runs docs/format_reader.py on `file`.
+fn run_reader(python: &str, file: &Path) -> Output {
     let reader = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/format_reader.py");
-    let out = Command::new(python).arg(reader).arg(file).output().unwrap();
+    Command::new(python).arg(reader).arg(file).output().unwrap()
+}
+
+/// docs/format_reader.py's figures of `file`, which it must read.
+fn read(python: &str, file: &Path) -> serde_json::Value {
+    let out = run_reader(python, file);
     assert!(
         out.status.success(),
         "format_reader.py {} failed:\n{}",
@@ -77,12 +84,7 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
     let mut bytes = std::fs::read(d.join("car.baked")).unwrap();
     bytes.truncate(bytes.len() - 1);
     std::fs::write(d.join("cut.baked"), &bytes).unwrap();
-    let reader = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/format_reader.py");
-    let out = Command::new(python)
-        .arg(&reader)
-        .arg(d.join("cut.baked"))
-        .output()
-        .unwrap();
+    let out = run_reader(python, &d.join("cut.baked"));
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cut.baked"));
 }
@@ -99,17 +101,7 @@ fn the_independent_reader_parses_an_order_file() {
         args("bake --path gltf --fps 4 --size 48x48 --samples 1 --keep-intersections -o t.baked");
     bake.insert(1, &truck);
     run(d, &bake, true);
-    let v = run_json(
-        d,
-        &[
-            "export-order",
-            "t.baked",
-            "--scene",
-            &truck,
-            "-o",
-            "t.order",
-        ],
-    );
+    let v = export_order_json(d, "t.baked", &truck, "t.order");
     let ours = read(python, &d.join("t.order"));
     for key in ["frames", "ranges", "triangles", "split"] {
         assert_eq!(ours[key], v[key], "{key}");
