@@ -47,7 +47,9 @@ use rayon::prelude::*;
 use trisort_format::{Baked, MatrixCell, Recording};
 
 pub use limits::Limit;
-pub use shards::{device_differences, differences, join, settings_differences, Difference};
+pub use shards::{
+    device_differences, differences, join, list_differences, settings_differences, Difference,
+};
 pub use strategy::{Layout, Strategy};
 pub use trisort_format::{Bridge, Choice, Seeding};
 

@@ -22,6 +22,14 @@ impl std::fmt::Display for Difference {
     }
 }
 
+/// Differences as one `; `-separated line (`size "1x1" vs "2x2"; samples "1" vs "4"`).
+pub fn list_differences(d: &[Difference]) -> String {
+    d.iter()
+        .map(|d| d.what.as_str())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 /// Named fields that differ: `what "x" vs "y"` for each (device?, what, x, y) with x ≠ y.
 fn differing(fields: Vec<(bool, &str, String, String)>) -> Vec<Difference> {
     fields
@@ -189,15 +197,14 @@ pub(crate) fn first_difference(
         return Err(MergeError::NoRecordings);
     };
     for (k, r) in recordings.iter().enumerate().skip(1) {
-        let d: Vec<String> = differences(first, r)
+        let d: Vec<Difference> = differences(first, r)
             .into_iter()
             .filter(|d| !(allow_mixed_devices && d.device))
-            .map(|d| d.what)
             .collect();
         if !d.is_empty() {
             return Err(MergeError::Differs {
                 recording: k,
-                differences: d.join("; "),
+                differences: list_differences(&d),
             });
         }
     }

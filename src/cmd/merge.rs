@@ -163,18 +163,12 @@ pub fn check_compatible(
         let (device, other): (Vec<_>, Vec<_>) = trisort_merger::differences(&recs[0], r)
             .into_iter()
             .partition(|d| d.device);
-        let list = |v: &[trisort_merger::Difference]| {
-            v.iter()
-                .map(|d| d.what.clone())
-                .collect::<Vec<_>>()
-                .join("; ")
-        };
         if !other.is_empty() {
             bail!(
                 "{} is not part of the same bake as {}: {}",
                 files[k].display(),
                 files[0].display(),
-                list(&other)
+                trisort_merger::list_differences(&other)
             );
         }
         if !device.is_empty() {
@@ -185,7 +179,7 @@ pub fn check_compatible(
                      --allow-mixed-devices)",
                     files[k].display(),
                     files[0].display(),
-                    list(&device)
+                    trisort_merger::list_differences(&device)
                 );
             }
             let w = format!(
@@ -194,7 +188,7 @@ pub fn check_compatible(
                  \"mixed: …\"",
                 files[k].display(),
                 files[0].display(),
-                list(&device)
+                trisort_merger::list_differences(&device)
             );
             eprintln!("trisort: warning: {w}");
             warnings.push(w);

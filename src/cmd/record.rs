@@ -208,7 +208,7 @@ pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
                 "{}: phase 1 was recorded on another device than this one ({}); record phase 1 \
                  on the kind of device that records phase 2",
                 f.display(),
-                join_differences(&differ)
+                trisort_merger::list_differences(&differ)
             );
         }
     }
@@ -269,7 +269,7 @@ fn union_of_visibility(
             bail!(
                 "{}: recorded with other settings than this command line's: {}",
                 f.display(),
-                join_differences(&differ)
+                trisort_merger::list_differences(&differ)
             );
         }
         devices.push((f.clone(), rec.device.clone()));
@@ -284,14 +284,6 @@ fn union_of_visibility(
     g.sort_unstable();
     g.dedup();
     Ok(Some((g, devices)))
-}
-
-/// Differences as one `; `-separated line.
-fn join_differences(d: &[trisort_merger::Difference]) -> String {
-    d.iter()
-        .map(|d| d.what.as_str())
-        .collect::<Vec<_>>()
-        .join("; ")
 }
 
 /// `--shard`: a shard index and count, or `auto` (from the batch scheduler's environment).
@@ -417,7 +409,7 @@ fn write_union(
         bail!(
             "{}: recorded with other settings than this command line's: {}",
             a.visibility[0].display(),
-            join_differences(&differ)
+            trisort_merger::list_differences(&differ)
         );
     }
     trisort_format::write_file_atomic(FileKind::Recording, &a.output, &rec)?;
