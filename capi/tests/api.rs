@@ -8,7 +8,8 @@ use std::ptr::{null, null_mut};
 use trisort_capi::ffi::*;
 use trisort_capi::{Order, OrderRange, OrderSource};
 
-fn last_error() -> String {
+/// The calling thread's last error message, as a host reads it.
+pub fn last_error() -> String {
     let mut buf = vec![0u8; 4096];
     let n = unsafe { trisort_last_error(buf.as_mut_ptr().cast::<c_char>(), buf.len()) };
     buf.truncate(n.min(4095));

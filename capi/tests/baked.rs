@@ -13,6 +13,8 @@ use trisort_format::{
 };
 use trisort_testkit::fixtures::{frame_at, material, quad, scene};
 
+use crate::api::last_error;
+
 /// Four quads (8 triangles) in front of each other; the index buffer holds 10 copies, front
 /// to back; frame 0 draws copies 0..4 and 6..10, frame 1 copies 2..8.
 fn sample() -> Baked {
@@ -235,9 +237,7 @@ fn more_than_65536_vertices_refuse_u16_indices() {
     let mut len = 0;
     let s = unsafe { trisort_indices_u16(h, false, null_mut(), 0, &mut len) };
     assert_eq!(s, TrisortStatus::Unsupported);
-    let mut msg = [0u8; 256];
-    let n = unsafe { trisort_last_error(msg.as_mut_ptr().cast(), msg.len()) };
-    assert!(String::from_utf8_lossy(&msg[..n]).contains("70000 vertices"));
+    assert!(last_error().contains("70000 vertices"), "{}", last_error());
     let idx: Vec<u32> = get(|o, c, l| unsafe { trisort_indices_u32(h, false, o, c, l) });
     assert_eq!(idx.len(), 30);
     unsafe { trisort_close(h) };
@@ -252,9 +252,7 @@ fn a_structurally_broken_file_is_refused_with_its_problem() {
     let s = unsafe { trisort_open_bytes(bytes.as_ptr(), bytes.len(), &mut h) };
     assert_eq!(s, TrisortStatus::Format);
     assert!(h.is_null());
-    let mut msg = [0u8; 256];
-    let n = unsafe { trisort_last_error(msg.as_mut_ptr().cast(), msg.len()) };
-    assert!(String::from_utf8_lossy(&msg[..n]).contains("draw 0"));
+    assert!(last_error().contains("draw 0"), "{}", last_error());
 }
 
 #[test]
@@ -269,9 +267,7 @@ fn export_order_refuses_a_structurally_broken_baked_file_before_reading_the_scen
     let (baked_c, scene_c, out_c) = (c(&baked), c(&dir.path().join("none.glb")), c(&out));
     let s = unsafe { trisort_export_order(baked_c.as_ptr(), scene_c.as_ptr(), out_c.as_ptr()) };
     assert_eq!(s, TrisortStatus::Format);
-    let mut msg = [0u8; 256];
-    let n = unsafe { trisort_last_error(msg.as_mut_ptr().cast(), msg.len()) };
-    let msg = String::from_utf8_lossy(&msg[..n]);
+    let msg = last_error();
     assert!(
         msg.contains("broken.baked") && msg.contains("draw 0"),
         "{msg}"
