@@ -498,24 +498,15 @@ impl<'g> Conservative<'g> {
         );
         enc.copy_buffer_to_buffer(&self.flags, 0, &self.staging, 0, self.flags.size());
         self.gpu.queue.submit([enc.finish()]);
-        let slice = self.staging.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
+        let bytes = trisort_gpu::map_read_all(device, &[&self.staging])
             .map_err(|e| RecordError::Device(e.to_string()))?;
-        let out = {
-            let data = slice
-                .get_mapped_range()
-                .map_err(|e| RecordError::Device(e.to_string()))?;
-            let flags: &[u32] = bytemuck::cast_slice(&data);
-            flags[..self.triangles as usize]
-                .iter()
-                .enumerate()
-                .filter(|(_, &f)| f != 0)
-                .map(|(t, _)| t as u32)
-                .collect()
-        };
-        self.staging.unmap();
-        Ok(out)
+        // One u32 flag a triangle (the bytes need not be 4-aligned: no cast).
+        Ok(bytes[0]
+            .chunks_exact(4)
+            .take(self.triangles as usize)
+            .enumerate()
+            .filter(|(_, f)| *f != [0; 4])
+            .map(|(t, _)| t as u32)
+            .collect())
     }
 }
