@@ -3,7 +3,7 @@
 //! dynamic offset (group 0 of [`crate::COMMON`]).
 
 use bytemuck::{Pod, Zeroable};
-use trisort_format::{AlphaMode, FrameState, Geometry, Vertex};
+use trisort_format::{AlphaMode, FrameState, Geometry, Material, Vertex};
 use wgpu::util::DeviceExt;
 
 /// Vertex buffer layout of [`Vertex`] (locations 0–4 of `VertexIn`).
@@ -381,7 +381,7 @@ impl SceneGpu {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        let materials = material_table(geometry, &uv_scales);
+        let materials = material_table(&geometry.materials, &uv_scales);
         // The texture tier packs every frame's matrices contiguously (64 bytes a node).
         let node_align = match bindings {
             Bindings::Storage => limits.min_storage_buffer_offset_alignment as u64,
@@ -446,17 +446,13 @@ impl SceneGpu {
     /// variant: slot k draws as `materials[k]`; textures are those uploaded, named by index).
     /// Takes effect for commands submitted after it. Panics unless `materials` has as many
     /// entries as the geometry uploaded.
-    pub fn set_materials(&self, queue: &wgpu::Queue, materials: &[trisort_format::Material]) {
+    pub fn set_materials(&self, queue: &wgpu::Queue, materials: &[Material]) {
         assert_eq!(
             materials.len(),
             self.material_count,
             "a material table replaces one of the same length"
         );
-        let geometry = Geometry {
-            materials: materials.to_vec(),
-            ..Geometry::default()
-        };
-        let table = material_table(&geometry, &self.uv_scales);
+        let table = material_table(materials, &self.uv_scales);
         let bytes: &[u8] = bytemuck::cast_slice(&table);
         match &self.material_store {
             MaterialStore::Buffer(buffer) => queue.write_buffer(buffer, 0, bytes),
@@ -631,9 +627,8 @@ fn upload_textures(
 }
 
 /// The materials as the shaders read them (one zeroed material where the scene has none).
-fn material_table(geometry: &Geometry, uv_scales: &[[f32; 2]]) -> Vec<MaterialGpu> {
-    let mut mats: Vec<MaterialGpu> = geometry
-        .materials
+fn material_table(materials: &[Material], uv_scales: &[[f32; 2]]) -> Vec<MaterialGpu> {
+    let mut mats: Vec<MaterialGpu> = materials
         .iter()
         .map(|m| {
             let mode = match m.alpha_mode {
