@@ -221,6 +221,12 @@ fn split_bakes_map_every_piece_to_its_source_and_wrong_scenes_are_refused() {
     assert!(!d.join("wrong.order").exists(), "no output on failure");
     let out = export_order(d, "split.baked", "demo", "wrong.order", false);
     assert!(String::from_utf8_lossy(&out.stderr).contains(".glb/.gltf"));
+    let out = export_order(d, "split.baked", "demolition.glb", "wrong.order", false);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("demolition.glb") && !err.contains("procedural demo car"),
+        "a missing file is not the demo car: {err}"
+    );
     std::fs::write(d.join("junk.baked"), b"TRISBAK\0junk").unwrap();
     let out = export_order(d, "junk.baked", &truck, "wrong.order", false);
     assert!(String::from_utf8_lossy(&out.stderr).contains("junk.baked"));

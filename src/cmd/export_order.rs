@@ -35,7 +35,10 @@ pub struct ExportOrderArgs {
 }
 
 pub fn run(a: ExportOrderArgs) -> Result<ExitCode> {
-    if a.scene.to_string_lossy().starts_with("demo") && !a.scene.exists() {
+    // `demo` and `demo:TRIANGLES` name the procedural car (as `load_scene` reads them); any
+    // other name, `demolition.glb` included, is a file.
+    let spec = a.scene.to_string_lossy();
+    if (spec == "demo" || spec.starts_with("demo:")) && !a.scene.exists() {
         bail!(
             "--scene {}: the order names glTF meshes and primitives, so it needs the \
              .glb/.gltf file the bake was made from (the procedural demo car has none: export \
