@@ -103,7 +103,7 @@ fn five_shards_bake_the_one_machine_bytes() {
     // A union missing shard 3, and one given a phase-2 recording, are refused.
     let mut missing = record(&["--phase", "union", "-o", "bad.rec", "--visibility"]);
     missing.extend(vis.iter().filter(|v| **v != "vis-3.rec"));
-    let err = String::from_utf8_lossy(&run(d, &missing, false).stderr).into_owned();
+    let err = refused(d, &missing);
     assert!(
         err.contains("frame 38") || err.contains("comes next"),
         "{err}"
@@ -165,22 +165,17 @@ fn five_shards_bake_the_one_machine_bytes() {
             "phase 2 of shard {i}"
         );
     }
-    let err = String::from_utf8_lossy(
-        &run(
-            d,
-            &record(&[
-                "--phase",
-                "union",
-                "-o",
-                "bad.rec",
-                "--visibility",
-                "graphs-0.rec",
-            ]),
-            false,
-        )
-        .stderr,
-    )
-    .into_owned();
+    let err = refused(
+        d,
+        &record(&[
+            "--phase",
+            "union",
+            "-o",
+            "bad.rec",
+            "--visibility",
+            "graphs-0.rec",
+        ]),
+    );
     assert!(
         err.contains("graphs-0.rec") && err.contains("not a phase-1"),
         "{err}"
@@ -364,6 +359,11 @@ fn bad_shards_are_refused_naming_the_cause() {
     assert!(err.contains("--visibility"), "{err}");
 }
 
+/// The stderr of `trisort ARGS` in `d`, which must fail.
+fn refused(d: &Path, args: &[&str]) -> String {
+    String::from_utf8_lossy(&run(d, args, false).stderr).into_owned()
+}
+
 /// Writes the synthetic turntable's frames 0..2, 2..6, 6..9 as `r0.rec`…`r2.rec`, after
 /// `forge` changed them; returns the whole recording.
 fn write_parts(d: &Path, forge: impl Fn(usize, &mut Recording)) -> Recording {
@@ -398,7 +398,7 @@ fn mixed_devices_are_refused_unless_allowed() {
             p.device.driver = "NVIDIA 550.54".into();
         }
     });
-    let err = String::from_utf8_lossy(&run(d, &args(PARTS), false).stderr).into_owned();
+    let err = refused(d, &args(PARTS));
     for want in [
         "r1.rec",
         "r0.rec",
@@ -458,7 +458,7 @@ fn mixed_devices_are_refused_unless_allowed() {
             p.device.adapter = "NVIDIA H200".into();
         }
     });
-    let err = String::from_utf8_lossy(&run(d, &allow, false).stderr).into_owned();
+    let err = refused(d, &allow);
     assert!(
         err.contains("r2.rec") && err.contains("size") && err.contains("samples"),
         "{err}"
@@ -483,15 +483,7 @@ fn merge_join_is_the_whole_recording() {
     assert!(read(d, "joined.rec") == read(d, "whole.rec"));
     assert!(read(d, "joined.baked") == read(d, "whole.baked"));
     // A missing range is refused, naming the files, and nothing is written.
-    let err = String::from_utf8_lossy(
-        &run(
-            d,
-            &args("merge r0.rec r2.rec --join j.rec -o j.baked"),
-            false,
-        )
-        .stderr,
-    )
-    .into_owned();
+    let err = refused(d, &args("merge r0.rec r2.rec --join j.rec -o j.baked"));
     assert!(
         err.contains("r2.rec") && err.contains("comes next"),
         "{err}"
