@@ -81,9 +81,11 @@ pub(super) fn references(
     frames: &[u32],
     glass: f32,
 ) -> Result<Vec<Vec<Vec<u8>>>, BenchError> {
-    conditions(config.size)
-        .iter()
-        .map(|c| {
+    // One reference per size: the offset conditions share it (only the offset changes).
+    let mut at: Option<((u32, u32), ExactReference)> = None;
+    let mut out = Vec::new();
+    for c in conditions(config.size) {
+        if at.as_ref().is_none_or(|(size, _)| *size != c.size) {
             let reference = ExactReference::new(
                 gpu,
                 scene,
@@ -96,13 +98,18 @@ pub(super) fn references(
                     max_layers: 4096,
                 },
             )?;
-            reference.set_subpixel_offset(c.offset);
+            at = Some((c.size, reference));
+        }
+        let (_, reference) = at.as_ref().expect("set above");
+        reference.set_subpixel_offset(c.offset);
+        out.push(
             frames
                 .iter()
                 .map(|&f| Ok(reference.render(f, None)?.rgba8))
-                .collect()
-        })
-        .collect()
+                .collect::<Result<Vec<_>, BenchError>>()?,
+        );
+    }
+    Ok(out)
 }
 
 /// `baked`'s error under each condition against `references` (from [`references`], same
