@@ -725,3 +725,17 @@ fn gltf_path_selection_names_what_the_scene_lacks() {
         );
     }
 }
+
+/// A missing file is named once with its cause once: the format errors carry the cause in
+/// their message and as their source, and the CLI prints the chain without repeating it.
+#[test]
+fn a_missing_file_names_its_cause_once() {
+    let dir = tempfile::tempdir().unwrap();
+    for cmd in ["inspect", "play", "verify"] {
+        let out = run(dir.path(), &[cmd, "missing.baked"], false);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("missing.baked"), "{cmd}: {err}");
+        let cause = "No such file or directory";
+        assert_eq!(err.matches(cause).count(), 1, "{cmd}: {err}");
+    }
+}
