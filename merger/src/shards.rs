@@ -92,6 +92,22 @@ pub fn settings_differences(s: &RecordSettings, t: &RecordSettings) -> Vec<Diffe
 /// two recordings with graphs, G. Frame ranges are not compared. Empty when they may be
 /// merged or joined.
 pub fn differences(a: &Recording, b: &Recording) -> Vec<Difference> {
+    // Every field, so that one added to `Recording` fails to compile here until it is either
+    // compared below or said not to need it.
+    let Recording {
+        tool_version: _,
+        scene_hash: _,
+        path_hash: _,
+        settings: _,
+        device: _,
+        phase: _,
+        scene_triangles: _,
+        frame_states: _,
+        unique_visible: _,
+        frames: _,   // the ranges: what is joined, not compared
+        geometry: _, // G's triangles: follows from the scene and G
+        fps: _,      // part of the path hash
+    } = a;
     let short = |h: &trisort_format::Hash| hash_hex(h)[..16].to_string();
     let phase = |r: &Recording| format!("{:?}", r.phase).to_lowercase();
     let mut out = device_differences(&a.device, &b.device);
