@@ -470,7 +470,26 @@ impl SceneGpu {
     /// zero offset rasterizes exactly what [`SceneGpu::new`] uploads. Takes effect for
     /// commands submitted after it.
     pub fn set_subpixel_offset(&self, queue: &wgpu::Queue, offset: [f64; 2]) {
-        for (f, (u, proj)) in self.uniforms.iter().enumerate() {
+        self.set_subpixel_offset_of(queue, offset, 0..self.uniforms.len() as u32);
+    }
+
+    /// [`SceneGpu::set_subpixel_offset`] for the frames of `frames` only (the recorder's
+    /// jittered patterns move one frame at a time: rewriting every frame's uniforms for each
+    /// pattern of each frame grew with the square of the path's length).
+    pub fn set_subpixel_offset_of(
+        &self,
+        queue: &wgpu::Queue,
+        offset: [f64; 2],
+        frames: std::ops::Range<u32>,
+    ) {
+        let frames = frames.start as usize..(frames.end as usize).min(self.uniforms.len());
+        for (f, (u, proj)) in self
+            .uniforms
+            .iter()
+            .enumerate()
+            .skip(frames.start)
+            .take(frames.len())
+        {
             let mut u = *u;
             u.proj = (subpixel_shift(offset, self.view) * *proj)
                 .as_mat4()

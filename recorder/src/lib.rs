@@ -139,7 +139,7 @@ fn visibility_frame(
     let offsets = s.robust.offsets();
     for &offset in &offsets {
         if offsets.len() > 1 {
-            peeler.set_subpixel_offset(offset);
+            peeler.set_frame_subpixel_offset(frame, offset);
         }
         let mut transmittance = vec![1.0f32; slots];
         let (l, t) = peeler.peel(frame, s.max_layers, |_, layer, done| {
@@ -165,7 +165,7 @@ fn visibility_frame(
         truncated |= t;
     }
     if offsets.len() > 1 {
-        peeler.set_subpixel_offset([0.0, 0.0]);
+        peeler.set_frame_subpixel_offset(frame, [0.0, 0.0]);
     }
     visible.extend(
         reached
@@ -207,7 +207,7 @@ fn graph_frame(
         .chain(grown.map(|p| (p, [0.0, 0.0], false, true)));
     for (peeler, offset, shift, is_grown) in passes {
         if shift {
-            peeler.set_subpixel_offset(offset);
+            peeler.set_frame_subpixel_offset(frame, offset);
         }
         let mut last_id = vec![0u32; slots];
         let mut last_depth = vec![0f32; slots];
@@ -240,7 +240,7 @@ fn graph_frame(
         truncated |= t;
     }
     if offsets.len() > 1 {
-        peeler.set_subpixel_offset([0.0, 0.0]);
+        peeler.set_frame_subpixel_offset(frame, [0.0, 0.0]);
     }
     merge_grown_edges(&mut edges, grown_edges);
     let covered: Vec<u32> = covered

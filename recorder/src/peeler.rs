@@ -464,6 +464,13 @@ impl<'g> Peeler<'g> {
         self.scene.set_subpixel_offset(&self.gpu.queue, offset);
     }
 
+    /// [`Peeler::set_subpixel_offset`] for frame `frame` only: what the recorder's jittered
+    /// patterns need, one frame at a time.
+    pub fn set_frame_subpixel_offset(&self, frame: u32, offset: [f64; 2]) {
+        self.scene
+            .set_subpixel_offset_of(&self.gpu.queue, offset, frame..frame + 1);
+    }
+
     /// Number of triangles drawn (ids in a [`Layer`] are positions in this list, plus 1).
     pub fn triangles(&self) -> usize {
         self.triangles as usize
