@@ -21,8 +21,7 @@ use crate::cmd::bake::{bake, recording_path};
 use crate::cmd::merge::MergeOpts;
 use crate::cmd::RecordOpts;
 use crate::common::{
-    default_size, load_path, load_scene, option_parser, parse_range, parse_size, print_json,
-    working_scene, FrameRange,
+    default_size, load_working, option_parser, parse_range, parse_size, print_json, FrameRange,
 };
 
 /// Arguments of `bench`.
@@ -247,17 +246,8 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
         bail!("--repeats must be at least 1");
     }
     let t0 = Instant::now();
-    let mut scene = load_scene(&a.scene)?;
-    let timeline = load_path(&a.path, &scene, a.fps)?;
     // Every bake and rival below sees the scene as the default settings record it.
-    let from = format!("path {}", a.path);
-    working_scene(
-        &mut scene,
-        &a.scene,
-        &timeline.frames,
-        &from,
-        &RecordSettings::default(),
-    )?;
+    let (scene, timeline, _) = load_working(&a.scene, &a.path, a.fps, &RecordSettings::default())?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let gpu = crate::common::open_gpu()?;
     let n = timeline.frames.len() as u32;
