@@ -110,6 +110,8 @@ fn rebuild(glb: &Path, baked: &Baked, order: &Order) -> Rebuilt {
                 uv: uvs[c],
                 material,
                 node,
+                tangent: [0.0; 4],
+                uv1: [0.0; 2],
             });
         }
     }

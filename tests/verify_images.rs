@@ -398,6 +398,8 @@ fn sub_pixel_texture_alpha_verifies_in_every_mode() {
         width: n,
         height: n,
         rgba8,
+        srgb: true,
+        mips: Vec::new(),
     };
     let textured = |mode| Material {
         base_color: [1.0, 1.0, 1.0, 1.0],

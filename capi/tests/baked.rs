@@ -32,6 +32,8 @@ fn sample() -> Baked {
         width: 2,
         height: 1,
         rgba8: vec![1, 2, 3, 4, 5, 6, 7, 8],
+        srgb: true,
+        mips: Vec::new(),
     });
     let copies = vec![0, 1, 2, 3, 4, 5, 6, 7, 2, 3];
     let draw = |first: u32, count: u32| DrawIndexedIndirectArgs {
@@ -64,6 +66,7 @@ fn sample() -> Baked {
         ],
         removed_edges: vec![vec![], vec![]],
         fps: None,
+        environment: trisort_format::Environment::uniform(1.0),
     }
 }
 

@@ -142,6 +142,8 @@ pub struct Baked {
     ///
     /// [`Recording::fps`]: crate::Recording::fps
     pub fps: Option<f64>,
+    /// The light the file is shaded with (the built-in studio unless the bake chose another).
+    pub environment: crate::Environment,
 }
 
 /// Checks a stored frame rate: absent, or finite and positive (a player divides by it).
@@ -218,6 +220,7 @@ impl Baked {
         for (f, s) in self.frame_states.iter().enumerate() {
             crate::camera::check_frame_state(f, s, Some(g.nodes.len()))?;
         }
+        self.environment.check_structure()?;
         check_fps(self.fps)
     }
 }

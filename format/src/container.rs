@@ -34,8 +34,11 @@ use serde::Serialize;
 /// the recording is ([`crate::Robust`]), and (before any release of 3) [`crate::Geometry`]
 /// its material variants and [`crate::Recording`] and [`crate::Baked`] the path's fps. Files
 /// of version 3 written before those two fields fail to decode with a "record or merge it
-/// again" message (the checksum matches, the layout does not).
-pub const FORMAT_VERSION: u32 = 3;
+/// again" message (the checksum matches, the layout does not); 4, physically based
+/// materials ([`crate::TextureSlot`]s, metallic-roughness, clearcoat), vertex tangents and a
+/// second texture coordinate, texture colour spaces and mip chains, and the baked file's
+/// [`crate::Environment`].
+pub const FORMAT_VERSION: u32 = 4;
 
 /// Decompressed payloads larger than this are refused (16 GiB).
 pub const MAX_PAYLOAD: u64 = 16 << 30;
@@ -388,14 +391,14 @@ mod tests {
         assert!(matches!(
             err,
             FormatError::Version {
-                found: 2,
-                supported: 3,
+                found: 3,
+                supported: 4,
                 ..
             }
         ));
         assert_eq!(
             err.to_string(),
-            "old.baked: format version 2 is not supported (this trisort reads version 3); \
+            "old.baked: format version 3 is not supported (this trisort reads version 4); \
              record or merge it again with this trisort"
         );
     }

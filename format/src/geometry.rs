@@ -22,6 +22,13 @@ pub struct Vertex {
     pub material: u32,
     /// Index into [`Geometry::nodes`].
     pub node: u32,
+    /// Tangent in the node's local space (xyz, unit) and handedness (w, ±1): the bitangent is
+    /// `cross(normal, tangent.xyz) * tangent.w`. From the file's TANGENT, else generated
+    /// (MikkTSpace) for materials with a normal texture; zero where there is none.
+    pub tangent: [f32; 4],
+    /// Second texture coordinate (TEXCOORD_1), for texture slots whose `tex_coord` is 1; zero
+    /// where the source has none.
+    pub uv1: [f32; 2],
 }
 
 /// How a material's alpha is interpreted (glTF `alphaMode`).
@@ -36,7 +43,62 @@ pub enum AlphaMode {
     Blend,
 }
 
-/// A material: the subset of glTF's metallic-roughness model that trisort renders.
+/// `KHR_texture_transform` of one texture reference: `uv' = T(offset) · R(rotation) ·
+/// S(scale) · uv`, as the extension defines it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TextureTransform {
+    /// Translation, in uv units.
+    pub offset: [f32; 2],
+    /// Rotation in radians, counter-clockwise in uv space.
+    pub rotation: f32,
+    /// Scale.
+    pub scale: [f32; 2],
+}
+
+impl Default for TextureTransform {
+    fn default() -> Self {
+        TextureTransform {
+            offset: [0.0; 2],
+            rotation: 0.0,
+            scale: [1.0; 2],
+        }
+    }
+}
+
+impl TextureTransform {
+    /// The transform as the 2×3 matrix the shaders use, row-major: `u' = m[0]·(u, v, 1)`,
+    /// `v' = m[1]·(u, v, 1)`.
+    pub fn matrix(&self) -> [[f32; 3]; 2] {
+        let (s, c) = self.rotation.sin_cos();
+        let [sx, sy] = self.scale;
+        let [ox, oy] = self.offset;
+        [[c * sx, s * sy, ox], [-s * sx, c * sy, oy]]
+    }
+
+    /// Whether every value is finite.
+    pub fn is_finite(&self) -> bool {
+        self.offset
+            .iter()
+            .chain(&self.scale)
+            .chain([&self.rotation])
+            .all(|x| x.is_finite())
+    }
+}
+
+/// A material's reference to a texture other than its base colour: which texture, which
+/// texture coordinate set, and its transform.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TextureSlot {
+    /// Index into [`Geometry::textures`].
+    pub texture: u32,
+    /// Texture coordinate set: 0 ([`Vertex::uv`]) or 1 ([`Vertex::uv1`]).
+    pub tex_coord: u32,
+    /// `KHR_texture_transform`.
+    pub transform: TextureTransform,
+}
+
+/// A material: glTF's metallic-roughness model with the extensions trisort renders
+/// (clearcoat, emissive strength, transmission, texture transforms).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Material {
     /// Name from the source file (may be empty).
@@ -57,6 +119,31 @@ pub struct Material {
     /// `KHR_materials_transmission` factor: 0 for ordinary materials, > 0 for glass. Glass is
     /// recorded at the recording's glass opacity instead of its alpha.
     pub transmission: f32,
+    /// Texture coordinate set (0 or 1) of the base-colour texture.
+    pub base_color_tex_coord: u32,
+    /// `KHR_texture_transform` of the base-colour texture (it moves the alpha that MASK and
+    /// BLEND materials are recorded with, too).
+    pub base_color_transform: TextureTransform,
+    /// Metallic factor (glTF default 1).
+    pub metallic: f32,
+    /// Perceptual roughness factor (glTF default 1).
+    pub roughness: f32,
+    /// Metallic-roughness texture (linear; blue: metallic, green: roughness).
+    pub metallic_roughness_texture: Option<TextureSlot>,
+    /// Tangent-space normal texture (linear).
+    pub normal_texture: Option<TextureSlot>,
+    /// Scale of the normal texture's x and y (glTF `normalTexture.scale`, default 1).
+    pub normal_scale: f32,
+    /// Ambient occlusion texture (linear, red channel).
+    pub occlusion_texture: Option<TextureSlot>,
+    /// Strength of the occlusion texture (glTF `occlusionTexture.strength`, default 1).
+    pub occlusion_strength: f32,
+    /// Emissive texture (sRGB), multiplied by [`Material::emissive`].
+    pub emissive_texture: Option<TextureSlot>,
+    /// `KHR_materials_clearcoat` layer intensity (0: no clearcoat).
+    pub clearcoat: f32,
+    /// `KHR_materials_clearcoat` layer roughness.
+    pub clearcoat_roughness: f32,
 }
 
 impl Default for Material {
@@ -70,6 +157,18 @@ impl Default for Material {
             double_sided: false,
             emissive: [0.0; 3],
             transmission: 0.0,
+            base_color_tex_coord: 0,
+            base_color_transform: TextureTransform::default(),
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            occlusion_texture: None,
+            occlusion_strength: 1.0,
+            emissive_texture: None,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
         }
     }
 }
@@ -90,7 +189,7 @@ impl Material {
     }
 }
 
-/// A decoded texture: tightly packed RGBA8, rows top to bottom, colour in sRGB encoding.
+/// A decoded texture: tightly packed RGBA8, rows top to bottom, with its mip chain.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Texture {
     /// Name (image name or URI from the source file; may be empty).
@@ -101,6 +200,13 @@ pub struct Texture {
     pub height: u32,
     /// `width * height * 4` bytes.
     pub rgba8: Vec<u8>,
+    /// Whether the colour channels are sRGB-encoded (base colour, emissive) rather than
+    /// linear data (metallic-roughness, normal, occlusion). An image the file uses both ways
+    /// is stored twice.
+    pub srgb: bool,
+    /// Mip levels 1, 2, … down to 1×1 (level k is `max(1, width >> k)` ×
+    /// `max(1, height >> k)`, RGBA8), generated at import; empty for a texture without mips.
+    pub mips: Vec<Vec<u8>>,
 }
 
 /// A node of the scene hierarchy.
@@ -401,6 +507,8 @@ mod tests {
             width: 2,
             height: 1,
             rgba8: vec![rgb, rgb, rgb, alpha, 0, 0, 0, 255],
+            srgb: true,
+            mips: Vec::new(),
         };
         let masked = |name: &str, t: u32| Material {
             base_color_texture: Some(t),

@@ -15,6 +15,7 @@
 pub mod baked;
 pub mod camera;
 pub mod container;
+pub mod environment;
 pub mod geometry;
 pub mod options;
 pub mod recording;
@@ -24,8 +25,10 @@ pub use camera::{world_transforms, Camera, FrameState, NodePose};
 #[cfg(not(target_arch = "wasm32"))]
 pub use container::write_file_atomic;
 pub use container::{read_file, FileKind, FormatError, FORMAT_VERSION};
+pub use environment::{Environment, Sun};
 pub use geometry::{
-    AlphaMode, Geometry, Material, MaterialVariant, Node, Texture, VariantError, Vertex,
+    AlphaMode, Geometry, Material, MaterialVariant, Node, Texture, TextureSlot, TextureTransform,
+    VariantError, Vertex,
 };
 pub use options::{
     Bridge, Choice, Choosable, DeviceBackend, DeviceLimits, Layout, Mode, OptionValue,

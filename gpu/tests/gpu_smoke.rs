@@ -13,6 +13,8 @@ fn vertex(x: f32, y: f32) -> Vertex {
         uv: [0.0; 2],
         material: 0,
         node: 0,
+        tangent: [0.0; 4],
+        uv1: [0.0; 2],
     }
 }
 

@@ -384,9 +384,9 @@ pub(crate) fn cut_triangle(source: &Source, cuts: &[Cut]) -> Pieces {
 }
 
 /// The vertex at `b` of the triangle with vertices `v`: position from
-/// [`Source::position`], normal and uv interpolated with the same weights (the normal
-/// renormalised; both kept bit for bit when the three corners agree), material and node
-/// kept.
+/// [`Source::position`], normal, tangent and both uvs interpolated with the same weights
+/// (normal and tangent renormalised; each kept bit for bit when the three corners agree),
+/// material and node kept.
 pub(crate) fn interpolate(source: &Source, v: [&Vertex; 3], b: &Bary) -> Vertex {
     let weights = || (0..3).filter(|&i| b.0[i] != 0.0).map(|i| (i, b.0[i]));
     let normal = if v[0].normal == v[1].normal && v[0].normal == v[2].normal {
@@ -402,22 +402,45 @@ pub(crate) fn interpolate(source: &Source, v: [&Vertex; 3], b: &Bary) -> Vertex 
             n.as_vec3().to_array()
         }
     };
-    let uv = if v[0].uv == v[1].uv && v[0].uv == v[2].uv {
-        v[0].uv
-    } else {
-        let mut uv = [0.0f64; 2];
-        for (i, w) in weights() {
-            uv[0] += f64::from(v[i].uv[0]) * w;
-            uv[1] += f64::from(v[i].uv[1]) * w;
+    // Per-vertex attributes, interpolated in f64 (kept exactly where the corners agree).
+    fn lerp<const N: usize>(
+        v: &[&Vertex; 3],
+        weights: impl Iterator<Item = (usize, f64)>,
+        get: impl Fn(&Vertex) -> [f32; N],
+    ) -> [f32; N] {
+        if get(v[0]) == get(v[1]) && get(v[0]) == get(v[2]) {
+            return get(v[0]);
         }
-        uv.map(|x| x as f32)
+        let mut out = [0.0f64; N];
+        for (i, w) in weights {
+            for (o, x) in out.iter_mut().zip(get(v[i])) {
+                *o += f64::from(x) * w;
+            }
+        }
+        out.map(|x| x as f32)
+    }
+    let uv = lerp(&v, weights(), |v| v.uv);
+    let uv1 = lerp(&v, weights(), |v| v.uv1);
+    // The tangent's direction is interpolated and renormalised; its handedness is the first
+    // corner's (a triangle's corners share one in any file that mirrors UVs per triangle).
+    let t = lerp(&v, weights(), |v| {
+        [v.tangent[0], v.tangent[1], v.tangent[2]]
+    });
+    let t = glam::Vec3::from(t);
+    let t = if t.length() > 0.0 && t.is_finite() {
+        t.normalize()
+    } else {
+        t
     };
+    let tangent = [t.x, t.y, t.z, v[0].tangent[3]];
     Vertex {
         position: source.position(b),
         normal,
         uv,
         material: v[0].material,
         node: v[0].node,
+        tangent,
+        uv1,
     }
 }
 

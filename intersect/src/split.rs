@@ -434,7 +434,7 @@ fn assemble(
     let mut triangles = Vec::with_capacity(geometry.triangles.len());
     let mut origin = Vec::with_capacity(geometry.triangles.len());
     let mut split = vec![false; geometry.triangles.len()];
-    let mut index_of: HashMap<[u32; 10], u32> = HashMap::new();
+    let mut index_of: HashMap<[u32; std::mem::size_of::<Vertex>() / 4], u32> = HashMap::new();
     let mut next = changed.iter().zip(outcomes).peekable();
     for (t, &tri) in geometry.triangles.iter().enumerate() {
         let pieces = match next.peek() {

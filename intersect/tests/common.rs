@@ -64,6 +64,8 @@ fn push_corners(g: &mut Geometry, corners: &[[f32; 3]], node: u32, material: u32
             uv: uv_at(position),
             material,
             node,
+            tangent: [0.0; 4],
+            uv1: [0.0; 2],
         });
     }
     base
@@ -298,6 +300,8 @@ pub fn grid(
                 uv: uv_at(position),
                 material,
                 node,
+                tangent: [0.0; 4],
+                uv1: [0.0; 2],
             });
         }
     }

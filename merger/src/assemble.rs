@@ -102,6 +102,7 @@ impl Assembled {
             frame_states: first.frame_states.clone(),
             removed_edges,
             fps: first.fps,
+            environment: trisort_format::Environment::uniform(1.0),
         }
     }
 }

@@ -83,6 +83,8 @@ pub fn recording_from_frames(scene_triangles: u32, frames: &[FrameSpec]) -> Reco
             uv: [0.0; 2],
             material: 0,
             node: 0,
+            tangent: [0.0; 4],
+            uv1: [0.0; 2],
         })
         .collect();
     let geometry = Geometry {

@@ -143,6 +143,8 @@ mod tests {
             uv: [0.0; 2],
             material: 0,
             node: 0,
+            tangent: [0.0; 4],
+            uv1: [0.0; 2],
         };
         let geometry = Geometry {
             vertices: vec![v; 15],
@@ -177,6 +179,7 @@ mod tests {
             frame_states: vec![],
             removed_edges: vec![],
             fps: None,
+            environment: trisort_format::Environment::uniform(1.0),
         }
     }
 

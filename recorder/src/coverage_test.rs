@@ -51,6 +51,8 @@ fn edge_case_scene() -> Geometry {
                 uv: [0.0; 2],
                 material: 0,
                 node: 0,
+                tangent: [0.0; 4],
+                uv1: [0.0; 2],
             });
         }
         g.triangles.push([base, base + 1, base + 2]);

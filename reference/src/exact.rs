@@ -260,6 +260,7 @@ pub fn whole_scene_baked(
         frame_states: frames.to_vec(),
         removed_edges: vec![vec![]; frames.len()],
         fps: None,
+        environment: trisort_format::Environment::uniform(1.0),
     }
 }
 

@@ -97,6 +97,8 @@ fn soup(n: u32, seed: u64) -> Geometry {
                     uv: [0.0; 2],
                     material,
                     node: 0,
+                    tangent: [0.0; 4],
+                    uv1: [0.0; 2],
                 });
             }
         }

@@ -45,6 +45,8 @@ pub fn quad(g: &mut Geometry, x0: f32, x1: f32, y0: f32, y1: f32, z0: f32, z1: f
             uv: [0.0; 2],
             material,
             node: 0,
+            tangent: [0.0; 4],
+            uv1: [0.0; 2],
         });
     }
     g.triangles.push([base, base + 1, base + 2]);
@@ -76,6 +78,8 @@ pub fn tri(g: &mut Geometry, corners: [[f32; 3]; 3], material: u32) {
             uv: [0.0; 2],
             material,
             node: 0,
+            tangent: [0.0; 4],
+            uv1: [0.0; 2],
         });
     }
     g.triangles.push([base, base + 1, base + 2]);

@@ -19,6 +19,8 @@ fn geometry(n: u32) -> Geometry {
                 uv: [0.0; 2],
                 material: 0,
                 node: 0,
+                tangent: [0.0; 4],
+                uv1: [0.0; 2],
             })
             .collect(),
         triangles: (0..n).map(|k| [k, k + 1, k + 2]).collect(),
@@ -143,6 +145,7 @@ fn baked(
         frame_states: rec.frame_states.clone(),
         removed_edges: vec![vec![], vec![]],
         fps: rec.fps,
+        environment: trisort_format::Environment::uniform(1.0),
     };
     restat(&mut b, rec);
     b

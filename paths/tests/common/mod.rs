@@ -38,6 +38,8 @@ pub fn scene_with_boxes(nodes: Vec<Node>, boxes: &[(u32, DVec3, DVec3)]) -> Scen
                 uv: [0.0; 2],
                 material: 0,
                 node,
+                tangent: [0.0; 4],
+                uv1: [0.0; 2],
             });
         }
         for [a, b, c] in [

@@ -103,6 +103,7 @@ pub fn quads() -> Baked {
         frame_states: vec![frame_state(); frames],
         removed_edges: vec![vec![]; frames],
         fps: None,
+        environment: trisort_format::Environment::uniform(1.0),
     }
 }
 
@@ -202,6 +203,8 @@ fn back_quad(g: &mut Geometry, x0: f32, y0: f32, x1: f32, y1: f32, z: f32, mater
             uv: [(x - x0) / (x1 - x0), (y - y0) / (y1 - y0)],
             material,
             node: 0,
+            tangent: [0.0; 4],
+            uv1: [0.0; 2],
         });
     }
     g.triangles.push([base, base + 1, base + 2]);
@@ -240,6 +243,8 @@ pub fn faces() -> Baked {
             width: 2,
             height: 1,
             rgba8: vec![255, 255, 255, 255, 255, 255, 255, 0],
+            srgb: true,
+            mips: Vec::new(),
         }],
         nodes: b.geometry.nodes.clone(),
         ..Default::default()
@@ -256,6 +261,8 @@ pub fn faces() -> Baked {
             uv: [(x - x0) / (x1 - x0), (y - y0) / (y1 - y0)],
             material: 2,
             node: 0,
+            tangent: [0.0; 4],
+            uv1: [0.0; 2],
         });
     }
     g.triangles.push([base, base + 1, base + 2]);

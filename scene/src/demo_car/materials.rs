@@ -69,5 +69,7 @@ pub(super) fn plate_texture() -> Texture {
         width: W as u32,
         height: H as u32,
         rgba8,
+        srgb: true,
+        mips: Vec::new(),
     }
 }

@@ -58,6 +58,8 @@ impl PartMesh {
                 uv,
                 material: s.material,
                 node: s.node,
+                tangent: [0.0; 4],
+                uv1: [0.0; 2],
             });
         }
         geometry

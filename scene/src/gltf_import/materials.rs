@@ -159,6 +159,7 @@ impl Importer<'_> {
             double_sided: m.double_sided(),
             emissive: m.emissive_factor().map(|c| c * strength),
             transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
+            ..Material::default()
         };
         Ok((material, set))
     }
@@ -207,6 +208,8 @@ impl Importer<'_> {
             width: decoded.width(),
             height: decoded.height(),
             rgba8: decoded.into_raw(),
+            srgb: true,
+            mips: Vec::new(),
         })
     }
 

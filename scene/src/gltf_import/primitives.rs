@@ -333,6 +333,8 @@ fn instance(
         uv: data.uvs.as_ref().map_or([0.0; 2], |uv| uv[i as usize]),
         material: data.material,
         node,
+        tangent: [0.0; 4],
+        uv1: [0.0; 2],
     };
     let order = |t: [u32; 3]| if flip { [t[0], t[2], t[1]] } else { t };
     match &data.normals {
