@@ -209,6 +209,156 @@ pub struct Texture {
     pub mips: Vec<Vec<u8>>,
 }
 
+impl Texture {
+    /// The largest width or height [`Texture::with_mips`] stores by default: a bigger image is
+    /// stored from its first mip level that fits.
+    pub const MAX_SIZE: u32 = 1024;
+
+    /// Width and height of mip level `level` of a `width` × `height` image:
+    /// `max(1, width >> level)` × `max(1, height >> level)`.
+    pub fn level_size(width: u32, height: u32, level: u32) -> (u32, u32) {
+        let shrink = |x: u32| x.checked_shr(level).unwrap_or(0).max(1);
+        (shrink(width), shrink(height))
+    }
+
+    /// The number of levels below level 0 of a full chain down to 1×1 (0 for a 1×1 image).
+    pub fn mip_count(width: u32, height: u32) -> usize {
+        let largest = width.max(height).max(1);
+        (u32::BITS - 1 - largest.leading_zeros()) as usize
+    }
+
+    /// Bytes of level 0 and every stored mip level.
+    pub fn byte_len(&self) -> u64 {
+        self.rgba8.len() as u64 + self.mips.iter().map(|m| m.len() as u64).sum::<u64>()
+    }
+
+    /// A texture from a decoded `width` × `height` RGBA8 image (rows top to bottom), with its
+    /// full mip chain ([`Texture::mips`]). Each level is a box filter of the one above it:
+    /// texel `(x, y)` averages the texels of the level above that its footprint overlaps (2×2,
+    /// or 3 along an odd dimension, 1 along a dimension of size 1), with equal weights. For an
+    /// `srgb` texture the colour channels are decoded to linear light, averaged and encoded
+    /// again (black and white average to 188, not 128); alpha, and every channel of a linear
+    /// texture, is averaged as stored. Rounds to nearest.
+    ///
+    /// An image wider or taller than `max_size` is stored from its first mip level that fits
+    /// (levels above it are computed and dropped); the second value returned is that level
+    /// (0 when it fits). `rgba8` must hold `width * height * 4` bytes and both sizes must be at
+    /// least 1, else this panics.
+    pub fn with_mips(
+        name: String,
+        width: u32,
+        height: u32,
+        rgba8: Vec<u8>,
+        srgb: bool,
+        max_size: u32,
+    ) -> (Texture, u32) {
+        assert!(width > 0 && height > 0, "an empty image has no mips");
+        assert_eq!(
+            rgba8.len() as u64,
+            width as u64 * height as u64 * 4,
+            "RGBA8 byte count of a {width}x{height} image"
+        );
+        let max_size = max_size.max(1);
+        let (mut w, mut h, mut level0) = (width, height, rgba8);
+        let mut dropped = 0;
+        while w > max_size || h > max_size {
+            let (nw, nh) = Texture::level_size(w, h, 1);
+            level0 = downsample(&level0, w, h, nw, nh, srgb);
+            (w, h) = (nw, nh);
+            dropped += 1;
+        }
+        let mut mips: Vec<Vec<u8>> = Vec::with_capacity(Texture::mip_count(w, h));
+        let (mut lw, mut lh) = (w, h);
+        for _ in 0..Texture::mip_count(w, h) {
+            let (nw, nh) = Texture::level_size(lw, lh, 1);
+            let above = mips.last().unwrap_or(&level0);
+            let next = downsample(above, lw, lh, nw, nh, srgb);
+            mips.push(next);
+            (lw, lh) = (nw, nh);
+        }
+        let texture = Texture {
+            name,
+            width: w,
+            height: h,
+            rgba8: level0,
+            srgb,
+            mips,
+        };
+        (texture, dropped)
+    }
+}
+
+/// sRGB-encoded byte to linear light.
+fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Linear light in [0, 1] to the nearest sRGB-encoded byte.
+fn linear_to_srgb(l: f32) -> u8 {
+    let l = l.clamp(0.0, 1.0);
+    let c = if l <= 0.0031308 {
+        l * 12.92
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    };
+    (c * 255.0).round() as u8
+}
+
+/// The `[start, end)` texels of a source dimension of `from` texels that dest texel `i` of
+/// `to` overlaps.
+fn footprint(i: u32, from: u32, to: u32) -> (usize, usize) {
+    let start = (i as u64 * from as u64) / to as u64;
+    let end = ((i as u64 + 1) * from as u64).div_ceil(to as u64);
+    (start as usize, end as usize)
+}
+
+/// One box-filtered level (see [`Texture::with_mips`]).
+fn downsample(src: &[u8], w: u32, h: u32, nw: u32, nh: u32, srgb: bool) -> Vec<u8> {
+    let decode: Vec<f32> = (0..=255u8)
+        .map(|c| {
+            if srgb {
+                srgb_to_linear(c)
+            } else {
+                c as f32 / 255.0
+            }
+        })
+        .collect();
+    let mut out = Vec::with_capacity(nw as usize * nh as usize * 4);
+    for y in 0..nh {
+        let (y0, y1) = footprint(y, h, nh);
+        for x in 0..nw {
+            let (x0, x1) = footprint(x, w, nw);
+            let mut sum = [0f32; 4];
+            for sy in y0..y1 {
+                let row = &src[sy * w as usize * 4..];
+                for sx in x0..x1 {
+                    let p = &row[sx * 4..sx * 4 + 4];
+                    for c in 0..3 {
+                        sum[c] += decode[p[c] as usize];
+                    }
+                    sum[3] += p[3] as f32;
+                }
+            }
+            let n = ((y1 - y0) * (x1 - x0)) as f32;
+            for c in sum.iter().take(3) {
+                let v = c / n;
+                out.push(if srgb {
+                    linear_to_srgb(v)
+                } else {
+                    (v * 255.0).round().clamp(0.0, 255.0) as u8
+                });
+            }
+            out.push((sum[3] / n).round().clamp(0.0, 255.0) as u8);
+        }
+    }
+    out
+}
+
 /// A node of the scene hierarchy.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Node {
@@ -307,7 +457,9 @@ impl Geometry {
 
     /// Checks the structural consistency a reader relies on before using the geometry:
     /// triangle vertices in range, vertex materials and nodes in range, finite positions,
-    /// finite material factors, textures present with the right byte count, parents before
+    /// finite material factors and texture transforms, every texture slot naming an existing
+    /// texture and texture coordinate set 0 or 1, every texture non-empty with the right byte
+    /// count for level 0 and each mip level (no mips, or the full chain), parents before
     /// children, finite rest transforms, variants mapping every material slot to an existing
     /// material. Returns the first problem found.
     pub fn check_structure(&self) -> Result<(), String> {
@@ -326,20 +478,88 @@ impl Geometry {
             }
         }
         for (k, m) in self.materials.iter().enumerate() {
-            let factors = m
-                .base_color
-                .iter()
-                .chain(&m.emissive)
-                .chain([&m.alpha_cutoff, &m.transmission]);
+            let factors = (m.base_color.iter().chain(&m.emissive)).chain([
+                &m.alpha_cutoff,
+                &m.transmission,
+                &m.metallic,
+                &m.roughness,
+                &m.normal_scale,
+                &m.occlusion_strength,
+                &m.clearcoat,
+                &m.clearcoat_roughness,
+            ]);
             if !factors.into_iter().all(|x| x.is_finite()) {
                 return Err(format!("material {k} has a non-finite factor"));
             }
-            if let Some(t) = m.base_color_texture {
-                let Some(tex) = self.textures.get(t as usize) else {
-                    return Err(format!("material {k} refers to missing texture {t}"));
-                };
-                if tex.rgba8.len() as u64 != tex.width as u64 * tex.height as u64 * 4 {
-                    return Err(format!("texture {t} has the wrong number of bytes"));
+            let base = m.base_color_texture.map(|texture| TextureSlot {
+                texture,
+                tex_coord: m.base_color_tex_coord,
+                transform: m.base_color_transform,
+            });
+            let slots = [
+                ("base-colour", base),
+                ("metallic-roughness", m.metallic_roughness_texture),
+                ("normal", m.normal_texture),
+                ("occlusion", m.occlusion_texture),
+                ("emissive", m.emissive_texture),
+            ];
+            for (what, slot) in slots {
+                let Some(slot) = slot else { continue };
+                let t = slot.texture;
+                if t as usize >= self.textures.len() {
+                    return Err(format!(
+                        "material {k}'s {what} texture refers to missing texture {t}"
+                    ));
+                }
+                if slot.tex_coord > 1 {
+                    return Err(format!(
+                        "material {k}'s {what} texture samples texture coordinate set {} \
+                         (only 0 and 1 exist)",
+                        slot.tex_coord
+                    ));
+                }
+                if !slot.transform.is_finite() {
+                    return Err(format!(
+                        "material {k}'s {what} texture transform is not finite"
+                    ));
+                }
+            }
+            if m.base_color_tex_coord > 1 {
+                return Err(format!(
+                    "material {k}'s base-colour texture coordinate set {} does not exist \
+                     (only 0 and 1 do)",
+                    m.base_color_tex_coord
+                ));
+            }
+        }
+        for (t, tex) in self.textures.iter().enumerate() {
+            if tex.width == 0 || tex.height == 0 {
+                return Err(format!(
+                    "texture {t} is empty ({}x{})",
+                    tex.width, tex.height
+                ));
+            }
+            if tex.rgba8.len() as u64 != tex.width as u64 * tex.height as u64 * 4 {
+                return Err(format!("texture {t} has the wrong number of bytes"));
+            }
+            let levels = Texture::mip_count(tex.width, tex.height);
+            if !tex.mips.is_empty() && tex.mips.len() != levels {
+                return Err(format!(
+                    "texture {t} ({}x{}) has {} mip levels, a full chain has {levels}",
+                    tex.width,
+                    tex.height,
+                    tex.mips.len()
+                ));
+            }
+            for (k, mip) in tex.mips.iter().enumerate() {
+                let (w, h) = Texture::level_size(tex.width, tex.height, k as u32 + 1);
+                if mip.len() as u64 != w as u64 * h as u64 * 4 {
+                    return Err(format!(
+                        "texture {t}'s mip level {} has {} bytes, {w}x{h} RGBA8 needs {}",
+                        k + 1,
+                        mip.len(),
+                        w as u64 * h as u64 * 4
+                    ));
                 }
             }
         }
@@ -406,8 +626,9 @@ impl Geometry {
     /// what slot k shows. Refused when the variant is unknown, or when it changes anything
     /// that decides which samples a triangle covers or how opaque it is, for any slot: alpha
     /// mode, double-sidedness, transmission, and for non-glass `Mask` materials the cutoff,
-    /// and for non-glass `Mask` and `Blend` materials the alpha factor and the base-colour
-    /// texture's alpha channel. Colour, emissive and opaque textures may change freely.
+    /// and for non-glass `Mask` and `Blend` materials the alpha factor, the base-colour
+    /// texture's alpha channel, and (where that alpha is not 255 everywhere) the base-colour
+    /// texture coordinate set and transform. Colour, emissive and opaque textures may change freely.
     pub fn variant_materials(&self, name: Option<&str>) -> Result<Vec<Material>, VariantError> {
         let Some(name) = name else {
             return Ok(self.materials.clone());
@@ -460,7 +681,27 @@ impl Geometry {
         if !self.same_texture_alpha(a.base_color_texture, b.base_color_texture) {
             return Some("base-colour texture's alpha");
         }
+        // Where the alpha varies, the coordinates it is sampled at move it.
+        if self.texture_alpha_varies(a.base_color_texture)
+            || self.texture_alpha_varies(b.base_color_texture)
+        {
+            if a.base_color_tex_coord != b.base_color_tex_coord {
+                return Some("base-colour texture coordinate set (it moves the alpha)");
+            }
+            let bits = |t: &TextureTransform| {
+                [t.offset[0], t.offset[1], t.rotation, t.scale[0], t.scale[1]].map(f32::to_bits)
+            };
+            if bits(&a.base_color_transform) != bits(&b.base_color_transform) {
+                return Some("base-colour texture transform (it moves the alpha)");
+            }
+        }
         None
+    }
+
+    /// Whether texture `t` exists and has a texel with alpha below 255.
+    fn texture_alpha_varies(&self, t: Option<u32>) -> bool {
+        t.and_then(|t| self.textures.get(t as usize))
+            .is_some_and(|t| t.rgba8.iter().skip(3).step_by(4).any(|&a| a != 255))
     }
 
     /// Whether two base-colour textures (or none, alpha 1) give the same alpha everywhere.
@@ -624,5 +865,240 @@ mod tests {
             .check_structure()
             .unwrap_err()
             .contains("missing material 9"));
+    }
+
+    fn image(w: u32, h: u32) -> Vec<u8> {
+        (0..w * h * 4).map(|i| (i * 37 % 251) as u8).collect()
+    }
+
+    #[test]
+    fn mip_chains_halve_each_dimension_down_to_one_texel() {
+        for (w, h, levels) in [
+            (1, 1, 0),
+            (2, 2, 1),
+            (5, 3, 2),
+            (7, 7, 2),
+            (8, 2, 3),
+            (1, 9, 3),
+            (13, 1, 3),
+            (1024, 3, 10),
+        ] {
+            let (t, dropped) = Texture::with_mips("t".into(), w, h, image(w, h), true, 1024);
+            assert_eq!(dropped, 0);
+            assert_eq!((t.width, t.height), (w, h));
+            assert_eq!(t.mips.len(), levels, "{w}x{h}");
+            for (k, mip) in t.mips.iter().enumerate() {
+                let (lw, lh) = Texture::level_size(w, h, k as u32 + 1);
+                assert_eq!((lw, lh), ((w >> (k + 1)).max(1), (h >> (k + 1)).max(1)));
+                assert_eq!(mip.len() as u32, lw * lh * 4, "{w}x{h} level {}", k + 1);
+            }
+            assert_eq!(t.mips.last().map_or(4, |m| m.len()), 4, "ends at 1x1");
+            let g = Geometry {
+                textures: vec![t],
+                ..Geometry::default()
+            };
+            g.check_structure().unwrap();
+        }
+    }
+
+    #[test]
+    fn srgb_mips_average_light_and_linear_ones_bytes() {
+        // Black and white texels with alpha 0 and 255.
+        let px = vec![0, 0, 0, 0, 255, 255, 255, 255];
+        let (srgb, _) = Texture::with_mips(String::new(), 2, 1, px.clone(), true, 1024);
+        assert_eq!(srgb.mips, vec![vec![188, 188, 188, 128]]);
+        let (linear, _) = Texture::with_mips(String::new(), 2, 1, px, false, 1024);
+        assert_eq!(linear.mips, vec![vec![128, 128, 128, 128]]);
+        // An odd row of three averages all three: 0, 0 and 255 give a third of the light.
+        let (odd, _) = Texture::with_mips(
+            String::new(),
+            3,
+            1,
+            vec![0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255, 255],
+            true,
+            1024,
+        );
+        // linear 1/3 -> sRGB 0.6134 -> 156.4
+        assert_eq!(odd.mips, vec![vec![156, 156, 156, 255]]);
+        // A uniform image stays uniform at every level.
+        let (flat, _) = Texture::with_mips(
+            String::new(),
+            6,
+            5,
+            [90u8, 20, 200, 77].repeat(30),
+            true,
+            1024,
+        );
+        assert!(flat
+            .mips
+            .iter()
+            .flatten()
+            .collect::<Vec<_>>()
+            .chunks(4)
+            .all(|p| *p[0] == 90 && *p[1] == 20 && *p[2] == 200 && *p[3] == 77));
+    }
+
+    #[test]
+    fn images_larger_than_the_cap_are_stored_from_the_first_level_that_fits() {
+        let (t, dropped) = Texture::with_mips("big".into(), 20, 6, image(20, 6), false, 4);
+        assert_eq!(dropped, 3);
+        assert_eq!((t.width, t.height), (2, 1));
+        assert_eq!(t.rgba8.len(), 2 * 4);
+        assert_eq!(t.mips.len(), 1);
+        // Level 0 as stored is what the full chain's level 3 would be.
+        let (chain, _) = Texture::with_mips(String::new(), 20, 6, image(20, 6), false, 1024);
+        assert_eq!(t.rgba8, chain.mips[2]);
+        assert_eq!(t.mips[0], chain.mips[3]);
+        let (fits, dropped) = Texture::with_mips("edge".into(), 4, 4, image(4, 4), false, 4);
+        assert_eq!((dropped, fits.width), (0, 4));
+        assert_eq!(fits.byte_len(), 4 * 4 * 4 + 2 * 2 * 4 + 4);
+    }
+
+    /// A valid geometry with one textured material using every slot.
+    fn textured() -> Geometry {
+        let (t, _) = Texture::with_mips("t".into(), 4, 2, image(4, 2), true, 1024);
+        let slot = TextureSlot {
+            texture: 0,
+            tex_coord: 1,
+            transform: TextureTransform::default(),
+        };
+        Geometry {
+            materials: vec![Material {
+                base_color_texture: Some(0),
+                metallic_roughness_texture: Some(slot),
+                normal_texture: Some(slot),
+                occlusion_texture: Some(slot),
+                emissive_texture: Some(slot),
+                ..Material::default()
+            }],
+            textures: vec![t],
+            ..Geometry::default()
+        }
+    }
+
+    #[test]
+    fn check_structure_refuses_bad_texture_slots_factors_and_mips() {
+        textured().check_structure().unwrap();
+        type Edit = fn(&mut Geometry);
+        let cases: Vec<(Edit, &str)> = vec![
+            (
+                |g| g.materials[0].base_color_texture = Some(1),
+                "base-colour texture refers to missing texture 1",
+            ),
+            (
+                |g| g.materials[0].normal_texture.as_mut().unwrap().texture = 3,
+                "normal texture refers to missing texture 3",
+            ),
+            (
+                |g| g.materials[0].occlusion_texture.as_mut().unwrap().tex_coord = 2,
+                "occlusion texture samples texture coordinate set 2",
+            ),
+            (
+                |g| g.materials[0].base_color_tex_coord = 2,
+                "base-colour texture samples texture coordinate set 2",
+            ),
+            (
+                |g| {
+                    g.materials[0]
+                        .emissive_texture
+                        .as_mut()
+                        .unwrap()
+                        .transform
+                        .rotation = f32::NAN
+                },
+                "emissive texture transform is not finite",
+            ),
+            (
+                |g| g.materials[0].base_color_transform.scale[1] = f32::INFINITY,
+                "base-colour texture transform is not finite",
+            ),
+            (
+                |g| {
+                    g.materials[0]
+                        .metallic_roughness_texture
+                        .as_mut()
+                        .unwrap()
+                        .transform
+                        .offset[0] = f32::NAN
+                },
+                "metallic-roughness texture transform",
+            ),
+            (|g| g.materials[0].metallic = f32::NAN, "non-finite factor"),
+            (
+                |g| g.materials[0].roughness = f32::INFINITY,
+                "non-finite factor",
+            ),
+            (
+                |g| g.materials[0].normal_scale = f32::NAN,
+                "non-finite factor",
+            ),
+            (
+                |g| g.materials[0].occlusion_strength = f32::NEG_INFINITY,
+                "non-finite factor",
+            ),
+            (|g| g.materials[0].clearcoat = f32::NAN, "non-finite factor"),
+            (
+                |g| g.materials[0].clearcoat_roughness = f32::NAN,
+                "non-finite factor",
+            ),
+            (
+                |g| {
+                    g.textures[0].mips.pop();
+                },
+                "has 1 mip levels, a full chain has 2",
+            ),
+            (
+                |g| {
+                    g.textures[0].mips[1].push(0);
+                },
+                "mip level 2 has 5 bytes, 1x1 RGBA8 needs 4",
+            ),
+            (
+                |g| {
+                    g.textures[0].mips[0].truncate(4);
+                },
+                "mip level 1 has 4 bytes, 2x1 RGBA8 needs 8",
+            ),
+            (
+                |g| {
+                    g.textures[0].rgba8.pop();
+                },
+                "texture 0 has the wrong number of bytes",
+            ),
+            (
+                |g| {
+                    g.textures[0].width = 0;
+                },
+                "texture 0 is empty",
+            ),
+        ];
+        for (edit, expected) in cases {
+            let mut g = textured();
+            edit(&mut g);
+            let err = g.check_structure().unwrap_err();
+            assert!(err.contains(expected), "{err:?} lacks {expected:?}");
+        }
+        // A texture without mips is valid.
+        let mut g = textured();
+        g.textures[0].mips.clear();
+        g.check_structure().unwrap();
+    }
+
+    #[test]
+    fn a_variant_moving_a_varying_alpha_is_refused() {
+        // Slot 1 ("leaf") is masked with texture 0, whose alpha varies.
+        let mut g = with(0, 5);
+        g.materials[5].base_color_tex_coord = 1;
+        let err = g.variant_materials(Some("v")).unwrap_err();
+        assert!(err.to_string().contains("texture coordinate set"), "{err}");
+        let mut g = with(0, 5);
+        g.materials[5].base_color_transform.rotation = 0.5;
+        let err = g.variant_materials(Some("v")).unwrap_err();
+        assert!(err.to_string().contains("texture transform"), "{err}");
+        // Opaque materials may move their texture freely.
+        let mut g = with(2, 1);
+        g.materials[2].base_color_texture = Some(0);
+        g.materials[2].base_color_transform.offset = [0.5, 0.0];
+        g.variant_materials(Some("v")).unwrap();
     }
 }
