@@ -95,10 +95,11 @@ fn car_concept_counts_glass_and_door_node() {
         .materials
         .iter()
         .any(|m| m.emissive.iter().any(|&c| c > 1.0)));
+    // Clearcoat is read (see import_pbr); iridescence is not rendered, and said so.
     assert!(scene
         .notes
         .iter()
-        .any(|n| n.contains("KHR_materials_clearcoat")));
+        .any(|n| n.contains("KHR_materials_iridescence")));
     assert!(!scene
         .notes
         .iter()
@@ -159,8 +160,14 @@ fn glass_vase_flowers_has_blend_mask_and_textures() {
         .expect("foliage texture");
     let t = &g.textures[tex as usize];
     assert!(t.width >= 64 && t.height >= 64);
-    // Only base-colour textures are decoded (normal and roughness maps are not).
-    assert_eq!(g.textures.len(), 1);
+    // Base colour (sRGB), metallic-roughness and normal maps (linear) are decoded; the volume
+    // extension's thickness texture is not.
+    assert_eq!(g.textures.len(), 3);
+    assert!(t.srgb);
+    let flowers = &g.materials[mask];
+    for slot in [flowers.metallic_roughness_texture, flowers.normal_texture] {
+        assert!(!g.textures[slot.expect("a map").texture as usize].srgb);
+    }
     // The foliage texture has cut-out texels and its vertices carry texture coordinates.
     assert!(t.rgba8.chunks_exact(4).any(|p| p[3] < 128));
     assert!(g

@@ -192,7 +192,7 @@ fn materials_textures_and_default_material() {
     doc["extensionsUsed"] = json!([
         "KHR_materials_emissive_strength",
         "KHR_materials_transmission",
-        "KHR_materials_clearcoat"
+        "KHR_materials_sheen"
     ]);
     doc["materials"] = json!([{
         "name": "glassy",
@@ -235,16 +235,21 @@ fn materials_textures_and_default_material() {
     assert_eq!((t.width, t.height, t.name.as_str()), (2, 2, "tiny"));
     assert_eq!(&t.rgba8[..8], &[255, 0, 0, 255, 0, 255, 0, 255]);
     assert_eq!(t.rgba8[15], 0);
-    // The texture samples TEXCOORD_1, so that is the vertex uv; the second primitive has
-    // the default material and no uv.
-    assert_eq!(g.vertices[0].uv, [0.25, 0.5]);
+    // The first material samples TEXCOORD_1 (vertex uv1), the second TEXCOORD_0 (vertex uv);
+    // the second primitive has the default material and no texture coordinates.
+    assert_eq!(
+        (m.base_color_tex_coord, g.materials[1].base_color_tex_coord),
+        (1, 0)
+    );
+    assert_eq!(g.vertices[0].uv1, [0.25, 0.5]);
+    assert_eq!(g.vertices[0].uv, [0.0, 0.0]);
     assert_eq!(g.triangle_material(4), 2);
-    assert_eq!(g.vertices[g.triangles[4][0] as usize].uv, [0.0, 0.0]);
-    assert!(scene.notes.iter().any(|n| n.contains("TEXCOORD_1")));
+    assert_eq!(g.vertices[g.triangles[4][0] as usize].uv1, [0.0, 0.0]);
+    assert!(!scene.notes.iter().any(|n| n.contains("TEXCOORD_1")));
     assert!(scene
         .notes
         .iter()
-        .any(|n| n.contains("KHR_materials_clearcoat")));
+        .any(|n| n.contains("KHR_materials_sheen")));
     assert_eq!(
         scene
             .notes

@@ -9,4 +9,5 @@ mod import;
 mod import_bad_input;
 mod import_built;
 mod import_compressed;
+mod import_pbr;
 mod import_variants;

@@ -15,6 +15,10 @@ use crate::SceneError;
 const HANDLED_EXTENSIONS: &[&str] = &[
     "KHR_materials_transmission",
     "KHR_materials_emissive_strength",
+    // Read from the raw JSON of every texture reference (`materials.rs`).
+    "KHR_texture_transform",
+    // Its factors; its textures are noted per material as not rendered.
+    "KHR_materials_clearcoat",
     // Quantized attributes: the accessor reader converts every component type.
     "KHR_mesh_quantization",
     "EXT_meshopt_compression",
@@ -455,9 +459,6 @@ impl Importer<'_> {
         for ext in self.doc.extensions_used() {
             if !HANDLED_EXTENSIONS.contains(&ext) {
                 let what = match ext {
-                    "KHR_texture_transform" => {
-                        "textures are sampled with untransformed coordinates"
-                    }
                     "KHR_materials_volume" => "glass thickness and attenuation are not modelled",
                     _ => "not supported",
                 };

@@ -18,20 +18,34 @@
 //!   [`Node::rest`](trisort_format::Node::rest) is the node's local matrix (its `matrix`, or
 //!   translation · rotation · scale) in f64. Animations and cameras refer to the new indices.
 //! - **Materials**: every material of the file at its own index, then one default material
-//!   (glTF's defaults) when some primitive has none: base colour factor and texture, alpha mode
-//!   and cutoff, double-sidedness, emissive × `KHR_materials_emissive_strength`, and the
-//!   `KHR_materials_transmission` factor. Other extensions are ignored with one note each.
+//!   (glTF's defaults) when some primitive has none: base colour, metallic and roughness
+//!   factors; base-colour, metallic-roughness, normal (with its scale), occlusion (with its
+//!   strength) and emissive textures, each with its texture coordinate set and
+//!   `KHR_texture_transform` (offset, rotation, scale and `texCoord` override, read from the
+//!   reference's raw JSON; a malformed one is [`SceneError::Malformed`] naming the material; a
+//!   set above 1 is noted and read as 0); alpha mode and cutoff, double-sidedness, emissive ×
+//!   `KHR_materials_emissive_strength`, the `KHR_materials_transmission` factor and
+//!   `KHR_materials_clearcoat`'s factor and roughness factor. What a material has that is not
+//!   rendered (clearcoat textures, iridescence, sheen, the transmission texture, …) is named in
+//!   one note per material; other extensions of the file get one note each.
 //! - **Material variants** (`KHR_materials_variants`): per variant, the material each
 //!   material slot shows ([`Geometry::variants`](trisort_format::Geometry::variants)). glTF
 //!   maps variants per primitive; where primitives sharing a material map it differently, a
 //!   primitive gets a copy of its material in a slot of its own (appended after the default
 //!   material, in order of first use), so one table per variant says it all.
-//! - **Textures**: only base-colour textures, decoded (PNG or JPEG) to RGBA8, one per image
-//!   (two textures sharing an image share one [`Texture`](trisort_format::Texture)), in order
-//!   of first use by the materials. [`Vertex::uv`](trisort_format::Vertex::uv) holds the
-//!   texture coordinate set the material's base-colour texture names (`TEXCOORD_0` almost
-//!   always; another set is noted), or for an untextured material the set of the first
-//!   textured material a variant maps it to, and is zero otherwise.
+//! - **Textures**: every image a material slot uses, decoded (PNG or JPEG) to RGBA8, once per
+//!   colour space it is used in (sRGB for base colour and emissive, linear for the others),
+//!   in order of first use by the materials (slots in the order above), with its mip chain
+//!   ([`Texture::with_mips`](trisort_format::Texture::with_mips)); an image wider or taller
+//!   than 1024 is stored from its first mip level that fits, with a note giving the bytes.
+//! - **Vertex attributes**: [`Vertex::uv`](trisort_format::Vertex::uv) is `TEXCOORD_0` and
+//!   [`Vertex::uv1`](trisort_format::Vertex::uv1) `TEXCOORD_1`, each read where a texture slot
+//!   of a material the primitive may show (its own or a variant's) samples that set, zero
+//!   otherwise. [`Vertex::tangent`](trisort_format::Vertex::tangent) is read from `TANGENT`
+//!   where such a material has a normal texture; a primitive without `TANGENT` gets MikkTSpace
+//!   tangents (the `mikktspace` crate) from the normal texture's set, computed in the file's
+//!   winding and local space before any winding flip and after flat-normal expansion; a vertex
+//!   whose triangle corners get different tangents is copied, one copy per tangent.
 //! - **Animations**: translation, rotation and scale channels with their times and flattened
 //!   values (LINEAR, STEP, CUBICSPLINE); morph-weight channels are skipped with a note.
 //! - **Cameras**: perspective cameras on nodes of the scene; orthographic ones are noted and
@@ -65,9 +79,10 @@
 //!
 //! Errors: a skin on a node of the scene, morph targets on a mesh of the scene, NaN or infinite
 //! positions, node cycles or nodes with two parents, accessors outside their data, missing or
-//! short buffers, and base-colour images that cannot be read or decoded; see [`SceneError`].
+//! short buffers, images that cannot be read or decoded, malformed texture transforms and
+//! clearcoat values; see [`SceneError`].
 //! Meshes outside the imported scene are not read, so they cannot fail the import; all nodes,
-//! materials, base-colour images and animations are.
+//! materials, their images and animations are.
 //!
 //! `stats.materials` counts the file's materials (not the appended default one);
 //! `stats.primitives` counts the triangle primitives of all meshes of the file, once per mesh.
@@ -81,6 +96,7 @@ mod materials;
 mod meshopt;
 mod nodes;
 mod primitives;
+mod tangents;
 
 use std::path::{Path, PathBuf};
 

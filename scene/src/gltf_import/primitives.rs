@@ -9,8 +9,9 @@ use gltf::mesh::Mode;
 use gltf::Semantic;
 use trisort_format::{Geometry, Node, Vertex};
 
-use super::materials::Materials;
+use super::materials::{Materials, Needs};
 use super::nodes::NodeTree;
+use super::tangents;
 use super::{mesh_label, node_label, Importer};
 use crate::SceneError;
 
@@ -18,13 +19,19 @@ use crate::SceneError;
 /// note per kind.
 type Skipped = BTreeMap<&'static str, Vec<String>>;
 
-/// The triangles of one mesh primitive, read once and instanced per node.
+/// The triangles of one mesh primitive, read once and instanced per node: one vertex per
+/// file vertex, or, for a primitive without normals, three vertices per triangle carrying its
+/// face normal.
 struct PrimitiveData {
     positions: Vec<[f32; 3]>,
-    /// Unit normals from the file; `None` means flat normals are generated.
-    normals: Option<Vec<[f32; 3]>>,
-    /// Texture coordinates of the material's base-colour set, if textured.
-    uvs: Option<Vec<[f32; 2]>>,
+    /// Unit normals (from the file, or flat).
+    normals: Vec<[f32; 3]>,
+    /// TEXCOORD_0 and TEXCOORD_1, where a material of the primitive samples that set and the
+    /// primitive has it.
+    uvs: [Option<Vec<[f32; 2]>>; 2],
+    /// Tangents (file's or generated), where a material of the primitive has a normal texture.
+    tangents: Option<Vec<[f32; 4]>>,
+    /// Triangles in the file's winding (counter-clockwise about the local normals).
     triangles: Vec<[u32; 3]>,
     zero_area: u64,
     material: u32,
@@ -125,12 +132,12 @@ impl Importer<'_> {
             Some(map) => map.iter().map(|t| t.unwrap_or(default)).collect(),
             None => vec![default; self.variants.len()],
         };
-        // Texture coordinates for the default material's texture, or else for the first
-        // textured material a variant puts here (an untextured default reads none).
-        let uv_set = (std::iter::once(default).chain(targets.iter().copied()))
-            .find_map(|m| materials.uv_set[m as usize]);
+        // What any material a variant may show here samples.
+        let needs = (std::iter::once(default).chain(targets.iter().copied()))
+            .map(|m| materials.needs[m as usize])
+            .fold(Needs::default(), Needs::union);
         let material = materials.slot(default, targets);
-        self.primitive(mesh, prim, material, uv_set)
+        self.primitive(mesh, prim, material, needs)
     }
 
     /// One note per kind of skipped primitive, naming the first few.
@@ -156,7 +163,7 @@ impl Importer<'_> {
         mesh: &gltf::Mesh,
         prim: &gltf::Primitive,
         material: u32,
-        uv_set: Option<u32>,
+        needs: Needs,
     ) -> Result<Option<PrimitiveData>, SceneError> {
         let where_ = format!("{} primitive {}", mesh_label(mesh), prim.index());
         if prim.morph_targets().next().is_some() {
@@ -202,25 +209,36 @@ impl Importer<'_> {
             }
             None => None,
         };
-        let uvs = match uv_set {
-            None => None,
-            Some(set) => match prim.get(&Semantic::TexCoords(set)) {
+        let mut uvs = [None, None];
+        for set in 0..2u32 {
+            if !needs.uv[set as usize] {
+                continue;
+            }
+            let what = format!("TEXCOORD_{set}");
+            match prim.get(&Semantic::TexCoords(set)) {
                 Some(acc) => {
-                    let what = format!("TEXCOORD_{set}");
                     let flat =
                         self.read_floats(&acc, &format!("{where_} {what}"), &[Dimensions::Vec2])?;
                     if flat.len() != 2 * n {
                         return Err(count_mismatch(&acc, &what, flat.len() / 2));
                     }
-                    Some(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+                    uvs[set as usize] = Some(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect());
                 }
-                None => {
-                    self.notes.push(format!(
-                        "{where_} has a textured material but no TEXCOORD_{set}; its uv is zero"
-                    ));
-                    None
+                None => self.notes.push(format!(
+                    "{where_} has a material sampling {what} but no {what}; it is zero"
+                )),
+            }
+        }
+        let tangents = match (needs.tangent_set, prim.get(&Semantic::Tangents)) {
+            (Some(_), Some(acc)) => {
+                let flat =
+                    self.read_floats(&acc, &format!("{where_} TANGENT"), &[Dimensions::Vec4])?;
+                if flat.len() != 4 * n {
+                    return Err(count_mismatch(&acc, "TANGENT", flat.len() / 4));
                 }
-            },
+                Some(flat.chunks_exact(4).map(tangent).collect())
+            }
+            _ => None,
         };
         let indices: Vec<u32> = match prim.indices() {
             Some(acc) => {
@@ -263,15 +281,111 @@ impl Importer<'_> {
             .iter()
             .filter(|t| is_zero_area(&positions, t))
             .count() as u64;
-        Ok(Some(PrimitiveData {
-            positions,
-            normals,
-            uvs,
-            triangles,
-            zero_area,
-            material,
-        }))
+        let mut data = match normals {
+            Some(normals) => PrimitiveData {
+                positions,
+                normals,
+                uvs,
+                tangents,
+                triangles,
+                zero_area,
+                material,
+            },
+            None => flat(positions, uvs, tangents, &triangles, zero_area, material),
+        };
+        if let (Some(set), None) = (needs.tangent_set, &data.tangents) {
+            match &data.uvs[set as usize] {
+                Some(uvs) => {
+                    let corners =
+                        tangents::generate(&data.positions, &data.normals, uvs, &data.triangles);
+                    weld(&mut data, &corners);
+                }
+                None => self.notes.push(format!(
+                    "{where_}: its normal texture samples TEXCOORD_{set}, which it lacks, and it \
+                     has no TANGENT; its tangents are zero (the normal texture has no effect)"
+                )),
+            }
+        }
+        Ok(Some(data))
     }
+}
+
+/// Gives every vertex the tangent of its triangle corners (`corners`, 3 per triangle); where
+/// the corners of one vertex got different tangents (MikkTSpace splits at mirrored or
+/// discontinuous texture coordinates), the vertex is copied, one copy per tangent, and the
+/// triangles use the copy of their corner. Triangle order and winding are unchanged.
+fn weld(data: &mut PrimitiveData, corners: &[[f32; 4]]) {
+    let n = data.positions.len();
+    let mut tangents: Vec<Option<[f32; 4]>> = vec![None; n];
+    let mut copies: HashMap<(u32, [u32; 4]), u32> = HashMap::new();
+    for (k, t) in data.triangles.iter_mut().flatten().enumerate() {
+        let tangent = corners[k];
+        let v = *t as usize;
+        match tangents[v] {
+            None => tangents[v] = Some(tangent),
+            Some(first) if first.map(f32::to_bits) == tangent.map(f32::to_bits) => {}
+            Some(_) => {
+                let key = (*t, tangent.map(f32::to_bits));
+                *t = *copies.entry(key).or_insert_with(|| {
+                    data.positions.push(data.positions[v]);
+                    data.normals.push(data.normals[v]);
+                    for uv in data.uvs.iter_mut().flatten() {
+                        uv.push(uv[v]);
+                    }
+                    tangents.push(Some(tangent));
+                    (tangents.len() - 1) as u32
+                });
+            }
+        }
+    }
+    data.tangents = Some(
+        tangents
+            .into_iter()
+            .map(|t| t.unwrap_or([0.0; 4]))
+            .collect(),
+    );
+}
+
+/// A primitive without normals as three vertices per triangle carrying the face normal (as
+/// the glTF specification requires), computed in the file's winding.
+fn flat(
+    positions: Vec<[f32; 3]>,
+    uvs: [Option<Vec<[f32; 2]>>; 2],
+    tangents: Option<Vec<[f32; 4]>>,
+    triangles: &[[u32; 3]],
+    zero_area: u64,
+    material: u32,
+) -> PrimitiveData {
+    let corners = || triangles.iter().flatten().map(|&i| i as usize);
+    let normals = triangles
+        .iter()
+        .flat_map(|t| {
+            let n: [f32; 3] = face_cross(&positions, t)
+                .normalize_or_zero()
+                .as_vec3()
+                .into();
+            [n; 3]
+        })
+        .collect();
+    let uvs = uvs.map(|uv| uv.map(|uv| corners().map(|i| uv[i]).collect()));
+    PrimitiveData {
+        positions: corners().map(|i| positions[i]).collect(),
+        normals,
+        uvs,
+        tangents: tangents.map(|t| corners().map(|i| t[i]).collect()),
+        triangles: (0..triangles.len() as u32)
+            .map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
+            .collect(),
+        zero_area,
+        material,
+    }
+}
+
+/// A file tangent: xyz scaled to unit length (zero when zero or not finite), w the sign of
+/// the file's w (±1; glTF requires ±1).
+fn tangent(t: &[f32]) -> [f32; 4] {
+    let [x, y, z] = unit([t[0], t[1], t[2]]);
+    [x, y, z, if t[3] < 0.0 { -1.0 } else { 1.0 }]
 }
 
 /// The normal scaled to unit length; zero when it is zero or not finite.
@@ -313,6 +427,8 @@ fn is_zero_area(positions: &[[f32; 3]], t: &[u32; 3]) -> bool {
 }
 
 /// Appends one instance of a primitive for `node`, flipping the winding when `flip`.
+/// Attributes stay in the node's local space (tangents included: their handedness is that of
+/// the file's winding).
 fn instance(
     geometry: &mut Geometry,
     data: &PrimitiveData,
@@ -320,49 +436,28 @@ fn instance(
     flip: bool,
 ) -> Result<(), String> {
     let base = geometry.vertices.len();
-    let added = match data.normals {
-        Some(_) => data.positions.len(),
-        None => 3 * data.triangles.len(),
-    };
-    if base + added > u32::MAX as usize {
+    if base + data.positions.len() > u32::MAX as usize {
         return Err("more than 2^32 vertices after expanding instances".to_string());
     }
-    let vertex = |i: u32, normal: [f32; 3]| Vertex {
-        position: data.positions[i as usize],
-        normal,
-        uv: data.uvs.as_ref().map_or([0.0; 2], |uv| uv[i as usize]),
-        material: data.material,
-        node,
-        tangent: [0.0; 4],
-        uv1: [0.0; 2],
-    };
+    let get2 = |a: &Option<Vec<[f32; 2]>>, i: usize| a.as_ref().map_or([0.0; 2], |a| a[i]);
+    geometry
+        .vertices
+        .extend((0..data.positions.len()).map(|i| Vertex {
+            position: data.positions[i],
+            normal: data.normals[i],
+            uv: get2(&data.uvs[0], i),
+            material: data.material,
+            node,
+            tangent: data.tangents.as_ref().map_or([0.0; 4], |t| t[i]),
+            uv1: get2(&data.uvs[1], i),
+        }));
     let order = |t: [u32; 3]| if flip { [t[0], t[2], t[1]] } else { t };
-    match &data.normals {
-        Some(normals) => {
-            geometry
-                .vertices
-                .extend((0..data.positions.len() as u32).map(|i| vertex(i, normals[i as usize])));
-            let base = base as u32;
-            geometry.triangles.extend(
-                data.triangles
-                    .iter()
-                    .map(|t| order([t[0] + base, t[1] + base, t[2] + base])),
-            );
-        }
-        None => {
-            for t in &data.triangles {
-                let n = face_cross(&data.positions, t)
-                    .normalize_or_zero()
-                    .as_vec3()
-                    .into();
-                let first = geometry.vertices.len() as u32;
-                geometry.vertices.extend(t.iter().map(|&i| vertex(i, n)));
-                geometry
-                    .triangles
-                    .push(order([first, first + 1, first + 2]));
-            }
-        }
-    }
+    let base = base as u32;
+    geometry.triangles.extend(
+        data.triangles
+            .iter()
+            .map(|t| order([t[0] + base, t[1] + base, t[2] + base])),
+    );
     Ok(())
 }
 
