@@ -10,11 +10,12 @@
 //! - per primitive: `POSITION` (with min/max), `NORMAL` (left out for a group with a zero or
 //!   non-unit normal, so readers compute their own), `TEXCOORD_0` for textured materials, and
 //!   u16 indices where the group has at most 65,535 vertices, else u32;
-//! - materials as metallic-roughness (metallic 0, roughness 0.5, which the scene model does not
-//!   carry) with base colour factor and texture, alpha mode (and cutoff for `MASK`), double
+//! - materials as metallic-roughness with base colour, metallic and roughness factors and the
+//!   base-colour texture (its TEXCOORD_0, untransformed: the other texture slots, texture
+//!   transforms and TEXCOORD_1 are not exported), alpha mode (and cutoff for `MASK`), double
 //!   sidedness, emissive colour (through `KHR_materials_emissive_strength` when brighter
-//!   than 1), and `KHR_materials_transmission` for glass; both extensions are listed in
-//!   `extensionsUsed` when used, never required;
+//!   than 1), `KHR_materials_transmission` for glass and `KHR_materials_clearcoat`'s factors;
+//!   the extensions are listed in `extensionsUsed` when used, never required;
 //! - every texture as an embedded PNG (sRGB texels stored as they are), linear filtering with
 //!   mipmaps, repeat wrapping.
 //!
@@ -258,8 +259,8 @@ fn validate(scene: &Scene, path: &Path) -> Result<(), ExportError> {
 fn material_json(m: &Material, extensions: &mut Vec<&'static str>) -> Value {
     let mut pbr = json!({
         "baseColorFactor": m.base_color.map(|c| c.clamp(0.0, 1.0)),
-        "metallicFactor": 0.0,
-        "roughnessFactor": 0.5,
+        "metallicFactor": m.metallic.clamp(0.0, 1.0),
+        "roughnessFactor": m.roughness.clamp(0.0, 1.0),
     });
     if let Some(t) = m.base_color_texture {
         pbr["baseColorTexture"] = json!({ "index": t });
@@ -296,9 +297,19 @@ fn material_json(m: &Material, extensions: &mut Vec<&'static str>) -> Value {
             json!({ "transmissionFactor": m.transmission.min(1.0) }),
         );
     }
+    if m.clearcoat > 0.0 {
+        ext.insert(
+            "KHR_materials_clearcoat".into(),
+            json!({
+                "clearcoatFactor": m.clearcoat.min(1.0),
+                "clearcoatRoughnessFactor": m.clearcoat_roughness.clamp(0.0, 1.0),
+            }),
+        );
+    }
     for name in [
         "KHR_materials_emissive_strength",
         "KHR_materials_transmission",
+        "KHR_materials_clearcoat",
     ] {
         if ext.contains_key(name) && !extensions.contains(&name) {
             extensions.push(name);

@@ -625,3 +625,47 @@ fn export_errors_name_the_file() {
     assert!(matches!(err, ExportError::Write { .. }), "{err}");
     assert!(err.to_string().contains("car.glb"));
 }
+
+#[test]
+fn materials_are_physically_plausible_and_survive_export() {
+    let car = demo_car(10_000);
+    let g = &car.geometry;
+    g.check_structure().unwrap();
+    let m = |name: &str| g.materials.iter().find(|m| m.name == name).unwrap();
+    // Clear-coated metallic paint, chrome rims, rough rubber, smooth dielectric glass.
+    let paint = m("paint");
+    assert!(paint.metallic > 0.0 && paint.clearcoat == 1.0 && paint.clearcoat_roughness < 0.1);
+    assert_eq!((m("rim").metallic, m("rim").roughness < 0.1), (1.0, true));
+    assert_eq!(m("tyre").metallic, 0.0);
+    assert!(m("tyre").roughness >= 0.8);
+    let glass = m(GLASS_MATERIAL);
+    assert_eq!((glass.metallic, glass.transmission), (0.0, 1.0));
+    assert!(glass.roughness < 0.1);
+    for m in &g.materials {
+        assert!((0.0..=1.0).contains(&m.metallic) && (0.0..=1.0).contains(&m.roughness));
+    }
+    // The plate texture carries its mip chain: 64x16 down to 1x1.
+    let plate = &g.textures[0];
+    assert!(plate.srgb);
+    assert_eq!(plate.mips.len(), 6);
+    assert_eq!(plate.mips[5].len(), 4);
+
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("car.glb");
+    trisort_scene::export::export_glb(&car, &path).unwrap();
+    let back = trisort_scene::load(&path).unwrap();
+    for (a, b) in g.materials.iter().zip(&back.geometry.materials) {
+        assert_eq!(a.name, b.name);
+        assert_eq!(
+            (a.metallic, a.roughness),
+            (b.metallic, b.roughness),
+            "{}",
+            a.name
+        );
+        assert_eq!(
+            (a.clearcoat, a.clearcoat_roughness),
+            (b.clearcoat, b.clearcoat_roughness)
+        );
+    }
+    assert_eq!(back.geometry.textures[0].mips, plate.mips);
+}

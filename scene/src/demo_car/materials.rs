@@ -1,4 +1,9 @@
 //! The car's materials and its one texture, the licence plate.
+//!
+//! Physically plausible metallic-roughness values, so the physically based shading has
+//! something to show: a metallic red paint under a clearcoat, chrome rims, rubber tyres,
+//! tinted glass with transmission (drawn at the bake's glass opacity), dielectric interior
+//! and plate.
 
 use trisort_format::{AlphaMode, Material, Texture};
 
@@ -6,34 +11,50 @@ use super::{GLASS_MATERIAL, PLATE};
 
 /// The materials, at the indices of the material constants (`PAINT`, `GLASS`, …).
 pub(super) fn materials() -> Vec<Material> {
-    let opaque = |name: &str, rgb: [f32; 3]| Material {
+    // A dielectric (metallic 0) of the given colour and roughness.
+    let dielectric = |name: &str, rgb: [f32; 3], roughness: f32| Material {
         name: name.into(),
         base_color: [rgb[0], rgb[1], rgb[2], 1.0],
+        metallic: 0.0,
+        roughness,
         ..Material::default()
     };
     let mut list = vec![
-        opaque("paint", [0.60, 0.04, 0.03]),
+        // Metallic flake paint under a smooth clearcoat.
+        Material {
+            metallic: 0.6,
+            roughness: 0.35,
+            clearcoat: 1.0,
+            clearcoat_roughness: 0.03,
+            ..dielectric("paint", [0.60, 0.04, 0.03], 0.35)
+        },
         Material {
             name: GLASS_MATERIAL.into(),
             base_color: [0.60, 0.80, 1.00, 0.30],
             alpha_mode: AlphaMode::Blend,
             double_sided: true,
             transmission: 1.0,
+            metallic: 0.0,
+            roughness: 0.02,
             ..Material::default()
         },
-        opaque("tyre", [0.03, 0.03, 0.03]),
-        opaque("rim", [0.55, 0.56, 0.58]),
-        opaque("seat", [0.30, 0.16, 0.08]),
-        opaque("dashboard", [0.05, 0.05, 0.06]),
-        opaque("steering", [0.02, 0.02, 0.02]),
-        opaque("licence plate", [1.0, 1.0, 1.0]),
+        dielectric("tyre", [0.03, 0.03, 0.03], 0.9),
+        // Chrome: a polished metal (base colour is its reflectance).
+        Material {
+            metallic: 1.0,
+            ..dielectric("rim", [0.55, 0.56, 0.58], 0.08)
+        },
+        dielectric("seat", [0.30, 0.16, 0.08], 0.6),
+        dielectric("dashboard", [0.05, 0.05, 0.06], 0.5),
+        dielectric("steering", [0.02, 0.02, 0.02], 0.45),
+        dielectric("licence plate", [1.0, 1.0, 1.0], 0.4),
     ];
     list[PLATE as usize].base_color_texture = Some(0);
     list
 }
 
 /// The licence plate texture: "TRISORT" in a 5×7 pixel font on a yellow plate with a dark
-/// border, 64×16 texels, sRGB.
+/// border, 64×16 texels, sRGB, with its mip chain.
 pub(super) fn plate_texture() -> Texture {
     const W: usize = 64;
     const H: usize = 16;
@@ -64,12 +85,13 @@ pub(super) fn plate_texture() -> Texture {
             rgba8.extend_from_slice(if border || in_text { &ink } else { &background });
         }
     }
-    Texture {
-        name: "licence plate".into(),
-        width: W as u32,
-        height: H as u32,
+    let (texture, _) = Texture::with_mips(
+        "licence plate".into(),
+        W as u32,
+        H as u32,
         rgba8,
-        srgb: true,
-        mips: Vec::new(),
-    }
+        true,
+        Texture::MAX_SIZE,
+    );
+    texture
 }
