@@ -200,11 +200,13 @@ fn geometry_hash(geometry: &Geometry) -> trisort_format::Hash {
 }
 
 pub mod demo_car;
+pub mod environment;
 mod error;
 pub mod export;
 pub mod gltf_import;
 
 pub use demo_car::{demo_car, DEFAULT_TRIANGLES, DOOR_NODE, DOOR_WINDOW_NODE};
+pub use environment::{load_hdr, EnvironmentError};
 pub use error::SceneError;
 pub use export::{export_glb, ExportError};
 pub use gltf_import::{load, load_slice, load_with_sources, TriangleSource};
