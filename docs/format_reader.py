@@ -12,9 +12,10 @@ import json
 import struct
 import sys
 
-# Versions this reader understands (FORMAT.md § Compatibility): 3, and 2 (no `robust`, no
-# `Geometry.variants`, no `fps`).
-FORMAT_VERSIONS = (2, 3)
+# Versions this reader understands (FORMAT.md § Compatibility): 4; 3 (no vertex tangent and
+# uv1, no material texture slots and PBR factors, no texture colour space and mips, no
+# environment); 2 (no `robust`, no `Geometry.variants`, no `fps` either).
+FORMAT_VERSIONS = (2, 3, 4)
 ORDER_VERSION = 1
 
 
@@ -49,6 +50,9 @@ class Postcard:
         if value >> bits:
             raise Bad("varint overflows %d bits" % bits)
         return value
+
+    def u16(self):
+        return self.varint(16)
 
     def u32(self):
         return self.varint(32)
@@ -130,16 +134,43 @@ def read_baked(p, version):
              p.u64, p.u64]
     b["stats"] = {n: k() for n, k in zip(names, kinds)}
     g = {}
-    g["vertices"] = p.seq(lambda: (p.array(p.f32, 3), p.array(p.f32, 3), p.array(p.f32, 2),
-                                   p.u32(), p.u32()))
+    if version >= 4:
+        g["vertices"] = p.seq(lambda: (p.array(p.f32, 3), p.array(p.f32, 3), p.array(p.f32, 2),
+                                       p.u32(), p.u32(), p.array(p.f32, 4), p.array(p.f32, 2)))
+    else:
+        g["vertices"] = p.seq(lambda: (p.array(p.f32, 3), p.array(p.f32, 3),
+                                       p.array(p.f32, 2), p.u32(), p.u32()))
     g["triangles"] = p.seq(lambda: p.array(p.u32, 3))
-    g["materials"] = p.seq(lambda: {
-        "name": p.string(), "base_color": p.array(p.f32, 4),
-        "base_color_texture": p.option(p.u32), "alpha_mode": p.enum(ALPHA_MODE),
-        "alpha_cutoff": p.f32(), "double_sided": p.boolean(), "emissive": p.array(p.f32, 3),
-        "transmission": p.f32()})
-    g["textures"] = p.seq(lambda: {"name": p.string(), "width": p.u32(), "height": p.u32(),
-                                   "rgba8": p.bytes()})
+    transform = lambda: {"offset": p.array(p.f32, 2), "rotation": p.f32(),
+                         "scale": p.array(p.f32, 2)}
+    slot = lambda: p.option(lambda: {"texture": p.u32(), "tex_coord": p.u32(),
+                                     "transform": transform()})
+
+    def material():
+        m = {"name": p.string(), "base_color": p.array(p.f32, 4),
+             "base_color_texture": p.option(p.u32), "alpha_mode": p.enum(ALPHA_MODE),
+             "alpha_cutoff": p.f32(), "double_sided": p.boolean(),
+             "emissive": p.array(p.f32, 3), "transmission": p.f32()}
+        if version >= 4:
+            m.update({"base_color_tex_coord": p.u32(), "base_color_transform": transform(),
+                      "metallic": p.f32(), "roughness": p.f32(),
+                      "metallic_roughness_texture": slot(), "normal_texture": slot(),
+                      "normal_scale": p.f32(), "occlusion_texture": slot(),
+                      "occlusion_strength": p.f32(), "emissive_texture": slot(),
+                      "clearcoat": p.f32(), "clearcoat_roughness": p.f32()})
+        return m
+
+    g["materials"] = p.seq(material)
+
+    def texture():
+        t = {"name": p.string(), "width": p.u32(), "height": p.u32(), "rgba8": p.bytes(),
+             "srgb": True, "mips": []}
+        if version >= 4:
+            t["srgb"] = p.boolean()
+            t["mips"] = p.seq(p.bytes)
+        return t
+
+    g["textures"] = p.seq(texture)
     g["nodes"] = p.seq(lambda: {"name": p.string(), "parent": p.option(p.u32),
                                 "rest": p.array(p.f64, 16)})
     if version >= 3:
@@ -155,7 +186,60 @@ def read_baked(p, version):
                                        "poses": p.seq(lambda: (p.u32(), p.array(p.f64, 16)))})
     b["removed_edges"] = p.seq(lambda: p.seq(lambda: (p.u32(), p.u32(), p.u32())))
     b["fps"] = p.option(p.f64) if version >= 3 else None
+    if version >= 4:
+        rgb = lambda: p.array(p.f32, 3)
+        b["environment"] = {
+            "name": p.string(), "width": p.u32(), "height": p.u32(),
+            "levels": p.seq(lambda: p.seq(p.u16)), "sh": p.array(rgb, 9),
+            "sun": p.option(lambda: {"direction": rgb(), "color": rgb()}),
+            "exposure": p.f32()}
+    else:
+        b["environment"] = None
     return b
+
+
+def level_size(width, height, k):
+    """Level k of a mip chain or of the environment (FORMAT.md § Baked)."""
+    return max(1, width >> k), max(1, height >> k)
+
+
+def check_lengths(b):
+    """The lengths FORMAT.md states, checked again: every texture level and environment level
+    has the bytes (halves) its size needs, mip chains run to 1x1, slots name textures and
+    texture coordinate sets that exist."""
+    g = b["geometry"]
+    for k, t in enumerate(g["textures"]):
+        w, h = t["width"], t["height"]
+        if w == 0 or h == 0 or len(t["rgba8"]) != w * h * 4:
+            raise Bad("texture %d: %dx%d with %d bytes" % (k, w, h, len(t["rgba8"])))
+        if t["mips"] and level_size(w, h, len(t["mips"])) != (1, 1):
+            raise Bad("texture %d: %d mip levels do not end at 1x1" % (k, len(t["mips"])))
+        if t["mips"] and level_size(w, h, len(t["mips"]) - 1) == (1, 1):
+            raise Bad("texture %d: mip levels go on past 1x1" % k)
+        for level, mip in enumerate(t["mips"], start=1):
+            lw, lh = level_size(w, h, level)
+            if len(mip) != lw * lh * 4:
+                raise Bad("texture %d mip %d: %d bytes for %dx%d" % (k, level, len(mip), lw, lh))
+    for k, m in enumerate(g["materials"]):
+        slots = [m["base_color_texture"]] + [
+            (m.get(s) or {}).get("texture") for s in
+            ("metallic_roughness_texture", "normal_texture", "occlusion_texture",
+             "emissive_texture")]
+        if any(t is not None and t >= len(g["textures"]) for t in slots):
+            raise Bad("material %d refers to a missing texture" % k)
+        sets = [m.get("base_color_tex_coord", 0)] + [
+            (m.get(s) or {}).get("tex_coord", 0) for s in
+            ("metallic_roughness_texture", "normal_texture", "occlusion_texture",
+             "emissive_texture")]
+        if any(c > 1 for c in sets):
+            raise Bad("material %d samples a texture coordinate set above 1" % k)
+    e = b["environment"]
+    if e is not None:
+        for level, texels in enumerate(e["levels"]):
+            lw, lh = level_size(e["width"], e["height"], level)
+            if len(texels) != lw * lh * 4:
+                raise Bad("environment level %d: %d halves for %dx%d RGBA" % (
+                    level, len(texels), lw, lh))
 
 
 def read_container(data, magic):
@@ -181,6 +265,7 @@ def baked_summary(data):
     b = read_baked(p, version)
     if p.at != len(p.data):
         raise Bad("%d trailing payload bytes" % (len(p.data) - p.at))
+    check_lengths(b)
     g = b["geometry"]
     nidx = 3 * len(b["copies"])
     for d in b["draws"]:
@@ -197,6 +282,16 @@ def baked_summary(data):
         "triangles": len(g["triangles"]),
         "materials": len(g["materials"]),
         "textures": len(g["textures"]),
+        "srgb_textures": sum(1 for t in g["textures"] if t["srgb"]),
+        "texture_bytes": sum(len(t["rgba8"]) + sum(len(m) for m in t["mips"])
+                             for t in g["textures"]),
+        "mip_levels": [len(t["mips"]) for t in g["textures"]],
+        "tangents": sum(1 for v in g["vertices"] if len(v) > 5 and any(v[5])),
+        "environment": None if b["environment"] is None else {
+            "name": b["environment"]["name"], "width": b["environment"]["width"],
+            "height": b["environment"]["height"], "levels": len(b["environment"]["levels"]),
+            "sun": b["environment"]["sun"] is not None,
+            "exposure": b["environment"]["exposure"]},
         "nodes": len(g["nodes"]),
         "variants": [v["name"] for v in g.get("variants", [])],
         "fps": b["fps"],

@@ -71,7 +71,22 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
     }
     assert_eq!(ours["stats_index_triangles"], inspect["index_triangles"]);
     assert_eq!(ours["triangles"], ours["unique_visible"]);
+    assert_eq!(ours["format_version"], 4);
     assert_eq!(ours["textures"], 1, "the demo car's licence plate");
+    // Version 4: the plate is sRGB with its mips (64x16 down to 1x1), the file has its light.
+    assert_eq!(ours["srgb_textures"], 1);
+    assert_eq!(ours["mip_levels"], serde_json::json!([6]));
+    let plate: u64 = (0..7)
+        .map(|k| (64u64 >> k).max(1) * (16u64 >> k).max(1) * 4)
+        .sum();
+    assert_eq!(ours["texture_bytes"], plate);
+    assert_eq!(ours["tangents"], 0, "no normal textures on the demo car");
+    let environment = &ours["environment"];
+    assert!(
+        environment["levels"].as_u64().unwrap() >= 1,
+        "{environment}"
+    );
+    assert!(environment["width"].as_u64().unwrap() >= 1, "{environment}");
     assert_eq!(ours["fps"], inspect["fps"]);
     assert_eq!(ours["fps"], 30.0, "the generators' default rate");
     assert_eq!(ours["variants"], serde_json::json!([]));
@@ -87,6 +102,38 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
     let out = run_reader(python, &d.join("cut.baked"));
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cut.baked"));
+}
+
+/// The reader checks the lengths FORMAT.md states: a mip level one byte short is refused
+/// (trisort's own check refuses it too), naming the texture and level.
+#[test]
+fn the_independent_reader_refuses_a_mip_level_of_the_wrong_length() {
+    let Some(python) = python() else { return };
+    let Some(dir) = gpu_tempdir() else { return };
+    let d = dir.path();
+    run(
+        d,
+        &args("bake demo:10000 --path orbit:frames=2,degrees=10 --size 32x32 --samples 1 -o car.baked"),
+        true,
+    );
+    let path = d.join("car.baked");
+    use trisort_format::container::{encode, read_file, write_bytes_atomic, FileKind};
+    let mut baked: trisort_format::Baked = read_file(FileKind::Baked, &path).unwrap();
+    baked.geometry.textures[0].mips[2].pop();
+    assert!(baked
+        .geometry
+        .check_structure()
+        .unwrap_err()
+        .contains("mip level 3"));
+    let bad = d.join("short-mip.baked");
+    write_bytes_atomic(&bad, &encode(FileKind::Baked, &baked)).unwrap();
+    let out = run_reader(python, &bad);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("short-mip.baked") && err.contains("texture 0 mip 3"),
+        "{err}"
+    );
 }
 
 #[test]

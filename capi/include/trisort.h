@@ -10,7 +10,7 @@
 // The ABI version of this library: bumped whenever a function, a struct or an enum of the
 // header changes incompatibly. Hosts compare [`trisort_abi_version`] with the header's
 // `TRISORT_ABI_VERSION`.
-#define TRISORT_ABI_VERSION 1
+#define TRISORT_ABI_VERSION 2
 
 // The ORDER file version this build writes and reads.
 #define TRISORT_ORDER_VERSION 1
@@ -131,38 +131,95 @@ typedef struct TrisortDrawIndexedIndirectArgs {
   uint32_t first_instance;
 } TrisortDrawIndexedIndirectArgs;
 
-// One vertex of G, 40 bytes, as trisort's own pipelines read it.
+// One vertex of G, 64 bytes, as trisort's own pipelines read it (the file's vertex layout:
+// `tangent` at byte 40, `uv1` at byte 56).
 typedef struct TrisortVertex {
   // Position in the local space of `node`.
   float position[3];
   // Unit normal in the local space of `node` (zero when unknown).
   float normal[3];
-  // Base-colour texture coordinate.
+  // Texture coordinate set 0 (`TEXCOORD_0`; zero where no texture samples it).
   float uv[2];
   // Material index.
   uint32_t material;
   // Node index: the node matrix that moves this vertex.
   uint32_t node;
+  // Tangent in the local space of `node` (xyz unit) and handedness (w, ±1): the bitangent
+  // is `cross(normal, tangent.xyz) * tangent.w`. Zero where the material has no normal
+  // texture.
+  float tangent[4];
+  // Texture coordinate set 1 (`TEXCOORD_1`; zero where no texture samples it).
+  float uv1[2];
 } TrisortVertex;
 
-// A material (the subset trisort draws).
+// A material's reference to a texture: which, sampled at which texture coordinate set,
+// through which `KHR_texture_transform`.
+typedef struct TrisortTextureSlot {
+  // Texture index, or -1 for none.
+  int32_t texture;
+  // Texture coordinate set: 0 (the vertex `uv`) or 1 (`uv1`).
+  uint32_t tex_coord;
+  // The transform as a 2×3 matrix, row major: `u' = m[0]·u + m[1]·v + m[2]`,
+  // `v' = m[3]·u + m[4]·v + m[5]` (identity: 1, 0, 0, 0, 1, 0).
+  float transform[6];
+} TrisortTextureSlot;
+
+// A material: glTF metallic-roughness with the extensions trisort reads.
 typedef struct TrisortMaterial {
   // Linear RGBA base colour factor.
   float base_color[4];
-  // Linear RGB emissive colour.
+  // Linear RGB emissive colour (factor × `KHR_materials_emissive_strength`).
   float emissive[3];
   // Alpha cutoff (for [`TrisortAlphaMode::Mask`]).
   float alpha_cutoff;
   // `KHR_materials_transmission` factor; > 0 marks glass, drawn at the info's
   // `glass_opacity`.
   float transmission;
-  // Base-colour texture index, or -1 for none.
+  // Base-colour texture index, or -1 for none (the same as `base_color_slot.texture`).
   int32_t base_color_texture;
   // Alpha mode.
   enum TrisortAlphaMode alpha_mode;
   // Whether back faces are drawn (single-sided materials discard them).
   bool double_sided;
+  // Base-colour texture (sRGB) with its set and transform; its alpha is what MASK and BLEND
+  // materials are recorded with.
+  struct TrisortTextureSlot base_color_slot;
+  // Metallic factor.
+  float metallic;
+  // Perceptual roughness factor.
+  float roughness;
+  // Metallic-roughness texture (linear; blue: metallic, green: roughness).
+  struct TrisortTextureSlot metallic_roughness;
+  // Tangent-space normal texture (linear).
+  struct TrisortTextureSlot normal;
+  // Scale of the normal texture's x and y.
+  float normal_scale;
+  // Occlusion texture (linear, red channel).
+  struct TrisortTextureSlot occlusion;
+  // Strength of the occlusion texture.
+  float occlusion_strength;
+  // Emissive texture (sRGB), multiplied by `emissive`.
+  struct TrisortTextureSlot emissive_texture;
+  // `KHR_materials_clearcoat` intensity (0: none).
+  float clearcoat;
+  // `KHR_materials_clearcoat` roughness.
+  float clearcoat_roughness;
 } TrisortMaterial;
+
+// A texture's size, colour space and mip levels.
+typedef struct TrisortTextureInfo {
+  // Width of level 0 in texels.
+  uint32_t width;
+  // Height of level 0 in texels.
+  uint32_t height;
+  // Whether the colour channels are sRGB-encoded (base colour, emissive: upload as
+  // `GL_SRGB8_ALPHA8`) rather than linear data (metallic-roughness, normal, occlusion:
+  // `GL_RGBA8`).
+  bool srgb;
+  // Levels stored, level 0 included: 1 without mips, else down to 1×1 (level k is
+  // `max(1, width >> k)` × `max(1, height >> k)`).
+  uint32_t level_count;
+} TrisortTextureInfo;
 
 // Figures of an ORDER file.
 typedef struct TrisortOrderInfo {
@@ -286,7 +343,7 @@ enum TrisortStatus trisort_frame_draws(const struct TrisortBaked *h,
                                        size_t cap,
                                        size_t *len);
 
-// Copies the vertex streams of G, interleaved (40 bytes per vertex).
+// Copies the vertex streams of G, interleaved (64 bytes per vertex).
 //
 // # Safety
 // `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
@@ -337,7 +394,8 @@ enum TrisortStatus trisort_materials(const struct TrisortBaked *h,
                                      size_t *len);
 
 // Stores texture `texture`'s size in `*width` and `*height` (either may be null) and copies
-// its texels (RGBA8, sRGB, rows top to bottom; `cap` and `len` count bytes).
+// its level-0 texels (RGBA8, rows top to bottom, sRGB or linear as
+// [`trisort_texture_info`] says; `cap` and `len` count bytes).
 //
 // # Safety
 // `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
@@ -349,6 +407,30 @@ enum TrisortStatus trisort_texture(const struct TrisortBaked *h,
                                    uint8_t *out,
                                    size_t cap,
                                    size_t *len);
+
+// Stores texture `texture`'s size, colour space and level count in `*out`.
+//
+// # Safety
+// `h` is an open handle; `out` is valid for one write.
+enum TrisortStatus trisort_texture_info(const struct TrisortBaked *h,
+                                        uint32_t texture,
+                                        struct TrisortTextureInfo *out);
+
+// Stores the size of mip level `level` of texture `texture` in `*width` and `*height`
+// (either may be null) and copies its texels (RGBA8, rows top to bottom; `cap` and `len`
+// count bytes). Level 0 is the texture itself; levels run to the info's `level_count`.
+//
+// # Safety
+// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
+// `len` as in the module conventions.
+enum TrisortStatus trisort_texture_level(const struct TrisortBaked *h,
+                                         uint32_t texture,
+                                         uint32_t level,
+                                         uint32_t *width,
+                                         uint32_t *height,
+                                         uint8_t *out,
+                                         size_t cap,
+                                         size_t *len);
 
 // Builds the order-only export of the baked file at `baked_path`, whose scene is the glTF
 // file `scene_path`, and writes it to `out_path` (atomically). The same as

@@ -19,14 +19,16 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
 use glam::DMat4;
-use trisort_format::{container, AlphaMode, Baked, FileKind};
+use trisort_format::{
+    container, AlphaMode, Baked, FileKind, Texture, TextureSlot, TextureTransform,
+};
 
 use crate::order::{Order, OrderRange, OrderSource};
 
 /// The ABI version of this library: bumped whenever a function, a struct or an enum of the
 /// header changes incompatibly. Hosts compare [`trisort_abi_version`] with the header's
 /// `TRISORT_ABI_VERSION`.
-pub const TRISORT_ABI_VERSION: u32 = 1;
+pub const TRISORT_ABI_VERSION: u32 = 2;
 
 /// The result of a call.
 #[repr(C)]
@@ -141,7 +143,8 @@ pub struct TrisortDrawIndexedIndirectArgs {
     pub first_instance: u32,
 }
 
-/// One vertex of G, 40 bytes, as trisort's own pipelines read it.
+/// One vertex of G, 64 bytes, as trisort's own pipelines read it (the file's vertex layout:
+/// `tangent` at byte 40, `uv1` at byte 56).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TrisortVertex {
@@ -149,33 +152,111 @@ pub struct TrisortVertex {
     pub position: [f32; 3],
     /// Unit normal in the local space of `node` (zero when unknown).
     pub normal: [f32; 3],
-    /// Base-colour texture coordinate.
+    /// Texture coordinate set 0 (`TEXCOORD_0`; zero where no texture samples it).
     pub uv: [f32; 2],
     /// Material index.
     pub material: u32,
     /// Node index: the node matrix that moves this vertex.
     pub node: u32,
+    /// Tangent in the local space of `node` (xyz unit) and handedness (w, ±1): the bitangent
+    /// is `cross(normal, tangent.xyz) * tangent.w`. Zero where the material has no normal
+    /// texture.
+    pub tangent: [f32; 4],
+    /// Texture coordinate set 1 (`TEXCOORD_1`; zero where no texture samples it).
+    pub uv1: [f32; 2],
 }
 
-/// A material (the subset trisort draws).
+/// A material's reference to a texture: which, sampled at which texture coordinate set,
+/// through which `KHR_texture_transform`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TrisortTextureSlot {
+    /// Texture index, or -1 for none.
+    pub texture: i32,
+    /// Texture coordinate set: 0 (the vertex `uv`) or 1 (`uv1`).
+    pub tex_coord: u32,
+    /// The transform as a 2×3 matrix, row major: `u' = m[0]·u + m[1]·v + m[2]`,
+    /// `v' = m[3]·u + m[4]·v + m[5]` (identity: 1, 0, 0, 0, 1, 0).
+    pub transform: [f32; 6],
+}
+
+impl TrisortTextureSlot {
+    fn new(texture: Option<u32>, tex_coord: u32, transform: &TextureTransform) -> Self {
+        let [a, b] = transform.matrix();
+        TrisortTextureSlot {
+            texture: texture.map_or(-1, |t| t as i32),
+            tex_coord,
+            transform: [a[0], a[1], a[2], b[0], b[1], b[2]],
+        }
+    }
+
+    fn of(slot: &Option<TextureSlot>) -> Self {
+        match slot {
+            Some(s) => TrisortTextureSlot::new(Some(s.texture), s.tex_coord, &s.transform),
+            None => TrisortTextureSlot::new(None, 0, &TextureTransform::default()),
+        }
+    }
+}
+
+/// A material: glTF metallic-roughness with the extensions trisort reads.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TrisortMaterial {
     /// Linear RGBA base colour factor.
     pub base_color: [f32; 4],
-    /// Linear RGB emissive colour.
+    /// Linear RGB emissive colour (factor × `KHR_materials_emissive_strength`).
     pub emissive: [f32; 3],
     /// Alpha cutoff (for [`TrisortAlphaMode::Mask`]).
     pub alpha_cutoff: f32,
     /// `KHR_materials_transmission` factor; > 0 marks glass, drawn at the info's
     /// `glass_opacity`.
     pub transmission: f32,
-    /// Base-colour texture index, or -1 for none.
+    /// Base-colour texture index, or -1 for none (the same as `base_color_slot.texture`).
     pub base_color_texture: i32,
     /// Alpha mode.
     pub alpha_mode: TrisortAlphaMode,
     /// Whether back faces are drawn (single-sided materials discard them).
     pub double_sided: bool,
+    /// Base-colour texture (sRGB) with its set and transform; its alpha is what MASK and BLEND
+    /// materials are recorded with.
+    pub base_color_slot: TrisortTextureSlot,
+    /// Metallic factor.
+    pub metallic: f32,
+    /// Perceptual roughness factor.
+    pub roughness: f32,
+    /// Metallic-roughness texture (linear; blue: metallic, green: roughness).
+    pub metallic_roughness: TrisortTextureSlot,
+    /// Tangent-space normal texture (linear).
+    pub normal: TrisortTextureSlot,
+    /// Scale of the normal texture's x and y.
+    pub normal_scale: f32,
+    /// Occlusion texture (linear, red channel).
+    pub occlusion: TrisortTextureSlot,
+    /// Strength of the occlusion texture.
+    pub occlusion_strength: f32,
+    /// Emissive texture (sRGB), multiplied by `emissive`.
+    pub emissive_texture: TrisortTextureSlot,
+    /// `KHR_materials_clearcoat` intensity (0: none).
+    pub clearcoat: f32,
+    /// `KHR_materials_clearcoat` roughness.
+    pub clearcoat_roughness: f32,
+}
+
+/// A texture's size, colour space and mip levels.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TrisortTextureInfo {
+    /// Width of level 0 in texels.
+    pub width: u32,
+    /// Height of level 0 in texels.
+    pub height: u32,
+    /// Whether the colour channels are sRGB-encoded (base colour, emissive: upload as
+    /// `GL_SRGB8_ALPHA8`) rather than linear data (metallic-roughness, normal, occlusion:
+    /// `GL_RGBA8`).
+    pub srgb: bool,
+    /// Levels stored, level 0 included: 1 without mips, else down to 1×1 (level k is
+    /// `max(1, width >> k)` × `max(1, height >> k)`).
+    pub level_count: u32,
 }
 
 /// glTF alpha mode.
@@ -647,7 +728,7 @@ pub unsafe extern "C" fn trisort_frame_draws(
     })
 }
 
-/// Copies the vertex streams of G, interleaved (40 bytes per vertex).
+/// Copies the vertex streams of G, interleaved (64 bytes per vertex).
 ///
 /// # Safety
 /// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
@@ -670,6 +751,8 @@ pub unsafe extern "C" fn trisort_vertices(
                 uv: v.uv,
                 material: v.material,
                 node: v.node,
+                tangent: v.tangent,
+                uv1: v.uv1,
             })
             .collect();
         copy_out(&v, out, cap, len)
@@ -802,14 +885,42 @@ pub unsafe extern "C" fn trisort_materials(
                     AlphaMode::Blend => TrisortAlphaMode::Blend,
                 },
                 double_sided: m.double_sided,
+                base_color_slot: TrisortTextureSlot::new(
+                    m.base_color_texture,
+                    m.base_color_tex_coord,
+                    &m.base_color_transform,
+                ),
+                metallic: m.metallic,
+                roughness: m.roughness,
+                metallic_roughness: TrisortTextureSlot::of(&m.metallic_roughness_texture),
+                normal: TrisortTextureSlot::of(&m.normal_texture),
+                normal_scale: m.normal_scale,
+                occlusion: TrisortTextureSlot::of(&m.occlusion_texture),
+                occlusion_strength: m.occlusion_strength,
+                emissive_texture: TrisortTextureSlot::of(&m.emissive_texture),
+                clearcoat: m.clearcoat,
+                clearcoat_roughness: m.clearcoat_roughness,
             })
             .collect();
         copy_out(&m, out, cap, len)
     })
 }
 
+fn texture_of(b: &Baked, texture: u32) -> Result<&Texture, Failure> {
+    b.geometry.textures.get(texture as usize).ok_or_else(|| {
+        Failure(
+            TrisortStatus::OutOfRange,
+            format!(
+                "texture {texture} is out of range ({} textures)",
+                b.geometry.textures.len()
+            ),
+        )
+    })
+}
+
 /// Stores texture `texture`'s size in `*width` and `*height` (either may be null) and copies
-/// its texels (RGBA8, sRGB, rows top to bottom; `cap` and `len` count bytes).
+/// its level-0 texels (RGBA8, rows top to bottom, sRGB or linear as
+/// [`trisort_texture_info`] says; `cap` and `len` count bytes).
 ///
 /// # Safety
 /// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
@@ -824,24 +935,75 @@ pub unsafe extern "C" fn trisort_texture(
     cap: usize,
     len: *mut usize,
 ) -> TrisortStatus {
+    trisort_texture_level(h, texture, 0, width, height, out, cap, len)
+}
+
+/// Stores texture `texture`'s size, colour space and level count in `*out`.
+///
+/// # Safety
+/// `h` is an open handle; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_texture_info(
+    h: *const TrisortBaked,
+    texture: u32,
+    out: *mut TrisortTextureInfo,
+) -> TrisortStatus {
     guard(|| {
-        let b = &handle(h, "handle")?.baked;
-        let t = b.geometry.textures.get(texture as usize).ok_or_else(|| {
-            Failure(
-                TrisortStatus::OutOfRange,
-                format!(
-                    "texture {texture} is out of range ({} textures)",
-                    b.geometry.textures.len()
-                ),
-            )
-        })?;
+        let t = texture_of(&handle(h, "handle")?.baked, texture)?;
+        if out.is_null() {
+            return Err(null("out"));
+        }
+        *out = TrisortTextureInfo {
+            width: t.width,
+            height: t.height,
+            srgb: t.srgb,
+            level_count: 1 + t.mips.len() as u32,
+        };
+        Ok(())
+    })
+}
+
+/// Stores the size of mip level `level` of texture `texture` in `*width` and `*height`
+/// (either may be null) and copies its texels (RGBA8, rows top to bottom; `cap` and `len`
+/// count bytes). Level 0 is the texture itself; levels run to the info's `level_count`.
+///
+/// # Safety
+/// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
+/// `len` as in the module conventions.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn trisort_texture_level(
+    h: *const TrisortBaked,
+    texture: u32,
+    level: u32,
+    width: *mut u32,
+    height: *mut u32,
+    out: *mut u8,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let t = texture_of(&handle(h, "handle")?.baked, texture)?;
+        let texels = match level {
+            0 => &t.rgba8,
+            k => t.mips.get(k as usize - 1).ok_or_else(|| {
+                Failure(
+                    TrisortStatus::OutOfRange,
+                    format!(
+                        "mip level {level} of texture {texture} is out of range ({} levels)",
+                        1 + t.mips.len()
+                    ),
+                )
+            })?,
+        };
+        let (w, ht) = Texture::level_size(t.width, t.height, level);
         if !width.is_null() {
-            *width = t.width;
+            *width = w;
         }
         if !height.is_null() {
-            *height = t.height;
+            *height = ht;
         }
-        copy_out(&t.rgba8, out, cap, len)
+        copy_out(texels, out, cap, len)
     })
 }
 

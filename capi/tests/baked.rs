@@ -9,7 +9,7 @@ use trisort_capi::ffi::*;
 use trisort_format::container::encode;
 use trisort_format::{
     Baked, DeviceInfo, DrawIndexedIndirectArgs, FileKind, FrameWindow, MergeInfo, MergeStats,
-    RecordSettings, Texture,
+    RecordSettings, Texture, TextureSlot, TextureTransform,
 };
 use trisort_testkit::fixtures::{frame_at, material, quad, scene};
 
@@ -27,6 +27,21 @@ fn sample() -> Baked {
         quad(&mut g, -1.0, 1.0, -1.0, 1.0, z, z, (k % 2) as u32);
     }
     g.materials[1].base_color_texture = Some(0);
+    g.materials[1].base_color_tex_coord = 1;
+    g.materials[1].base_color_transform.offset = [0.5, 0.25];
+    g.materials[0].metallic = 0.25;
+    g.materials[0].clearcoat = 0.75;
+    g.materials[0].normal_texture = Some(TextureSlot {
+        texture: 1,
+        tex_coord: 0,
+        transform: TextureTransform {
+            offset: [0.0; 2],
+            rotation: std::f32::consts::FRAC_PI_2,
+            scale: [2.0, 3.0],
+        },
+    });
+    g.vertices[5].tangent = [1.0, 0.0, 0.0, -1.0];
+    g.vertices[5].uv1 = [0.125, 0.875];
     g.textures.push(Texture {
         name: "t".into(),
         width: 2,
@@ -35,6 +50,8 @@ fn sample() -> Baked {
         srgb: true,
         mips: Vec::new(),
     });
+    let (normals, _) = Texture::with_mips("n".into(), 4, 2, vec![128; 32], false, 1024);
+    g.textures.push(normals);
     let copies = vec![0, 1, 2, 3, 4, 5, 6, 7, 2, 3];
     let draw = |first: u32, count: u32| DrawIndexedIndirectArgs {
         index_count: 3 * count,
@@ -105,7 +122,7 @@ fn counts_index_buffers_and_ranges_match_the_file() {
     assert_eq!((info.triangle_count, info.index_triangle_count), (8, 10));
     assert_eq!(
         (info.draw_count, info.material_count, info.texture_count),
-        (3, 2, 1)
+        (3, 2, 2)
     );
     assert!(info.fits_u16 && !info.depth_only);
     assert_eq!(info.recommended_mode, TrisortMode::Blend);
@@ -157,7 +174,18 @@ fn matrices_materials_and_textures() {
     let vertices: Vec<TrisortVertex> = get(|o, c, l| unsafe { trisort_vertices(h, o, c, l) });
     assert_eq!(vertices.len(), b.geometry.vertices.len());
     assert_eq!(vertices[5].position, b.geometry.vertices[5].position);
-    assert_eq!(std::mem::size_of::<TrisortVertex>(), 40);
+    assert_eq!(std::mem::size_of::<TrisortVertex>(), 64);
+    assert_eq!(
+        (vertices[5].tangent, vertices[5].uv1),
+        ([1.0, 0.0, 0.0, -1.0], [0.125, 0.875])
+    );
+    // The C struct is the file's vertex, byte for byte.
+    let bytes = |p: *const u8| unsafe { std::slice::from_raw_parts(p, 64) };
+    assert_eq!(std::mem::size_of::<trisort_format::Vertex>(), 64);
+    assert_eq!(
+        bytes((&b.geometry.vertices[5] as *const trisort_format::Vertex).cast()),
+        bytes((&vertices[5] as *const TrisortVertex).cast())
+    );
 
     let mut view = [0f32; 16];
     assert_eq!(
@@ -207,13 +235,75 @@ fn matrices_materials_and_textures() {
         ),
         (-1, 0)
     );
+    // Texture slots: index, set and the 2x3 matrix of the transform.
+    let base = materials[1].base_color_slot;
+    assert_eq!((base.texture, base.tex_coord), (0, 1));
+    assert_eq!(base.transform, [1.0, 0.0, 0.5, 0.0, 1.0, 0.25]);
+    let m0 = &materials[0];
+    assert_eq!((m0.metallic, m0.roughness, m0.clearcoat), (0.25, 1.0, 0.75));
+    assert_eq!((m0.normal.texture, m0.normal_scale), (1, 1.0));
+    let r = m0.normal.transform;
+    assert!((r[0]).abs() < 1e-6 && (r[1] - 3.0).abs() < 1e-6 && (r[3] + 2.0).abs() < 1e-6);
+    assert_eq!(
+        (m0.occlusion.texture, m0.emissive_texture.texture),
+        (-1, -1)
+    );
+    assert_eq!(
+        m0.metallic_roughness.transform,
+        [1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+    );
+    assert_eq!(
+        (
+            materials[0].base_color_slot.texture,
+            materials[0].base_color_texture
+        ),
+        (-1, -1)
+    );
+
     let (mut w, mut ht) = (0, 0);
     let texels: Vec<u8> = get(|o, c, l| unsafe { trisort_texture(h, 0, &mut w, &mut ht, o, c, l) });
     assert_eq!((w, ht, texels), (2, 1, vec![1, 2, 3, 4, 5, 6, 7, 8]));
+    let mut info = TrisortTextureInfo::default();
+    assert_eq!(
+        unsafe { trisort_texture_info(h, 0, &mut info) },
+        TrisortStatus::Ok
+    );
+    assert_eq!((info.srgb, info.level_count), (true, 1));
+    assert_eq!(
+        unsafe { trisort_texture_info(h, 1, &mut info) },
+        TrisortStatus::Ok
+    );
+    assert_eq!(
+        (info.width, info.height, info.srgb, info.level_count),
+        (4, 2, false, 3)
+    );
+    for (level, size) in [(0, (4, 2)), (1, (2, 1)), (2, (1, 1))] {
+        let texels: Vec<u8> =
+            get(|o, c, l| unsafe { trisort_texture_level(h, 1, level, &mut w, &mut ht, o, c, l) });
+        assert_eq!((w, ht), size);
+        assert_eq!(texels, vec![128; (size.0 * size.1 * 4) as usize]);
+    }
     let mut len = 0;
     assert_eq!(
-        unsafe { trisort_texture(h, 1, null_mut(), null_mut(), null_mut(), 0, &mut len) },
+        unsafe { trisort_texture_level(h, 1, 3, null_mut(), null_mut(), null_mut(), 0, &mut len) },
         TrisortStatus::OutOfRange
+    );
+    assert!(
+        last_error().contains("mip level 3 of texture 1"),
+        "{}",
+        last_error()
+    );
+    assert_eq!(
+        unsafe { trisort_texture(h, 2, null_mut(), null_mut(), null_mut(), 0, &mut len) },
+        TrisortStatus::OutOfRange
+    );
+    assert_eq!(
+        unsafe { trisort_texture_info(h, 2, &mut info) },
+        TrisortStatus::OutOfRange
+    );
+    assert_eq!(
+        unsafe { trisort_texture_info(h, 0, null_mut()) },
+        TrisortStatus::NullArgument
     );
     assert_eq!(
         unsafe { trisort_frame_view(h, 0, null_mut()) },

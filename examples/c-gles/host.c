@@ -155,10 +155,12 @@ static const char *VS =
     "layout(location = 2) in vec2 a_uv;\n"
     "layout(location = 3) in uint a_material;\n"
     "layout(location = 4) in uint a_node;\n"
+    "layout(location = 5) in vec2 a_uv1;\n"
     "uniform mat4 u_proj;\n"
     "uniform highp sampler2D u_nodes;\n" /* 4 texels (columns) per node: view x world */
     "flat out uint v_material;\n"
     "out vec2 v_uv;\n"
+    "out vec2 v_uv1;\n"
     "out vec3 v_normal;\n"
     "invariant gl_Position;\n"
     "void main() {\n"
@@ -168,6 +170,7 @@ static const char *VS =
     "  gl_Position = u_proj * (m * vec4(a_position, 1.0));\n"
     "  v_material = a_material;\n"
     "  v_uv = a_uv;\n"
+    "  v_uv1 = a_uv1;\n"
     "  v_normal = (m * vec4(a_normal, 0.0)).xyz;\n"
     "}\n";
 
@@ -178,9 +181,12 @@ static const char *FS =
     "precision highp sampler2DArray;\n"
     "flat in uint v_material;\n"
     "in vec2 v_uv;\n"
+    "in vec2 v_uv1;\n"
     "in vec3 v_normal;\n"
-    /* 4 texels per material: base colour; emissive + transmission; alpha mode, cutoff,
-     * double sided, texture layer (-1: none); uv scale into the layer. */
+    /* 6 texels per material: base colour; emissive + transmission; alpha mode, cutoff,
+     * double sided, texture layer (-1: none); uv scale into the layer; the base-colour
+     * texture's KHR_texture_transform rows (u', v') with its texture coordinate set in the
+     * first row's w. */
     "uniform highp sampler2D u_materials;\n"
     "uniform sampler2DArray u_textures;\n"
     "uniform vec4 u_light;\n"
@@ -193,9 +199,13 @@ static const char *FS =
     "  vec4 emissive = texelFetch(u_materials, ivec2(1, mi), 0);\n"
     "  vec4 params = texelFetch(u_materials, ivec2(2, mi), 0);\n"
     "  vec4 uv_scale = texelFetch(u_materials, ivec2(3, mi), 0);\n"
+    "  vec4 tu = texelFetch(u_materials, ivec2(4, mi), 0);\n"
+    "  vec4 tv = texelFetch(u_materials, ivec2(5, mi), 0);\n"
+    "  vec3 st = vec3(tu.w > 0.5 ? v_uv1 : v_uv, 1.0);\n"
+    "  vec2 uv = vec2(dot(tu.xyz, st), dot(tv.xyz, st));\n"
     "  if (params.z < 0.5 && !gl_FrontFacing) discard;\n"
     "  vec4 c = base;\n"
-    "  if (params.w >= 0.0) c *= textureLod(u_textures, vec3(fract(v_uv) * uv_scale.xy, params.w), 0.0);\n"
+    "  if (params.w >= 0.0) c *= textureLod(u_textures, vec3(fract(uv) * uv_scale.xy, params.w), 0.0);\n"
     "  int mode = int(params.x);\n"
     "  if (emissive.a > 0.0) c.a = u_glass_opacity;\n"
     "  else if (mode == 0) c.a = 1.0;\n"
@@ -255,14 +265,14 @@ static void open_gles(void) {
             (const char *)glGetString(GL_RENDERER), (const char *)glGetString(GL_VERSION));
 }
 
-/* A sampled RGBA32F data texture, `height` rows of 4 texels. */
-static GLuint data_texture(GLsizei height, const float *texels) {
+/* A sampled RGBA32F data texture, `height` rows of `width` texels. */
+static GLuint data_texture(GLsizei width, GLsizei height, const float *texels) {
     GLuint t;
     glGenTextures(1, &t);
     glBindTexture(GL_TEXTURE_2D, t);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, 4, height, 0, GL_RGBA, GL_FLOAT, texels);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, texels);
     return t;
 }
 
@@ -326,6 +336,9 @@ int main(int argc, char **argv) {
     glVertexAttribIPointer(3, 1, GL_UNSIGNED_INT, sizeof(TrisortVertex), (void *)32);
     glEnableVertexAttribArray(4);
     glVertexAttribIPointer(4, 1, GL_UNSIGNED_INT, sizeof(TrisortVertex), (void *)36);
+    /* The tangent at byte 40 is not used: this host shades with its normals alone. */
+    glEnableVertexAttribArray(5);
+    glVertexAttribPointer(5, 2, GL_FLOAT, GL_FALSE, sizeof(TrisortVertex), (void *)56);
     free(vertices);
 
     /* The sorted index buffer, reversed for back-to-front blending; u16 where it fits. */
@@ -378,14 +391,14 @@ int main(int argc, char **argv) {
     }
     check_gl("textures");
 
-    /* Materials: 4 texels each. */
+    /* Materials: 6 texels each. */
     check(trisort_materials(h, NULL, 0, &nm), "trisort_materials");
     materials = xmalloc(nm * sizeof *materials);
     check(trisort_materials(h, materials, nm, &nm), "trisort_materials");
-    material_texels = xmalloc(nm * 16 * sizeof(float));
+    material_texels = xmalloc(nm * 24 * sizeof(float));
     for (k = 0; k < nm; k++) {
         const TrisortMaterial *m = &materials[k];
-        float *p = material_texels + 16 * k;
+        float *p = material_texels + 24 * k;
         float sx = 1.0f, sy = 1.0f;
         if (m->base_color_texture >= 0) {
             uint32_t tx, ty;
@@ -406,15 +419,19 @@ int main(int argc, char **argv) {
         p[13] = sy;
         p[14] = 0.0f;
         p[15] = 0.0f;
+        memcpy(p + 16, m->base_color_slot.transform, 3 * sizeof(float));
+        p[19] = (float)m->base_color_slot.tex_coord;
+        memcpy(p + 20, m->base_color_slot.transform + 3, 3 * sizeof(float));
+        p[23] = 0.0f;
     }
-    materials_tex = data_texture((GLsizei)nm, material_texels);
+    materials_tex = data_texture(6, (GLsizei)nm, material_texels);
     free(material_texels);
     free(materials);
 
     check(trisort_frame_node_matrices(h, 0, true, NULL, 0, &nn), "trisort_frame_node_matrices");
     node_texels = xmalloc(nn * sizeof(float));
     check(trisort_frame_node_matrices(h, 0, true, node_texels, nn, &nn), "trisort_frame_node_matrices");
-    nodes_tex = data_texture((GLsizei)(nn / 16), node_texels);
+    nodes_tex = data_texture(4, (GLsizei)(nn / 16), node_texels);
 
     prog = glCreateProgram();
     glAttachShader(prog, compile(GL_VERTEX_SHADER, VS));
