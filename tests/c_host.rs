@@ -1,6 +1,7 @@
 //! The C host (examples/c-gles/host.c): built with the system C compiler against the C API's
 //! static library and Mesa's EGL/GLES, it draws the demo bake through `trisort.h` with its own
-//! shaders, and its frames must match the Rust player's on the same CPU driver.
+//! shaders (the basic model: one light plus ambient), and its frames must match the Rust
+//! player's `--shading basic` on the same CPU driver.
 //!
 //! Tolerance: at most 0.5% of a frame's pixels may differ by more than 2/255 in a channel
 //! (rasterizers of two APIs may place an edge sample differently). Measured on Mesa 22.3.6
@@ -126,6 +127,9 @@ fn c_host_draws_the_demo_bake_like_the_player() {
                 mode,
                 "--backend",
                 "vulkan",
+                // The C host implements the basic model only (one light plus ambient).
+                "--shading",
+                "basic",
             ],
             true,
         );

@@ -180,13 +180,20 @@ fn depth_reference_equals_the_plain_z_buffer_on_opaque_scenes() {
     );
     let frames = [frame_at(DVec3::ZERO), frame_at(DVec3::new(0.2, -0.1, 0.3))];
     let s = settings(64, 4);
-    let zbuffer = trisort_reference::exact::whole_scene_baked(&g, &frames, s);
+    // Lit alike: the z-buffer bake and the reference under the default (uniform) environment.
+    let lighting = trisort_gpu::Lighting::default();
+    let zbuffer = trisort_reference::exact::whole_scene_baked(&g, &frames, s, lighting.environment);
     let played =
         trisort_player::render_frames(&gpu, &zbuffer, &[0, 1], (64, 64), 4, Mode::Depth, None)
             .expect("z-buffer renders");
-    let reference =
-        trisort_reference::ExactReference::new(&gpu, &g, &frames, reference_config(Mode::Depth))
-            .expect("reference");
+    let reference = trisort_reference::ExactReference::new(
+        &gpu,
+        &g,
+        &frames,
+        lighting,
+        reference_config(Mode::Depth),
+    )
+    .expect("reference");
     for f in 0..2 {
         let r = reference.render(f, None).expect("reference frame");
         assert_eq!(r.rgba8, played[f as usize].rgba8, "frame {f}");
@@ -355,11 +362,17 @@ fn default_pipeline_is_exact_only_when_id_order_is_back_to_front() {
         glass_opacity: 0.0,
     };
     let render = |g: &Geometry| {
-        let default = trisort_reference::DefaultRenderer::new(&gpu, g, &frames, view)
+        let lighting = trisort_gpu::Lighting::default();
+        let default = trisort_reference::DefaultRenderer::new(&gpu, g, &frames, view, lighting)
             .expect("default pipeline");
-        let reference =
-            trisort_reference::ExactReference::new(&gpu, g, &frames, reference_config(Mode::Blend))
-                .expect("reference");
+        let reference = trisort_reference::ExactReference::new(
+            &gpu,
+            g,
+            &frames,
+            lighting,
+            reference_config(Mode::Blend),
+        )
+        .expect("reference");
         let d = default.render(0).expect("default frame");
         let r = reference.render(0, None).expect("reference frame");
         trisort_reference::compare(&d, &r.rgba8, 64, 64, &[])

@@ -145,6 +145,8 @@ impl<'g> PlayerMethod<'g> {
             glass_opacity: Some(view.glass_opacity),
             draw_path: DrawPath::for_device(&gpu.adapter, &gpu.device),
             device: None,
+            shading: trisort_gpu::Shading::Pbr,
+            tone_map: trisort_gpu::ToneMap::Neutral,
         };
         let player = Player::new(&gpu.device, &gpu.queue, baked, config)?;
         let order = if mode.back_to_front() {
@@ -289,14 +291,21 @@ pub struct DefaultMethod<'g> {
 }
 
 impl<'g> DefaultMethod<'g> {
-    /// Uploads the whole scene.
+    /// Uploads the whole scene, lit by `environment` (the bake's).
     pub fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
+        environment: &trisort_format::Environment,
         view: BenchView,
     ) -> Result<DefaultMethod<'g>, BenchError> {
-        let renderer = DefaultRenderer::new(gpu, geometry, frames, view.view())?;
+        let renderer = DefaultRenderer::new(
+            gpu,
+            geometry,
+            frames,
+            view.view(),
+            trisort_gpu::Lighting::pbr(environment),
+        )?;
         let target = FrameTarget::new(
             &gpu.adapter,
             &gpu.device,
@@ -379,9 +388,10 @@ pub fn default_depth<'g>(
     geometry: &Geometry,
     frames: &[FrameState],
     settings: trisort_format::RecordSettings,
+    environment: &trisort_format::Environment,
     view: BenchView,
 ) -> Result<PlayerMethod<'g>, BenchError> {
-    let baked = whole_scene_baked(geometry, frames, settings);
+    let baked = whole_scene_baked(geometry, frames, settings, environment);
     PlayerMethod::new(
         "default",
         "all triangles, depth test".into(),

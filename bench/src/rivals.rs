@@ -2,7 +2,7 @@
 //! and GPU depth peeling (both in `trisort-reference`).
 
 use trisort_format::{FrameState, Geometry};
-use trisort_gpu::Gpu;
+use trisort_gpu::{Gpu, Lighting};
 use trisort_player::Mode;
 use trisort_reference::{OitConfig, OitRenderer, PeelingConfig, PeelingRenderer};
 
@@ -17,18 +17,19 @@ pub struct OitMethod<'g> {
 }
 
 impl<'g> OitMethod<'g> {
-    /// Uploads the whole scene with the default fragment budget.
+    /// Uploads the whole scene with the default fragment budget, lit by `environment`.
     pub fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
+        environment: &trisort_format::Environment,
         view: BenchView,
     ) -> Result<OitMethod<'g>, BenchError> {
         let config = OitConfig {
             glass_opacity: view.glass_opacity,
             ..OitConfig::new(view.size, view.samples)
         };
-        let renderer = OitRenderer::new(gpu, geometry, frames, config)?;
+        let renderer = OitRenderer::new(gpu, geometry, frames, Lighting::pbr(environment), config)?;
         Ok(OitMethod {
             gpu,
             renderer,
@@ -90,6 +91,7 @@ impl<'g> PeelingMethod<'g> {
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
+        environment: &trisort_format::Environment,
         view: BenchView,
         mode: Mode,
         max_layers: u32,
@@ -98,7 +100,8 @@ impl<'g> PeelingMethod<'g> {
             glass_opacity: view.glass_opacity,
             ..PeelingConfig::new(view.size, view.samples, mode, max_layers)
         };
-        let renderer = PeelingRenderer::new(gpu, geometry, frames, config)?;
+        let renderer =
+            PeelingRenderer::new(gpu, geometry, frames, Lighting::pbr(environment), config)?;
         Ok(PeelingMethod {
             gpu,
             renderer,
@@ -180,6 +183,7 @@ pub(crate) fn build<'g>(
                 gpu,
                 input.geometry,
                 input.frame_states,
+                &input.baked.environment,
                 input.view,
             )?))
         }
@@ -189,6 +193,7 @@ pub(crate) fn build<'g>(
                 gpu,
                 input.geometry,
                 input.frame_states,
+                &input.baked.environment,
                 input.view,
                 input.mode,
                 input.baked.settings.max_layers.max(1),

@@ -254,6 +254,7 @@ fn build_methods<'a>(
                         input.geometry,
                         input.frame_states,
                         input.baked.settings,
+                        &input.baked.environment,
                         view,
                     )?)
                 } else {
@@ -261,6 +262,7 @@ fn build_methods<'a>(
                         gpu,
                         input.geometry,
                         input.frame_states,
+                        &input.baked.environment,
                         view,
                     )?)
                 };
@@ -362,6 +364,7 @@ fn count_frames(
         gpu,
         input.geometry,
         input.frame_states,
+        trisort_gpu::Lighting::pbr(&input.baked.environment),
         ReferenceConfig {
             size: view.size,
             samples: view.samples,

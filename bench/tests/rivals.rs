@@ -4,6 +4,7 @@
 //! and (peeling) `depth` mode; the default pipeline does not.
 
 use trisort_gpu::scene_gpu::View;
+use trisort_gpu::Lighting;
 use trisort_player::Mode;
 use trisort_reference::{
     DefaultRenderer, ExactReference, OitConfig, OitRenderer, PeelingConfig, PeelingRenderer,
@@ -38,11 +39,13 @@ fn oit_and_peeling_equal_the_reference_on_glass_vase_flowers() {
                 max_layers: 4096,
             };
             let exact =
-                ExactReference::new(&gpu, &scene.geometry, &frames, config).expect("reference");
+                ExactReference::new(&gpu, &scene.geometry, &frames, Lighting::default(), config)
+                    .expect("reference");
             let peeling = PeelingRenderer::new(
                 &gpu,
                 &scene.geometry,
                 &frames,
+                Lighting::default(),
                 PeelingConfig {
                     glass_opacity: glass,
                     ..PeelingConfig::new(size, samples, mode, 4096)
@@ -54,7 +57,8 @@ fn oit_and_peeling_equal_the_reference_on_glass_vase_flowers() {
                     glass_opacity: glass,
                     ..OitConfig::new(size, samples)
                 };
-                OitRenderer::new(&gpu, &scene.geometry, &frames, config).expect("oit")
+                OitRenderer::new(&gpu, &scene.geometry, &frames, Lighting::default(), config)
+                    .expect("oit")
             });
             let default = (mode == Mode::Blend).then(|| {
                 DefaultRenderer::new(
@@ -67,6 +71,7 @@ fn oit_and_peeling_equal_the_reference_on_glass_vase_flowers() {
                         samples,
                         glass_opacity: glass,
                     },
+                    Lighting::default(),
                 )
                 .expect("default")
             });

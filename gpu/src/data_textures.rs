@@ -10,7 +10,7 @@ use crate::scene_gpu::{FrameData, SharedBindings, DATA_WIDTH};
 
 /// The bind group layout of group 0 on the texture tier.
 pub(crate) fn texture_tier_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let base_colour = crate::scene_gpu::base_colour_entries();
+    let surface = crate::scene_gpu::surface_entries();
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let uniform = |binding, size: u64| wgpu::BindGroupLayoutEntry {
         binding,
@@ -41,9 +41,13 @@ pub(crate) fn texture_tier_layout(device: &wgpu::Device) -> wgpu::BindGroupLayou
             ),
             uniform(1, 16),
             data(2),
-            base_colour[0],
-            base_colour[1],
+            surface[0],
+            surface[1],
             data(5),
+            surface[2],
+            surface[3],
+            surface[4],
+            surface[5],
         ],
     })
 }
@@ -142,19 +146,22 @@ pub(crate) fn bind_group(
         label: Some("trisort scene (data textures)"),
         layout: &layout,
         entries: &[
-            shared.frame,
-            crate::scene_gpu::sized_buffer_entry(1, &base_buffer, 16),
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(&materials),
-            },
-            shared.texture,
-            shared.sampler,
-            wgpu::BindGroupEntry {
-                binding: 5,
-                resource: wgpu::BindingResource::TextureView(&nodes),
-            },
-        ],
+            [
+                shared.frame,
+                crate::scene_gpu::sized_buffer_entry(1, &base_buffer, 16),
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&materials),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&nodes),
+                },
+            ]
+            .as_slice(),
+            &shared.surface,
+        ]
+        .concat(),
     });
     (
         layout,

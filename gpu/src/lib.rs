@@ -29,7 +29,7 @@ pub use readback::{f16_to_f32, halves, linear_to_srgb, poll_ready, quantize_rgba
 pub use target::{clear_colour, FrameTarget, TargetConfig, BACKGROUND, COLOR_FORMAT, DEPTH_FORMAT};
 pub use timer::GpuTimer;
 pub mod scene_gpu;
-pub use scene_gpu::Bindings;
+pub use scene_gpu::{Bindings, Lighting, Shading, ToneMap};
 
 /// The shared bindings, vertex layout, vertex transform and surface functions.
 pub const COMMON: &str = include_str!("wgsl/common.wgsl");
@@ -312,6 +312,6 @@ pub const STORAGE_BINDINGS: &str = include_str!("wgsl/storage.wgsl");
 pub const TEXTURE_BINDINGS: &str = include_str!("wgsl/textures.wgsl");
 
 /// Size in bytes of the `Frame` uniform of [`COMMON`].
-pub const FRAME_UNIFORM_SIZE: u64 = 64 + 16 + 16;
+pub const FRAME_UNIFORM_SIZE: u64 = 64 + 16 + 16 + 48;
 /// Size in bytes of one `MaterialGpu` of [`COMMON`].
-pub const MATERIAL_SIZE: u64 = 64;
+pub const MATERIAL_SIZE: u64 = 20 * 16;

@@ -1,14 +1,18 @@
 //! GPU resources of a scene shared by every pipeline: the vertex buffer, the materials, the
-//! base-colour texture array, and per-frame uniforms and camera-relative node matrices bound by
-//! dynamic offset (group 0 of [`crate::COMMON`]).
+//! texture arrays (sRGB and linear, with mips), the environment light, and per-frame uniforms
+//! and camera-relative node matrices bound by dynamic offset (group 0 of [`crate::COMMON`]).
 
 use bytemuck::{Pod, Zeroable};
-use trisort_format::{AlphaMode, FrameState, Geometry, Material, Vertex};
+use trisort_format::{
+    AlphaMode, Environment, FrameState, Geometry, Material, TextureTransform, Vertex,
+};
 use wgpu::util::DeviceExt;
 
-/// Vertex buffer layout of [`Vertex`] (locations 0–4 of `VertexIn`).
-pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
-    0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32, 4 => Uint32
+/// Vertex buffer layout of [`Vertex`] (locations 0–6 of `VertexIn`: position, normal, uv,
+/// material, node, tangent, uv1).
+pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 7] = wgpu::vertex_attr_array![
+    0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32, 4 => Uint32,
+    5 => Float32x4, 6 => Float32x2
 ];
 
 /// The vertex buffer layout for pipelines.
@@ -30,6 +34,8 @@ pub struct FrameUniform {
     pub light: [f32; 4],
     /// Glass opacity, width, height, sample count.
     pub params: [f32; 4],
+    /// Columns (xyz) of the view-to-world rotation: environment lookups are in world space.
+    pub view_to_world: [[f32; 4]; 3],
 }
 
 /// The `MaterialGpu` struct of the shared WGSL.
@@ -39,7 +45,180 @@ pub struct MaterialGpu {
     base_color: [f32; 4],
     emissive: [f32; 4],
     params: [f32; 4],
-    uv_scale: [f32; 4],
+    pbr: [f32; 4],
+    coat: [f32; 4],
+    /// Base colour, metallic-roughness, normal, occlusion, emissive: u row, v row, scale.
+    slots: [[[f32; 4]; 3]; 5],
+}
+
+/// The `Lighting` uniform of the shared WGSL (binding 7).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LightingUniform {
+    /// Irradiance / π, spherical harmonics (rgb).
+    pub sh: [[f32; 4]; 9],
+    /// World direction towards the sun (xyz), 1 with a sun (w).
+    pub sun_direction: [f32; 4],
+    /// Sun radiance.
+    pub sun_color: [f32; 4],
+    /// Exposure, shading (0 basic, 1 pbr), tone map (0 neutral, 1 ACES), last mip level.
+    pub params: [f32; 4],
+}
+
+/// The surface model the shaders light with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Shading {
+    /// One view-space directional light plus ambient, plus the emissive factor, no tone map:
+    /// what trisort drew before physically based shading (the C host draws this).
+    Basic,
+    /// glTF metallic-roughness with normal, occlusion, emissive maps and clearcoat, lit by the
+    /// baked file's environment and sun, exposed and tone mapped.
+    #[default]
+    Pbr,
+}
+
+impl Shading {
+    /// Every model, by name.
+    pub const ALL: [Shading; 2] = [Shading::Basic, Shading::Pbr];
+
+    /// A short name (`basic`, `pbr`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Shading::Basic => "basic",
+            Shading::Pbr => "pbr",
+        }
+    }
+}
+
+impl std::str::FromStr for Shading {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Shading, String> {
+        Shading::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown shading {s:?}: expected basic or pbr"))
+    }
+}
+
+impl std::fmt::Display for Shading {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The tone mapping of [`Shading::Pbr`] (after exposure, before blending).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ToneMap {
+    /// Khronos PBR Neutral.
+    #[default]
+    Neutral,
+    /// ACES filmic (Narkowicz's fit).
+    Aces,
+}
+
+impl ToneMap {
+    /// Every tone map, by name.
+    pub const ALL: [ToneMap; 2] = [ToneMap::Neutral, ToneMap::Aces];
+
+    /// A short name (`neutral`, `aces`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneMap::Neutral => "neutral",
+            ToneMap::Aces => "aces",
+        }
+    }
+}
+
+impl std::str::FromStr for ToneMap {
+    type Err = String;
+    fn from_str(s: &str) -> Result<ToneMap, String> {
+        ToneMap::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown tone map {s:?}: expected neutral or aces"))
+    }
+}
+
+impl std::fmt::Display for ToneMap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// How a scene is lit: the surface model, the tone map and the environment (a baked file's
+/// [`trisort_format::Baked::environment`], so every player of it lights alike).
+#[derive(Clone, Copy, Debug)]
+pub struct Lighting<'a> {
+    /// Surface model.
+    pub shading: Shading,
+    /// Tone map (for [`Shading::Pbr`]).
+    pub tone_map: ToneMap,
+    /// Environment and sun.
+    pub environment: &'a Environment,
+}
+
+impl Default for Lighting<'static> {
+    /// [`Shading::Pbr`], [`ToneMap::Neutral`], under a uniform environment of radiance 1 and no
+    /// sun (`Environment::uniform(1.0)`, what a bake without another environment stores).
+    fn default() -> Lighting<'static> {
+        static UNIFORM: std::sync::LazyLock<Environment> =
+            std::sync::LazyLock::new(|| Environment::uniform(1.0));
+        Lighting {
+            shading: Shading::Pbr,
+            tone_map: ToneMap::Neutral,
+            environment: &UNIFORM,
+        }
+    }
+}
+
+impl<'a> Lighting<'a> {
+    /// [`Shading::Pbr`] with [`ToneMap::Neutral`] under `environment`.
+    pub fn pbr(environment: &'a Environment) -> Lighting<'a> {
+        Lighting {
+            shading: Shading::Pbr,
+            tone_map: ToneMap::Neutral,
+            environment,
+        }
+    }
+}
+
+impl LightingUniform {
+    /// The uniform for `lighting`, whose prefiltered radiance was uploaded with `levels` mip
+    /// levels.
+    pub fn new(lighting: &Lighting<'_>, levels: u32) -> LightingUniform {
+        let env = lighting.environment;
+        let mut sh = [[0.0; 4]; 9];
+        for (d, s) in sh.iter_mut().zip(&env.sh) {
+            *d = [s[0], s[1], s[2], 0.0];
+        }
+        let (sun_direction, sun_color) = match &env.sun {
+            Some(sun) => {
+                let d = glam::Vec3::from(sun.direction).normalize_or_zero();
+                (
+                    [d.x, d.y, d.z, if d == glam::Vec3::ZERO { 0.0 } else { 1.0 }],
+                    [sun.color[0], sun.color[1], sun.color[2], 0.0],
+                )
+            }
+            None => ([0.0; 4], [0.0; 4]),
+        };
+        LightingUniform {
+            sh,
+            sun_direction,
+            sun_color,
+            params: [
+                env.exposure,
+                match lighting.shading {
+                    Shading::Basic => 0.0,
+                    Shading::Pbr => 1.0,
+                },
+                match lighting.tone_map {
+                    ToneMap::Neutral => 0.0,
+                    ToneMap::Aces => 1.0,
+                },
+                levels.saturating_sub(1) as f32,
+            ],
+        }
+    }
 }
 
 /// The view-space light of every pipeline: towards upper left behind the viewer; ambient 0.35.
@@ -78,10 +257,12 @@ pub struct SceneGpu {
     view: View,
     /// Where the material table lives (rewritten by [`SceneGpu::set_materials`]).
     material_store: MaterialStore,
-    /// Per texture, its uv scale in the array (for rewriting the material table).
-    uv_scales: Vec<[f32; 2]>,
+    /// Per texture, where it lies in the arrays (for rewriting the material table).
+    texture_places: Vec<TexturePlace>,
     /// Number of materials uploaded.
     material_count: usize,
+    /// [`SceneGpu::texture_bytes`].
+    texture_bytes: u64,
 }
 
 /// The material table on the GPU: a storage buffer, or the texture tier's data texture.
@@ -181,7 +362,7 @@ pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 
 /// Creates the bind group layout of group 0 for `bindings`.
 pub fn bind_group_layout_for(device: &wgpu::Device, bindings: Bindings) -> wgpu::BindGroupLayout {
-    let base_colour = base_colour_entries();
+    let surface = surface_entries();
     let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     if bindings == Bindings::Textures {
         return crate::data_textures::texture_tier_layout(device);
@@ -221,8 +402,12 @@ pub fn bind_group_layout_for(device: &wgpu::Device, bindings: Bindings) -> wgpu:
                 },
                 count: None,
             },
-            base_colour[0],
-            base_colour[1],
+            surface[0],
+            surface[1],
+            surface[2],
+            surface[3],
+            surface[4],
+            surface[5],
         ],
     })
 }
@@ -244,26 +429,44 @@ pub(crate) fn sized_buffer_entry(
     }
 }
 
-/// Bindings 3 and 4 of every tier's scene group: the base-colour texture array and its
-/// filtering sampler, read by the fragment stage.
-pub(crate) fn base_colour_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
+/// Bindings 3, 4 and 6–9 of every tier's scene group, read by the fragment stage: the sRGB
+/// texture array (3), the material sampler (4), the linear texture array (6), the `Lighting`
+/// uniform (7), the prefiltered environment (8) and its sampler (9).
+pub(crate) fn surface_entries() -> [wgpu::BindGroupLayoutEntry; 6] {
+    let texture = |binding, view_dimension| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension,
+            multisampled: false,
+        },
+        count: None,
+    };
+    let sampler = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    };
     [
+        texture(3, wgpu::TextureViewDimension::D2Array),
+        sampler(4),
+        texture(6, wgpu::TextureViewDimension::D2Array),
         wgpu::BindGroupLayoutEntry {
-            binding: 3,
+            binding: 7,
             visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2Array,
-                multisampled: false,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(
+                    std::mem::size_of::<LightingUniform>() as u64
+                ),
             },
             count: None,
         },
-        wgpu::BindGroupLayoutEntry {
-            binding: 4,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-            count: None,
-        },
+        texture(8, wgpu::TextureViewDimension::D2),
+        sampler(9),
     ]
 }
 
@@ -336,11 +539,14 @@ pub fn begin_peel_pass<'e>(
 
 impl SceneGpu {
     /// Uploads the geometry, materials, textures and the uniforms of every frame, on the
-    /// storage tier ([`SceneGpu::with_bindings`] with [`Bindings::Storage`]).
+    /// storage tier ([`SceneGpu::with_bindings`] with [`Bindings::Storage`]), lit by
+    /// [`Shading::Pbr`] under a uniform environment of radiance 1 (what the recorder and tools
+    /// that only need visibility use; players light with [`SceneGpu::with_lighting`]).
     ///
-    /// Textures share one array: each layer is as large as the largest texture, and a
-    /// texture smaller than that fills the top-left corner (its uv scaled to fit), so one bind
-    /// group serves every material. Node matrices are computed in f64 and cast once.
+    /// Textures share two arrays (sRGB and linear, each texture in the array of its colour
+    /// space, with its mips): each layer is as large as the array's largest texture, and a
+    /// smaller texture fills the top-left corner of every level (its uv scaled to fit), so one
+    /// bind group serves every material. Node matrices are computed in f64 and cast once.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -361,6 +567,21 @@ impl SceneGpu {
         view: View,
         bindings: Bindings,
     ) -> SceneGpu {
+        let lighting = Lighting::default();
+        SceneGpu::with_lighting(device, queue, geometry, frames, view, bindings, lighting)
+    }
+
+    /// [`SceneGpu::with_bindings`] lit as `lighting` says (the player and the reference pass
+    /// the baked file's environment, so both light alike).
+    pub fn with_lighting(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+        bindings: Bindings,
+        lighting: Lighting<'_>,
+    ) -> SceneGpu {
         let limits = device.limits();
         let vertex_bytes: &[u8] = if geometry.vertices.is_empty() {
             &[0u8; std::mem::size_of::<Vertex>()]
@@ -372,16 +593,33 @@ impl SceneGpu {
             contents: vertex_bytes,
             usage: wgpu::BufferUsages::VERTEX,
         });
-        let (texture_view, uv_scales) = upload_textures(device, queue, geometry);
+        let textures = upload_textures(device, queue, geometry);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("base colour"),
+            label: Some("material textures"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
             ..Default::default()
         });
-        let materials = material_table(&geometry.materials, &uv_scales);
+        let env = upload_environment(device, queue, lighting.environment);
+        let environment_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("environment"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let lighting_uniform = LightingUniform::new(&lighting, env.levels);
+        let lighting_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("lighting"),
+            contents: bytemuck::bytes_of(&lighting_uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let materials = material_table(&geometry.materials, &textures.places);
         // The texture tier packs every frame's matrices contiguously (64 bytes a node).
         let node_align = match bindings {
             Bindings::Storage => limits.min_storage_buffer_offset_alignment as u64,
@@ -393,6 +631,14 @@ impl SceneGpu {
             contents: &data.frame_bytes,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
+        let view_entry = |binding, view| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(view),
+        };
+        let sampler_entry = |binding, sampler| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::Sampler(sampler),
+        };
         let shared = SharedBindings {
             frame: wgpu::BindGroupEntry {
                 binding: 0,
@@ -402,14 +648,17 @@ impl SceneGpu {
                     size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniform>() as u64),
                 }),
             },
-            texture: wgpu::BindGroupEntry {
-                binding: 3,
-                resource: wgpu::BindingResource::TextureView(&texture_view),
-            },
-            sampler: wgpu::BindGroupEntry {
-                binding: 4,
-                resource: wgpu::BindingResource::Sampler(&sampler),
-            },
+            surface: [
+                view_entry(3, &textures.srgb),
+                sampler_entry(4, &sampler),
+                view_entry(6, &textures.linear),
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: lighting_buffer.as_entire_binding(),
+                },
+                view_entry(8, &env.view),
+                sampler_entry(9, &environment_sampler),
+            ],
         };
         let (layout, bind_group, node_stride, material_store) = match bindings {
             Bindings::Storage => storage_bind_group(device, shared, &data, &materials),
@@ -437,9 +686,16 @@ impl SceneGpu {
             frame_buffer,
             view,
             material_store,
-            uv_scales,
+            texture_places: textures.places,
             material_count: geometry.materials.len(),
+            texture_bytes: textures.bytes + env.bytes,
         }
+    }
+
+    /// Bytes of GPU memory the scene's textures take: both material texture arrays with every
+    /// mip level of every layer (unused corners included), and the prefiltered environment.
+    pub fn texture_bytes(&self) -> u64 {
+        self.texture_bytes
     }
 
     /// Rewrites the material table with `materials` in place of the uploaded ones (a material
@@ -452,7 +708,7 @@ impl SceneGpu {
             self.material_count,
             "a material table replaces one of the same length"
         );
-        let table = material_table(materials, &self.uv_scales);
+        let table = material_table(materials, &self.texture_places);
         let bytes: &[u8] = bytemuck::cast_slice(&table);
         match &self.material_store {
             MaterialStore::Buffer(buffer) => queue.write_buffer(buffer, 0, bytes),
@@ -537,6 +793,14 @@ pub fn subpixel_shift(offset: [f64; 2], view: View) -> glam::DMat4 {
 /// The `Frame` uniform for one frame at a view.
 pub fn frame_uniform(state: &FrameState, view: View) -> FrameUniform {
     let proj = projection(state, view).as_mat4();
+    let rotation = glam::DMat3::from_mat4(state.camera.view_matrix());
+    let to_world = if rotation.determinant().abs() > 1e-300 {
+        rotation.inverse()
+    } else {
+        glam::DMat3::IDENTITY
+    }
+    .as_mat3();
+    let column = |c: glam::Vec3| [c.x, c.y, c.z, 0.0];
     FrameUniform {
         proj: proj.to_cols_array_2d(),
         light: LIGHT,
@@ -546,25 +810,133 @@ pub fn frame_uniform(state: &FrameState, view: View) -> FrameUniform {
             view.height as f32,
             view.samples as f32,
         ],
+        view_to_world: [
+            column(to_world.x_axis),
+            column(to_world.y_axis),
+            column(to_world.z_axis),
+        ],
     }
 }
 
-/// Uploads the base-colour textures into one array (each layer as large as the largest
-/// texture, clamped to the device's limit; smaller textures fill the top-left corner) and
-/// returns its view and each texture's uv scale. A scene without textures gets one white
-/// texel. On GL the array has two layers at least (see the comment inside).
-fn upload_textures(
+/// Where a texture lies on the GPU: its array (sRGB or linear), layer, and the uv scale of the
+/// corner it fills at level 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct TexturePlace {
+    linear: bool,
+    layer: u32,
+    scale: [f32; 2],
+}
+
+/// The two material texture arrays.
+struct Textures {
+    srgb: wgpu::TextureView,
+    linear: wgpu::TextureView,
+    /// Per texture of the geometry.
+    places: Vec<TexturePlace>,
+    /// Bytes both arrays take with every level.
+    bytes: u64,
+}
+
+/// Number of mip levels of a full chain for a `w` × `h` level 0.
+fn full_chain(w: u32, h: u32) -> u32 {
+    32 - w.max(h).max(1).leading_zeros()
+}
+
+/// Level `k` of `t` (RGBA8, `max(1, w >> k)` × `max(1, h >> k)`): level 0, a level of its
+/// chain, or for a level beyond it (or a texture stored without mips) a 2×2 box filter of the
+/// level above, made here (averaging the stored bytes, sRGB-encoded or not).
+fn texture_levels(t: &trisort_format::Texture, levels: u32) -> Vec<(u32, u32, Vec<u8>)> {
+    let mut out: Vec<(u32, u32, Vec<u8>)> = vec![(t.width, t.height, t.rgba8.clone())];
+    for k in 1..levels {
+        let (w, h) = ((t.width >> k).max(1), (t.height >> k).max(1));
+        let stored = t.mips.get(k as usize - 1);
+        let level = match stored {
+            Some(bytes) if bytes.len() == (w * h * 4) as usize => bytes.clone(),
+            _ => {
+                let (pw, ph, prev) = &out[k as usize - 1];
+                box_filter(prev, *pw, *ph, w, h)
+            }
+        };
+        out.push((w, h, level));
+    }
+    out
+}
+
+/// A `w` × `h` RGBA8 level from the `pw` × `ph` level above: each texel averages the 2×2 (or,
+/// along a side of 1, the 1×2 or 2×1) texels it covers.
+fn box_filter(prev: &[u8], pw: u32, ph: u32, w: u32, h: u32) -> Vec<u8> {
+    let mut out = Vec::with_capacity((w * h * 4) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let xs = [(2 * x).min(pw - 1), (2 * x + 1).min(pw - 1)];
+            let ys = [(2 * y).min(ph - 1), (2 * y + 1).min(ph - 1)];
+            for c in 0..4 {
+                let mut sum = 0u32;
+                for yy in ys {
+                    for xx in xs {
+                        sum += prev[((yy * pw + xx) * 4 + c) as usize] as u32;
+                    }
+                }
+                out.push(((sum + 2) / 4) as u8);
+            }
+        }
+    }
+    out
+}
+
+/// Uploads the material textures into two arrays, sRGB (`Rgba8UnormSrgb`) and linear
+/// (`Rgba8Unorm`), each texture in the array of its [`trisort_format::Texture::srgb`] flag. A
+/// layer is as large as its array's largest texture (clamped to the device's limit), with a
+/// full mip chain; a smaller texture fills the top-left corner of every level with its own
+/// level of the same index. An empty array gets one white texel; on GL an array has two layers
+/// at least (see the comment inside).
+fn upload_textures(device: &wgpu::Device, queue: &wgpu::Queue, geometry: &Geometry) -> Textures {
+    let mut places = vec![
+        TexturePlace {
+            linear: false,
+            layer: 0,
+            scale: [1.0, 1.0]
+        };
+        geometry.textures.len()
+    ];
+    let mut bytes = 0;
+    let mut views = Vec::new();
+    for linear in [false, true] {
+        let members: Vec<usize> = (0..geometry.textures.len())
+            .filter(|&i| geometry.textures[i].srgb != linear)
+            .collect();
+        let (view, b) = upload_array(device, queue, geometry, &members, linear, &mut places);
+        views.push(view);
+        bytes += b;
+    }
+    let linear = views.pop().expect("two arrays");
+    let srgb = views.pop().expect("two arrays");
+    Textures {
+        srgb,
+        linear,
+        places,
+        bytes,
+    }
+}
+
+/// One array of [`upload_textures`]: the textures `members` of `geometry`; fills their places
+/// and returns the view and its bytes.
+fn upload_array(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     geometry: &Geometry,
-) -> (wgpu::TextureView, Vec<[f32; 2]>) {
+    members: &[usize],
+    linear: bool,
+    places: &mut [TexturePlace],
+) -> (wgpu::TextureView, u64) {
     let limits = device.limits();
-    let (tw, th) = geometry
-        .textures
-        .iter()
-        .fold((1u32, 1u32), |(w, h), t| (w.max(t.width), h.max(t.height)));
+    let (tw, th) = members.iter().fold((1u32, 1u32), |(w, h), &i| {
+        let t = &geometry.textures[i];
+        (w.max(t.width), h.max(t.height))
+    });
     let max_dim = limits.max_texture_dimension_2d;
     let (tw, th) = (tw.min(max_dim), th.min(max_dim));
+    let levels = full_chain(tw, th);
     // wgpu's GL backend picks the GL texture target when the texture is made, from its
     // layer count alone: one layer becomes TEXTURE_2D, which a `texture_2d_array` binding
     // (sampler2DArray) then samples as an incomplete texture, black. Two layers at least on
@@ -574,41 +946,42 @@ fn upload_textures(
     } else {
         1
     };
-    let layers = geometry.textures.len().max(min_layers) as u32;
+    let layers = members.len().max(min_layers) as u32;
     let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("base colour textures"),
+        label: Some(if linear {
+            "linear textures"
+        } else {
+            "sRGB textures"
+        }),
         size: wgpu::Extent3d {
             width: tw,
             height: th,
             depth_or_array_layers: layers,
         },
-        mip_level_count: 1,
+        mip_level_count: levels,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8UnormSrgb,
+        format: if linear {
+            wgpu::TextureFormat::Rgba8Unorm
+        } else {
+            wgpu::TextureFormat::Rgba8UnormSrgb
+        },
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
-    let mut uv_scales = Vec::new();
-    for (layer, t) in geometry.textures.iter().enumerate() {
-        let (w, h) = (t.width.min(tw), t.height.min(th));
-        // Rows beyond the device limit are cropped (documented limitation).
-        let mut data = Vec::with_capacity((w * h * 4) as usize);
-        for y in 0..h as usize {
-            data.extend_from_slice(&t.rgba8[y * t.width as usize * 4..][..w as usize * 4]);
-        }
+    let write = |level: u32, layer: u32, w: u32, h: u32, data: &[u8]| {
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &texture,
-                mip_level: 0,
+                mip_level: level,
                 origin: wgpu::Origin3d {
                     x: 0,
                     y: 0,
-                    z: layer as u32,
+                    z: layer,
                 },
                 aspect: wgpu::TextureAspect::All,
             },
-            &data,
+            data,
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
                 bytes_per_row: Some(w * 4),
@@ -620,33 +993,152 @@ fn upload_textures(
                 depth_or_array_layers: 1,
             },
         );
-        uv_scales.push([w as f32 / tw as f32, h as f32 / th as f32]);
+    };
+    for (layer, &i) in members.iter().enumerate() {
+        let t = &geometry.textures[i];
+        for (k, (lw, lh, level)) in texture_levels(t, levels).iter().enumerate() {
+            let (aw, ah) = ((tw >> k).max(1), (th >> k).max(1));
+            // Texels beyond the device limit are cropped (documented limitation).
+            let (w, h) = ((*lw).min(aw), (*lh).min(ah));
+            let mut data = Vec::with_capacity((w * h * 4) as usize);
+            for y in 0..h as usize {
+                data.extend_from_slice(&level[y * *lw as usize * 4..][..w as usize * 4]);
+            }
+            write(k as u32, layer as u32, w, h, &data);
+        }
+        places[i] = TexturePlace {
+            linear,
+            layer: layer as u32,
+            scale: [
+                t.width.min(tw) as f32 / tw as f32,
+                t.height.min(th) as f32 / th as f32,
+            ],
+        };
     }
-    if geometry.textures.is_empty() {
-        queue.write_texture(
-            texture.as_image_copy(),
-            &[255u8; 4],
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(4),
-                rows_per_image: Some(1),
-            },
-            wgpu::Extent3d {
-                width: 1,
-                height: 1,
-                depth_or_array_layers: 1,
-            },
-        );
+    if members.is_empty() {
+        write(0, 0, 1, 1, &[255u8; 4]);
     }
-    let texture_view = texture.create_view(&wgpu::TextureViewDescriptor {
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
     });
-    (texture_view, uv_scales)
+    let bytes = (0..levels)
+        .map(|k| ((tw >> k).max(1) as u64) * ((th >> k).max(1) as u64) * 4)
+        .sum::<u64>()
+        * layers as u64;
+    (view, bytes)
+}
+
+/// The prefiltered environment on the GPU.
+struct EnvironmentGpu {
+    view: wgpu::TextureView,
+    /// Mip levels uploaded.
+    levels: u32,
+    bytes: u64,
+}
+
+/// Uploads an environment's prefiltered radiance as an `Rgba16Float` texture with one mip
+/// level per stored level (as many as a full chain of its size holds; levels larger than the
+/// device allows are left out from the top).
+fn upload_environment(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    env: &Environment,
+) -> EnvironmentGpu {
+    let max_dim = device.limits().max_texture_dimension_2d;
+    let first = (0..env.levels.len())
+        .find(|&k| {
+            let (w, h) = env.level_size(k);
+            w <= max_dim && h <= max_dim
+        })
+        .unwrap_or(env.levels.len());
+    let white = [0x3c00u16; 4];
+    let mut stored: Vec<(u32, u32, &[u16])> = (first..env.levels.len())
+        .map(|k| {
+            let (w, h) = env.level_size(k);
+            (w, h, env.levels[k].as_slice())
+        })
+        .filter(|(w, h, l)| l.len() as u64 == *w as u64 * *h as u64 * 4)
+        .collect();
+    if stored.is_empty() {
+        stored.push((1, 1, &white));
+    }
+    let (w0, h0) = (stored[0].0, stored[0].1);
+    let levels = (stored.len() as u32).min(full_chain(w0, h0));
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("environment"),
+        size: wgpu::Extent3d {
+            width: w0,
+            height: h0,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: levels,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba16Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let mut bytes = 0;
+    for (k, &(sw, sh, texels)) in stored.iter().take(levels as usize).enumerate() {
+        // A level's size is that of the chain (`max(1, w0 >> k)`): the file's sizes agree.
+        let (w, h) = (sw.min((w0 >> k).max(1)), sh.min((h0 >> k).max(1)));
+        let row = w as usize * 4;
+        let mut data: Vec<u16> = Vec::with_capacity(row * h as usize);
+        for y in 0..h as usize {
+            data.extend_from_slice(&texels[y * sw as usize * 4..][..row]);
+        }
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: k as u32,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(&data),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(w * 8),
+                rows_per_image: Some(h),
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        bytes += w as u64 * h as u64 * 8;
+    }
+    EnvironmentGpu {
+        view: texture.create_view(&Default::default()),
+        levels,
+        bytes,
+    }
+}
+
+/// A texture slot as the shaders read it: transform rows with the layer (< 0: none) and the
+/// texture coordinate set, and the layer's uv scale with its array (0 sRGB, 1 linear).
+fn slot_gpu(
+    texture: Option<u32>,
+    tex_coord: u32,
+    transform: &TextureTransform,
+    places: &[TexturePlace],
+) -> [[f32; 4]; 3] {
+    let m = transform.matrix();
+    let place = texture.and_then(|t| places.get(t as usize));
+    let (layer, scale, array) = match place {
+        Some(p) => (p.layer as f32, p.scale, if p.linear { 1.0 } else { 0.0 }),
+        None => (-1.0, [1.0, 1.0], 0.0),
+    };
+    [
+        [m[0][0], m[0][1], m[0][2], layer],
+        [m[1][0], m[1][1], m[1][2], tex_coord.min(1) as f32],
+        [scale[0], scale[1], array, 0.0],
+    ]
 }
 
 /// The materials as the shaders read them (one zeroed material where the scene has none).
-fn material_table(materials: &[Material], uv_scales: &[[f32; 2]]) -> Vec<MaterialGpu> {
+fn material_table(materials: &[Material], places: &[TexturePlace]) -> Vec<MaterialGpu> {
     let mut mats: Vec<MaterialGpu> = materials
         .iter()
         .map(|m| {
@@ -655,10 +1147,16 @@ fn material_table(materials: &[Material], uv_scales: &[[f32; 2]]) -> Vec<Materia
                 AlphaMode::Mask => 1.0,
                 AlphaMode::Blend => 2.0,
             };
-            let (layer, scale) = match m.base_color_texture {
-                Some(t) if (t as usize) < uv_scales.len() => (t as f32, uv_scales[t as usize]),
-                _ => (-1.0, [1.0, 1.0]),
+            let slot = |s: &Option<trisort_format::TextureSlot>| match s {
+                Some(s) => slot_gpu(Some(s.texture), s.tex_coord, &s.transform, places),
+                None => slot_gpu(None, 0, &TextureTransform::default(), places),
             };
+            let base = slot_gpu(
+                m.base_color_texture,
+                m.base_color_tex_coord,
+                &m.base_color_transform,
+                places,
+            );
             MaterialGpu {
                 base_color: m.base_color,
                 emissive: [m.emissive[0], m.emissive[1], m.emissive[2], m.transmission],
@@ -666,9 +1164,22 @@ fn material_table(materials: &[Material], uv_scales: &[[f32; 2]]) -> Vec<Materia
                     mode,
                     m.alpha_cutoff,
                     if m.double_sided { 1.0 } else { 0.0 },
-                    layer,
+                    base[0][3],
                 ],
-                uv_scale: [scale[0], scale[1], 0.0, 0.0],
+                pbr: [
+                    m.metallic,
+                    m.roughness,
+                    m.normal_scale,
+                    m.occlusion_strength,
+                ],
+                coat: [m.clearcoat, m.clearcoat_roughness, 0.0, 0.0],
+                slots: [
+                    base,
+                    slot(&m.metallic_roughness_texture),
+                    slot(&m.normal_texture),
+                    slot(&m.occlusion_texture),
+                    slot(&m.emissive_texture),
+                ],
             }
         })
         .collect();
@@ -688,12 +1199,11 @@ pub(crate) struct FrameData {
     pub(crate) node_count: u64,
 }
 
-/// Bind group entries both tiers share: the frame uniform (0), the base-colour texture array
-/// (3) and its sampler (4).
+/// Bind group entries both tiers share: the frame uniform (0) and the surface bindings of
+/// [`surface_entries`] (3, 4, 6–9).
 pub(crate) struct SharedBindings<'a> {
     pub(crate) frame: wgpu::BindGroupEntry<'a>,
-    pub(crate) texture: wgpu::BindGroupEntry<'a>,
-    pub(crate) sampler: wgpu::BindGroupEntry<'a>,
+    pub(crate) surface: [wgpu::BindGroupEntry<'a>; 6],
 }
 
 /// The storage tier's layout and bind group, and its node-matrix stride per frame.
@@ -719,15 +1229,18 @@ fn storage_bind_group(
         label: Some("trisort scene"),
         layout: &layout,
         entries: &[
-            shared.frame,
-            sized_buffer_entry(1, &node_buffer, data.node_count * 64),
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: materials.as_entire_binding(),
-            },
-            shared.texture,
-            shared.sampler,
-        ],
+            [
+                shared.frame,
+                sized_buffer_entry(1, &node_buffer, data.node_count * 64),
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: materials.as_entire_binding(),
+                },
+            ]
+            .as_slice(),
+            &shared.surface,
+        ]
+        .concat(),
     });
     (
         layout,

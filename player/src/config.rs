@@ -1,7 +1,8 @@
-//! How a baked file is played: mode, target formats, size, glass opacity, draw path; and the
+//! How a baked file is played: mode, target formats, size, glass opacity, draw path, shading; and the
 //! warnings for playing it away from its recorded sample pattern.
 
 use trisort_format::{Baked, DeviceInfo, Mode};
+use trisort_gpu::{Shading, ToneMap};
 
 /// How draws are issued.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -66,6 +67,11 @@ pub struct PlayerConfig {
     /// (`trisort_gpu::device_info`), to warn when it is not the recording device.
     /// `None` skips that check.
     pub device: Option<DeviceInfo>,
+    /// Surface model: [`Shading::Pbr`] lit by the file's environment (the default), or
+    /// [`Shading::Basic`], the one light plus ambient trisort drew before.
+    pub shading: Shading,
+    /// Tone map of [`Shading::Pbr`].
+    pub tone_map: ToneMap,
 }
 
 impl PlayerConfig {
@@ -81,6 +87,8 @@ impl PlayerConfig {
             glass_opacity: None,
             draw_path: DrawPath::MultiDrawIndirect,
             device: None,
+            shading: Shading::Pbr,
+            tone_map: ToneMap::Neutral,
         }
     }
 

@@ -3,7 +3,7 @@
 //! 8-bit sRGB, the way the exact reference renders (DESIGN § Frame accuracy).
 
 use trisort_format::Baked;
-use trisort_gpu::Gpu;
+use trisort_gpu::{Gpu, Shading, ToneMap};
 
 use crate::config::{DrawPath, PlayerConfig};
 use crate::error::PlayerError;
@@ -41,6 +41,10 @@ pub struct HeadlessConfig {
     pub draw_path: Option<DrawPath>,
     /// Use 32-bit indices even where 16 bits fit.
     pub force_u32: bool,
+    /// Surface model ([`PlayerConfig::shading`]).
+    pub shading: Shading,
+    /// Tone map ([`PlayerConfig::tone_map`]).
+    pub tone_map: ToneMap,
 }
 
 impl HeadlessConfig {
@@ -53,6 +57,8 @@ impl HeadlessConfig {
             glass_opacity: None,
             draw_path: None,
             force_u32: false,
+            shading: Shading::Pbr,
+            tone_map: ToneMap::Neutral,
         }
     }
 }
@@ -73,8 +79,7 @@ pub fn render_frames(
         samples,
         mode,
         glass_opacity,
-        draw_path: None,
-        force_u32: false,
+        ..HeadlessConfig::recorded(baked)
     };
     let renderer = HeadlessRenderer::new(gpu, baked, &config)?;
     frames.iter().map(|&f| renderer.render(f)).collect()
@@ -117,6 +122,8 @@ impl<'g> HeadlessRenderer<'g> {
                 .draw_path
                 .unwrap_or_else(|| DrawPath::for_device(&gpu.adapter, &gpu.device)),
             device: Some(gpu.device_info()),
+            shading: config.shading,
+            tone_map: config.tone_map,
         };
         let player = if config.force_u32 {
             Player::new_u32(&gpu.device, &gpu.queue, baked, player_config)?

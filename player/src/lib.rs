@@ -46,6 +46,7 @@ pub use self_check::{SelfCheck, SelfCheckFrame};
 pub use trisort_format::{Mode, ParseOptionError};
 /// The background every frame is drawn over (re-exported from the GPU crate for hosts).
 pub use trisort_gpu::BACKGROUND;
+pub use trisort_gpu::{Shading, ToneMap};
 
 /// Instance flags with wgpu's indirect-call validation (`VALIDATION_INDIRECT_CALL`) switched
 /// on or off, the other flags as wgpu chooses them (build type and `WGPU_*` environment).

@@ -20,6 +20,10 @@ pub struct OnScreenSettings {
     pub mode: Mode,
     /// Glass opacity; `None` plays the recorded one.
     pub glass_opacity: Option<f32>,
+    /// Surface model ([`crate::PlayerConfig::shading`]).
+    pub shading: trisort_gpu::Shading,
+    /// Tone map ([`crate::PlayerConfig::tone_map`]).
+    pub tone_map: trisort_gpu::ToneMap,
 }
 
 impl OnScreenSettings {
@@ -29,6 +33,8 @@ impl OnScreenSettings {
             samples: baked.settings.samples.max(1),
             mode,
             glass_opacity: None,
+            shading: trisort_gpu::Shading::Pbr,
+            tone_map: trisort_gpu::ToneMap::Neutral,
         }
     }
 }
@@ -70,6 +76,8 @@ impl OnScreen {
             mode: settings.mode,
             glass_opacity: settings.glass_opacity,
             draw_path: DrawPath::for_device(&gpu.adapter, &gpu.device),
+            shading: settings.shading,
+            tone_map: settings.tone_map,
             ..PlayerConfig::for_adapter(baked, &gpu.adapter, COLOR_FORMAT)
         };
         let player = Player::new(&gpu.device, &gpu.queue, baked, config)?;

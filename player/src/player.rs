@@ -114,13 +114,18 @@ impl Player {
         bindings
             .check_fits(&device.limits(), &baked.geometry, baked.frame_states.len())
             .map_err(PlayerError::DeviceTooSmall)?;
-        let scene = SceneGpu::with_bindings(
+        let scene = SceneGpu::with_lighting(
             device,
             queue,
             &baked.geometry,
             &baked.frame_states,
             view,
             bindings,
+            trisort_gpu::Lighting {
+                shading: config.shading,
+                tone_map: config.tone_map,
+                environment: &baked.environment,
+            },
         );
         let order = if config.mode.back_to_front() {
             Order::BackToFront
@@ -313,6 +318,12 @@ impl Player {
     /// of [`Bindings::Textures`] where the device's limits have no vertex storage (WebGL2).
     pub fn bindings(&self) -> Bindings {
         self.bindings
+    }
+
+    /// GPU bytes of the scene's textures (both material arrays with their mips) and the
+    /// prefiltered environment ([`SceneGpu::texture_bytes`]).
+    pub fn texture_bytes(&self) -> u64 {
+        self.scene.texture_bytes()
     }
 
     /// Shifts the projection of every frame by `offset` pixels (x right, y down) at the

@@ -25,6 +25,8 @@ fn config(mode: Mode, draw_path: DrawPath) -> PlayerConfig {
         mode,
         draw_path,
         depth_format: (mode == Mode::Depth).then_some(wgpu::TextureFormat::Depth32Float),
+        // The pixels these tests expect are `support::lit`'s: the basic model.
+        shading: trisort_gpu::Shading::Basic,
         ..PlayerConfig::recorded(&baked, wgpu::TextureFormat::Rgba8Unorm)
     }
 }
@@ -38,6 +40,7 @@ fn headless(mode: Mode, samples: u32) -> HeadlessConfig {
     HeadlessConfig {
         samples,
         mode,
+        shading: trisort_gpu::Shading::Basic,
         ..HeadlessConfig::recorded(&quads())
     }
 }

@@ -54,6 +54,8 @@ fn a_variant_draws_what_a_file_with_its_materials_draws_and_switches_back() {
     for mode in [Mode::Blend, Mode::Saturate] {
         let config = HeadlessConfig {
             mode,
+            // `lit` is the basic model's colour.
+            shading: trisort_gpu::Shading::Basic,
             ..HeadlessConfig::recorded(&baked)
         };
         let r = HeadlessRenderer::new(&gpu, &baked, &config).unwrap();

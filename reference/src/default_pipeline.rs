@@ -9,7 +9,7 @@
 //! reference is what sorting buys.
 
 use trisort_format::{AlphaMode, FrameState, Geometry};
-use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::scene_gpu::{Lighting, SceneGpu, ScenePipeline, View};
 use trisort_gpu::Gpu;
 use trisort_gpu::{clear_colour, halves, quantize_rgba16f, COLOR_FORMAT};
 use trisort_player::{blend_state, Mode};
@@ -38,13 +38,14 @@ pub struct DefaultRenderer<'g> {
 }
 
 impl<'g> DefaultRenderer<'g> {
-    /// Uploads the whole scene for rendering at `view`. Errors where the adapter cannot
+    /// Uploads the whole scene for rendering at `view`, lit as `lighting` says. Errors where the adapter cannot
     /// multisample the targets.
     pub fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
         view: View,
+        lighting: Lighting<'_>,
     ) -> Result<DefaultRenderer<'g>, ReferenceError> {
         let device = &gpu.device;
         let target = Target::new(
@@ -54,7 +55,15 @@ impl<'g> DefaultRenderer<'g> {
             COLOR_FORMAT,
             true,
         )?;
-        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let scene = SceneGpu::with_lighting(
+            device,
+            &gpu.queue,
+            geometry,
+            frames,
+            view,
+            trisort_gpu::Bindings::Storage,
+            lighting,
+        );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("default pipeline"),
             source: wgpu::ShaderSource::Wgsl(trisort_gpu::compose(&[], trisort_gpu::PLAYER).into()),

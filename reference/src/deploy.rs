@@ -4,7 +4,7 @@
 
 use trisort_format::Baked;
 use trisort_gpu::Gpu;
-use trisort_gpu::{clear_colour, linear_to_srgb, BACKGROUND};
+use trisort_gpu::{clear_colour, linear_to_srgb, Shading, ToneMap, BACKGROUND};
 use trisort_player::{Mode, Player, PlayerConfig};
 
 use crate::target::{Target, DEPTH_FORMAT};
@@ -22,7 +22,8 @@ pub struct Srgb8Player<'g> {
 }
 
 impl<'g> Srgb8Player<'g> {
-    /// Uploads `baked` for playing at `size` with `samples` in `mode`, glass as recorded.
+    /// Uploads `baked` for playing at `size` with `samples` in `mode`, glass as recorded,
+    /// with the default shading ([`Shading::Pbr`], [`ToneMap::Neutral`]).
     pub fn new(
         gpu: &'g Gpu,
         baked: &Baked,
@@ -30,12 +31,33 @@ impl<'g> Srgb8Player<'g> {
         samples: u32,
         mode: Mode,
     ) -> Result<Srgb8Player<'g>, ReferenceError> {
+        Srgb8Player::with_shading(
+            gpu,
+            baked,
+            size,
+            samples,
+            mode,
+            (Shading::Pbr, ToneMap::Neutral),
+        )
+    }
+
+    /// [`Srgb8Player::new`] with a surface model and tone map.
+    pub fn with_shading(
+        gpu: &'g Gpu,
+        baked: &Baked,
+        size: (u32, u32),
+        samples: u32,
+        mode: Mode,
+        (shading, tone_map): (Shading, ToneMap),
+    ) -> Result<Srgb8Player<'g>, ReferenceError> {
         let target = Target::new(gpu, size, samples, SRGB8_FORMAT, mode == Mode::Depth)?;
         let config = PlayerConfig {
             depth_format: (mode == Mode::Depth).then_some(DEPTH_FORMAT),
             sample_count: samples,
             size,
             mode,
+            shading,
+            tone_map,
             ..PlayerConfig::for_adapter(baked, &gpu.adapter, SRGB8_FORMAT)
         };
         let player = Player::new(&gpu.device, &gpu.queue, baked, config)?;

@@ -26,9 +26,10 @@
 use std::collections::HashSet;
 
 use trisort_format::{
-    Baked, DrawIndexedIndirectArgs, FrameState, FrameWindow, Geometry, RecordSettings, Recording,
+    Baked, DrawIndexedIndirectArgs, Environment, FrameState, FrameWindow, Geometry, RecordSettings,
+    Recording,
 };
-use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::scene_gpu::{Bindings, Lighting, SceneGpu, ScenePipeline, View};
 use trisort_gpu::Gpu;
 use trisort_gpu::{clear_colour, halves, quantize_rgba16f, BACKGROUND, COLOR_FORMAT};
 use trisort_player::{blend_state, Mode};
@@ -225,11 +226,12 @@ pub struct ExactReference<'g> {
 /// A baked file that draws every triangle of `geometry` in ascending id order in every frame
 /// (front-to-back playback is the stored order): played by the player in `depth` mode it is
 /// the plain z-buffer of all triangles in id order (equal to the `depth` reference on opaque
-/// scenes).
+/// scenes), lit by `environment` (the bake's, so it lights like the bake).
 pub fn whole_scene_baked(
     geometry: &Geometry,
     frames: &[FrameState],
     settings: RecordSettings,
+    environment: &Environment,
 ) -> Baked {
     let n = geometry.triangles.len() as u32;
     let frame_count = frames.len() as u32;
@@ -260,18 +262,21 @@ pub fn whole_scene_baked(
         frame_states: frames.to_vec(),
         removed_edges: vec![vec![]; frames.len()],
         fps: None,
-        environment: trisort_format::Environment::uniform(1.0),
+        environment: environment.clone(),
     }
 }
 
 impl<'g> ExactReference<'g> {
-    /// Uploads the full scene `geometry` with the path's `frames` for rendering at `config`.
-    /// Errors where the device lacks what the peeler needs (`PRIMITIVE_INDEX`, multisampled
-    /// integer targets) or cannot multisample the targets.
+    /// Uploads the full scene `geometry` with the path's `frames` for rendering at `config`,
+    /// lit as `lighting` says (a baked file's environment and the player's shading, so the
+    /// reference lights like the player it checks). Errors where the device lacks what the
+    /// peeler needs (`PRIMITIVE_INDEX`, multisampled integer targets) or cannot multisample
+    /// the targets.
     pub fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
+        lighting: Lighting<'_>,
         config: ReferenceConfig,
     ) -> Result<ExactReference<'g>, ReferenceError> {
         check_pattern(config.size, config.samples)?;
@@ -279,7 +284,15 @@ impl<'g> ExactReference<'g> {
         let view = config.view();
         let peeler = Peeler::new(gpu, geometry, &all, frames, view)?;
         let device = &gpu.device;
-        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let scene = SceneGpu::with_lighting(
+            device,
+            &gpu.queue,
+            geometry,
+            frames,
+            view,
+            Bindings::Storage,
+            lighting,
+        );
         let storage = |binding| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::FRAGMENT,

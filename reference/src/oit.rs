@@ -35,7 +35,7 @@
 
 use trisort_format::Mode;
 use trisort_format::{FrameState, Geometry};
-use trisort_gpu::scene_gpu::{SceneGpu, ScenePipeline, View};
+use trisort_gpu::scene_gpu::{Lighting, SceneGpu, ScenePipeline, View};
 use trisort_gpu::Gpu;
 use trisort_gpu::{
     clear_colour, halves, quantize_rgba16f, FrameTarget, TargetConfig, COLOR_FORMAT,
@@ -359,14 +359,15 @@ pub struct OitRenderer<'g> {
 }
 
 impl<'g> OitRenderer<'g> {
-    /// Uploads the full scene `geometry` with the path's `frames` and allocates the lists at
-    /// `config`. Errors where the configuration is invalid, the pool or head buffer exceeds the
+    /// Uploads the full scene `geometry` with the path's `frames`, lit as `lighting` says, and
+    /// allocates the lists at `config`. Errors where the configuration is invalid, the pool or head buffer exceeds the
     /// device's storage-buffer limits, or the device lacks `PRIMITIVE_INDEX`, writable storage
     /// in fragment shaders or multisampled `Rgba16Float` targets.
     pub fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
+        lighting: Lighting<'_>,
         config: OitConfig,
     ) -> Result<OitRenderer<'g>, ReferenceError> {
         let device = &gpu.device;
@@ -385,7 +386,15 @@ impl<'g> OitRenderer<'g> {
             samples: config.samples,
             glass_opacity: config.glass_opacity,
         };
-        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let scene = SceneGpu::with_lighting(
+            device,
+            &gpu.queue,
+            geometry,
+            frames,
+            view,
+            trisort_gpu::Bindings::Storage,
+            lighting,
+        );
         let index = scene_index(device, geometry, "oit indices");
         let lists = Lists::new(gpu, &config);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

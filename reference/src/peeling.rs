@@ -40,7 +40,7 @@ use std::sync::Mutex;
 
 use trisort_format::{FrameState, Geometry};
 use trisort_gpu::scene_gpu::{
-    begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
+    begin_peel_pass, previous_key_entries, Lighting, SceneGpu, ScenePipeline, View,
 };
 use trisort_gpu::Gpu;
 use trisort_gpu::{clear_colour, FrameTarget, TargetConfig, COLOR_FORMAT, DEPTH_FORMAT};
@@ -279,7 +279,8 @@ impl LayerTargets {
 }
 
 impl<'g> PeelingRenderer<'g> {
-    /// Uploads `geometry` with the path's `frames` for rendering as `config` says.
+    /// Uploads `geometry` with the path's `frames` for rendering as `config` says, lit as
+    /// `lighting` says.
     ///
     /// Errors: [`ReferenceError::Invalid`] for `Saturate`, an empty size or another sample
     /// count than 1 or 4; [`ReferenceError::Unsupported`] where the device lacks
@@ -289,6 +290,7 @@ impl<'g> PeelingRenderer<'g> {
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
+        lighting: Lighting<'_>,
         config: PeelingConfig,
     ) -> Result<Self, ReferenceError> {
         let PeelingConfig {
@@ -308,7 +310,15 @@ impl<'g> PeelingRenderer<'g> {
             samples,
             glass_opacity,
         };
-        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let scene = SceneGpu::with_lighting(
+            device,
+            &gpu.queue,
+            geometry,
+            frames,
+            view,
+            trisort_gpu::Bindings::Storage,
+            lighting,
+        );
         let index = scene_index(device, geometry, "peeling indices");
 
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

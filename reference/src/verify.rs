@@ -25,7 +25,7 @@
 
 use serde::Serialize;
 use trisort_format::{Baked, DeviceInfo, FrameState, Geometry, RecordSettings, Recording};
-use trisort_gpu::Gpu;
+use trisort_gpu::{Gpu, Lighting, Shading, ToneMap};
 use trisort_player::{HeadlessConfig, HeadlessRenderer, Mode};
 
 use crate::compare::{compare, Comparison};
@@ -55,6 +55,11 @@ pub struct ImageCheck {
     /// exact reference alike (`verify --subpixel-offset`, a test aid standing for another
     /// GPU's vertex snapping); anything but zero is off the recorded pattern.
     pub subpixel_offset: [f64; 2],
+    /// Surface model of the player and the reference alike (both light with the baked file's
+    /// environment).
+    pub shading: Shading,
+    /// Tone map of [`Shading::Pbr`].
+    pub tone_map: ToneMap,
 }
 
 impl ImageCheck {
@@ -68,6 +73,8 @@ impl ImageCheck {
             srgb8: true,
             captured: false,
             subpixel_offset: [0.0, 0.0],
+            shading: Shading::Pbr,
+            tone_map: ToneMap::Neutral,
         }
     }
 }
@@ -201,6 +208,8 @@ impl<'g> ImageVerifier<'g> {
                     glass_opacity: None,
                     draw_path: None,
                     force_u32: false,
+                    shading: check.shading,
+                    tone_map: check.tone_map,
                 },
             )?)
         };
@@ -208,6 +217,11 @@ impl<'g> ImageVerifier<'g> {
             gpu,
             geometry,
             truth.frame_states,
+            Lighting {
+                shading: check.shading,
+                tone_map: check.tone_map,
+                environment: &baked.environment,
+            },
             ReferenceConfig {
                 size: check.size,
                 samples: check.samples,
@@ -217,12 +231,13 @@ impl<'g> ImageVerifier<'g> {
             },
         )?;
         let srgb8 = if check.srgb8 && !check.captured {
-            Some(Srgb8Player::new(
+            Some(Srgb8Player::with_shading(
                 gpu,
                 baked,
                 check.size,
                 check.samples,
                 check.mode,
+                (check.shading, check.tone_map),
             )?)
         } else {
             None

@@ -13,7 +13,7 @@
 
 use glam::DVec3;
 use trisort_format::{FrameState, Geometry};
-use trisort_gpu::Gpu;
+use trisort_gpu::{Gpu, Lighting};
 use trisort_player::Mode;
 use trisort_reference::{
     ExactReference, OitConfig, OitFrame, OitRenderer, ReferenceConfig, ReferenceError,
@@ -47,7 +47,7 @@ fn reference<'g>(
         glass_opacity: trisort_format::RecordSettings::default().glass_opacity,
         max_layers: 256,
     };
-    ExactReference::new(gpu, g, frames, config).expect("exact reference")
+    ExactReference::new(gpu, g, frames, Lighting::default(), config).expect("exact reference")
 }
 
 /// Channels that differ and the largest difference.
@@ -66,8 +66,14 @@ fn assert_matches(name: &str, g: &Geometry, frames: &[FrameState], size: u32) ->
     let mut out = vec![];
     for samples in [1, 4] {
         let exact = reference(&gpu, g, frames, size, samples);
-        let oit = OitRenderer::new(&gpu, g, frames, OitConfig::new((size, size), samples))
-            .expect("oit renderer");
+        let oit = OitRenderer::new(
+            &gpu,
+            g,
+            frames,
+            Lighting::default(),
+            OitConfig::new((size, size), samples),
+        )
+        .expect("oit renderer");
         for f in 0..frames.len() as u32 {
             let r = exact.render(f, None).expect("reference frame");
             let o = oit.render(f).expect("oit frame");
@@ -180,7 +186,8 @@ fn a_full_pool_drops_fragments_and_says_how_many() {
             nodes_per_sample: 2,
             ..OitConfig::new((16, 16), samples)
         };
-        let oit = OitRenderer::new(&gpu, &g, &frames, config).expect("oit renderer");
+        let oit =
+            OitRenderer::new(&gpu, &g, &frames, Lighting::default(), config).expect("oit renderer");
         let o = oit.render(0).expect("frame");
         let samples_total = 16 * 16 * samples as u64;
         assert_eq!(
@@ -195,6 +202,7 @@ fn a_full_pool_drops_fragments_and_says_how_many() {
             &gpu,
             &g,
             &frames,
+            Lighting::default(),
             OitConfig {
                 nodes_per_sample: 3,
                 ..config
@@ -221,7 +229,7 @@ fn a_short_sort_array_overflows_and_keeps_the_nearest() {
         max_sorted: 4,
         ..OitConfig::new((16, 16), 4)
     };
-    let o = OitRenderer::new(&gpu, &g, &frames, config)
+    let o = OitRenderer::new(&gpu, &g, &frames, Lighting::default(), config)
         .expect("oit renderer")
         .render(0)
         .expect("frame");
@@ -242,6 +250,7 @@ fn a_short_sort_array_overflows_and_keeps_the_nearest() {
         &gpu,
         &g,
         &frames,
+        Lighting::default(),
         OitConfig {
             max_sorted: 6,
             ..config
@@ -260,7 +269,8 @@ fn bad_configurations_are_errors_not_panics() {
     let Some(gpu) = gpu() else { return };
     let g = full_screen_layers(1);
     let frames = vec![frame_at(DVec3::ZERO)];
-    let try_new = |config| OitRenderer::new(&gpu, &g, &frames, config).map(|_| ());
+    let try_new =
+        |config| OitRenderer::new(&gpu, &g, &frames, Lighting::default(), config).map(|_| ());
     assert!(matches!(
         try_new(OitConfig::new((16, 16), 2)),
         Err(ReferenceError::Invalid(_))
@@ -288,10 +298,16 @@ fn bad_configurations_are_errors_not_panics() {
     eprintln!("{e}");
     // No triangles at all: the background.
     let empty = scene(vec![material([1.0, 1.0, 1.0], 0.5)]);
-    let o = OitRenderer::new(&gpu, &empty, &frames, OitConfig::new((8, 8), 4))
-        .expect("oit renderer")
-        .render(0)
-        .expect("frame");
+    let o = OitRenderer::new(
+        &gpu,
+        &empty,
+        &frames,
+        Lighting::default(),
+        OitConfig::new((8, 8), 4),
+    )
+    .expect("oit renderer")
+    .render(0)
+    .expect("frame");
     assert_eq!(o.fragments, 0);
     let r = reference(&gpu, &empty, &frames, 8, 4)
         .render(0, None)
@@ -321,7 +337,7 @@ fn a_pool_split_over_several_buffers() {
         nodes_per_sample: 10,
         ..OitConfig::new((512, 512), 4)
     };
-    let o = match OitRenderer::new(&gpu, &g, &frames, config) {
+    let o = match OitRenderer::new(&gpu, &g, &frames, Lighting::default(), config) {
         Ok(oit) => oit.render(0).expect("frame"),
         Err(e @ ReferenceError::Unsupported(_)) => {
             eprintln!("skipping: {e}");
@@ -352,7 +368,14 @@ fn encode_brackets_the_list_pass_with_statistics_queries() {
     }
     let g = stacked();
     let frames = frames();
-    let oit = OitRenderer::new(&gpu, &g, &frames, OitConfig::new((32, 32), 4)).expect("oit");
+    let oit = OitRenderer::new(
+        &gpu,
+        &g,
+        &frames,
+        Lighting::default(),
+        OitConfig::new((32, 32), 4),
+    )
+    .expect("oit");
     assert_eq!(oit.passes(), 1);
     assert_eq!(oit.triangles(), g.triangles.len() as u64);
     let device = &gpu.device;

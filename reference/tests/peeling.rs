@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 use trisort_format::{FrameState, Geometry, Vertex};
-use trisort_gpu::Gpu;
+use trisort_gpu::{Gpu, Lighting};
 use trisort_player::Mode;
 use trisort_reference::{
     ExactReference, PeelingConfig, PeelingRenderer, ReferenceConfig, ReferenceError,
@@ -135,6 +135,7 @@ fn same_as_reference(
         gpu,
         geometry,
         frames,
+        Lighting::default(),
         ReferenceConfig {
             size: (size, size),
             samples,
@@ -148,6 +149,7 @@ fn same_as_reference(
         gpu,
         geometry,
         frames,
+        Lighting::default(),
         PeelingConfig::new((size, size), samples, mode, max_layers),
     )
     .expect("peeling renderer");
@@ -327,6 +329,7 @@ fn encode_records_a_frame_without_readback_and_counts_passes() {
         &gpu,
         &g,
         &fs,
+        Lighting::default(),
         PeelingConfig::new((32, 32), 4, Mode::Blend, 16),
     )
     .unwrap();
@@ -363,7 +366,13 @@ fn saturate_and_bad_patterns_are_rejected() {
     let g = stack(1);
     let fs = [frame_at(DVec3::ZERO)];
     let new = |size, samples, mode| {
-        PeelingRenderer::new(&gpu, &g, &fs, PeelingConfig::new(size, samples, mode, 8))
+        PeelingRenderer::new(
+            &gpu,
+            &g,
+            &fs,
+            Lighting::default(),
+            PeelingConfig::new(size, samples, mode, 8),
+        )
     };
     assert!(matches!(
         new((8, 8), 4, Mode::Saturate),

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde_json::json;
 use trisort_format::{Baked, FileKind};
-use trisort_gpu::{DeviceBackend, DeviceLimits, Gpu, GpuOptions};
+use trisort_gpu::{DeviceBackend, DeviceLimits, Gpu, GpuOptions, Shading, ToneMap};
 use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
 use trisort_player::{Mode, SelfCheck};
 
@@ -71,7 +71,23 @@ pub struct PlayArgs {
     #[arg(long)]
     self_check: bool,
     #[command(flatten)]
+    shading: ShadingArgs,
+    #[command(flatten)]
     device: DeviceArgs,
+}
+
+/// `--shading` and `--tonemap`: how `play` and `verify` light the scene (the player and the
+/// reference alike), with the baked file's environment.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct ShadingArgs {
+    /// Surface model: pbr (glTF metallic-roughness, normal, occlusion, emissive maps and
+    /// clearcoat, lit by the baked file's environment and sun, tone mapped) or basic (one
+    /// light plus ambient, no tone map: what trisort drew before, and what the C host draws).
+    #[arg(long, default_value = "pbr")]
+    pub shading: Shading,
+    /// Tone map of --shading pbr: neutral (Khronos PBR Neutral) or aces.
+    #[arg(long, default_value = "neutral")]
+    pub tonemap: ToneMap,
 }
 
 /// Parses `--subpixel-offset X,Y`: two finite numbers of pixels, each a decimal or a fraction
@@ -134,6 +150,8 @@ pub struct PlayedPath {
     pub bindings: &'static str,
     /// `multi-draw-indirect` or `direct` (`trisort_player::DrawPath::name`).
     pub draw_path: &'static str,
+    /// GPU bytes of the scene's textures and environment (`SceneGpu::texture_bytes`).
+    pub texture_bytes: u64,
 }
 
 /// Writes a frame as PNG atomically.
@@ -181,6 +199,7 @@ pub fn play_frames_on_path(
     let path = PlayedPath {
         bindings: renderer.player().bindings().name(),
         draw_path: renderer.player().config().draw_path.name(),
+        texture_bytes: renderer.player().texture_bytes(),
     };
     for w in renderer.player().warnings() {
         eprintln!("trisort: warning: {w}");
@@ -234,6 +253,7 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
             glass_opacity: a.glass_opacity,
             fps: a.fps,
             variant: a.variant.clone(),
+            shading: a.shading,
             exit_after: a.window_frames,
             json: a.json,
         });
@@ -250,6 +270,8 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
     let mut config = HeadlessConfig::recorded(&baked);
     config.mode = a.mode;
     config.glass_opacity = a.glass_opacity;
+    config.shading = a.shading.shading;
+    config.tone_map = a.shading.tonemap;
     if let Some(s) = a.size {
         config.size = s;
     }
@@ -308,6 +330,9 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
             "bindings": path.bindings,
             "draw_path": path.draw_path,
             "mode": a.mode.name(),
+            "shading": config.shading.name(),
+            "tonemap": config.tone_map.name(),
+            "texture_bytes": path.texture_bytes,
             "variant": a.variant,
             "subpixel_offset": offset,
             "frames": list,

@@ -85,6 +85,10 @@ pub struct VerifyArgs {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// `--shading` and `--tonemap`: the player and the exact reference light alike, with the
+    /// baked file's environment.
+    #[command(flatten)]
+    shading: crate::cmd::play::ShadingArgs,
     /// `--backend` and `--limits`: other than `auto`/`default`, the frames are played on that
     /// device (webgl2: the player's GLES 3.0 / WebGL2 path) and checked as captured frames
     /// against the reference on the default device (the reference needs storage buffers and
@@ -212,6 +216,8 @@ fn elsewhere_player<'g>(
         size: check.size,
         samples: check.samples,
         mode: check.mode,
+        shading: check.shading,
+        tone_map: check.tone_map,
         ..HeadlessConfig::recorded(baked)
     };
     let player = HeadlessRenderer::new(gpu, baked, &config)?;
@@ -354,6 +360,8 @@ fn image_check(
         max_error: a.max_error,
         captured: a.frames_dir.is_some() || a.device.options() != GpuOptions::default(),
         subpixel_offset: a.subpixel_offset.unwrap_or([0.0, 0.0]),
+        shading: a.shading.shading,
+        tone_map: a.shading.tonemap,
         ..ImageCheck::recorded(baked, a.mode)
     };
     if check.samples != 1 && check.samples != 4 {
@@ -427,6 +435,8 @@ fn json_report(
     if let Some((report, check)) = images {
         out["images_ok"] = json!(report.ok);
         out["mode"] = json!(check.mode.name());
+        out["shading"] = json!(check.shading.name());
+        out["tonemap"] = json!(check.tone_map.name());
         out["size"] = json!([check.size.0, check.size.1]);
         out["samples"] = json!(check.samples);
         out["at_recorded_pattern"] = json!(report.at_recorded_pattern);

@@ -49,6 +49,10 @@ impl WebPlayer {
     /// triangle of the file): in `depth` mode the twin's frame equals the file's frame
     /// wherever no triangle the frame leaves out is nearest, so the page's self-check counts
     /// the pixels where the two differ: the holes on this browser's rasterizer.
+    ///
+    /// `shading` (`pbr`, the default, or `basic`) and `tonemap` (`neutral`, the default, or
+    /// `aces`) light it as `trisort play --shading --tonemap` does.
+    #[allow(clippy::too_many_arguments)]
     pub async fn open(
         canvas: web_sys::HtmlCanvasElement,
         bytes: Vec<u8>,
@@ -56,8 +60,14 @@ impl WebPlayer {
         backend: String,
         mode: String,
         zbuffer: bool,
+        shading: Option<String>,
+        tonemap: Option<String>,
     ) -> Result<WebPlayer, JsError> {
         let backend: BrowserBackend = backend.parse().map_err(|e: String| JsError::new(&e))?;
+        let shading: trisort_gpu::Shading =
+            (shading.as_deref().unwrap_or("pbr").parse()).map_err(|e: String| JsError::new(&e))?;
+        let tone_map: trisort_gpu::ToneMap = (tonemap.as_deref().unwrap_or("neutral").parse())
+            .map_err(|e: String| JsError::new(&e))?;
         let mode: Mode = mode.parse().map_err(js_error)?;
         let mut baked: Baked =
             trisort_player::baked_from_bytes(&bytes, Path::new(&name)).map_err(js_error)?;
@@ -84,7 +94,11 @@ impl WebPlayer {
         let uncaptured = UncapturedError::install(&gpu.device);
         let setup = configure_surface(&gpu, &surface, (width, height)).map_err(js_error)?;
         let blit = Blit::new(&gpu.device, setup.view_format, mode);
-        let settings = OnScreenSettings::recorded(&baked, mode);
+        let settings = OnScreenSettings {
+            shading,
+            tone_map,
+            ..OnScreenSettings::recorded(&baked, mode)
+        };
         let on_screen =
             OnScreen::new(&gpu, &baked, &blit, (width, height), settings).map_err(js_error)?;
         let warnings = on_screen.player().warnings().to_vec();

@@ -1,7 +1,7 @@
 // trisort's web player page: loads a baked file (?file=, default demo.baked, or a dropped
 // one), plays it on the canvas with the wasm player (pkg/, made by web/build.sh), and shows
 // play/pause, a scrub bar and the frame figures. ?backend=auto|webgpu|webgl2 and
-// ?mode=blend|depth|saturate choose how. ?selfcheck=1 plays in depth mode and also draws the
+// ?mode=blend|depth|saturate, ?shading=pbr|basic and ?tonemap=neutral|aces choose how. ?selfcheck=1 plays in depth mode and also draws the
 // file's z-buffer twin on a hidden canvas: pixels where the two differ are holes on this
 // browser (a triangle the frame leaves out is nearest there); the figures show their count.
 // window.trisort exposes the player and the self-check to tests.
@@ -11,6 +11,8 @@ const params = new URLSearchParams(location.search);
 const backend = params.get("backend") || "auto";
 const selfcheck = params.get("selfcheck") === "1";
 const mode = selfcheck ? "depth" : params.get("mode") || "blend";
+const shading = params.get("shading") || "pbr";
+const tonemap = params.get("tonemap") || "neutral";
 const $ = (id) => document.getElementById(id);
 const canvas = $("canvas");
 
@@ -88,8 +90,10 @@ async function open(bytes, name) {
     }
   }
   const target = $("canvas");
-  const p = await WebPlayer.open(target, bytes, name, backend, mode, false);
-  if (selfcheck) state.twin = await WebPlayer.open($("twin"), bytes, name, backend, mode, true);
+  const p = await WebPlayer.open(target, bytes, name, backend, mode, false, shading, tonemap);
+  if (selfcheck) {
+    state.twin = await WebPlayer.open($("twin"), bytes, name, backend, mode, true, shading, tonemap);
+  }
   state.player = p;
   state.frame = 0;
   const scrub = $("scrub");

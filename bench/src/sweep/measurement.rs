@@ -50,8 +50,7 @@ pub(super) fn measure(
             samples: config.samples,
             mode: Mode::Blend,
             glass_opacity: Some(baked.settings.glass_opacity),
-            draw_path: None,
-            force_u32: false,
+            ..HeadlessConfig::recorded(baked)
         },
     )?;
     let (w, h) = config.size;

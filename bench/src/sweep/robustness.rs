@@ -72,7 +72,8 @@ pub struct ConditionError {
     pub order_errors: u64,
 }
 
-/// The exact reference's blend frames under each condition (glass at `glass`).
+/// The exact reference's blend frames under each condition (glass at `glass`), lit by the
+/// bake's `environment`.
 pub(super) fn references(
     gpu: &Gpu,
     scene: &trisort_format::Geometry,
@@ -80,6 +81,7 @@ pub(super) fn references(
     config: &SweepConfig,
     frames: &[u32],
     glass: f32,
+    environment: &trisort_format::Environment,
 ) -> Result<Vec<Vec<Vec<u8>>>, BenchError> {
     // One reference per size: the offset conditions share it (only the offset changes).
     let mut at: Option<((u32, u32), ExactReference)> = None;
@@ -90,6 +92,7 @@ pub(super) fn references(
                 gpu,
                 scene,
                 path,
+                trisort_gpu::Lighting::pbr(environment),
                 ReferenceConfig {
                     size: c.size,
                     samples: config.samples,

@@ -130,10 +130,6 @@ impl Sweep<'_> {
             }
             let (rec, record_seconds) = self.record(*settings)?;
             let glass_key = settings.glass_opacity.to_bits();
-            if let Entry::Vacant(slot) = references.entry(glass_key) {
-                slot.insert(self.reference_frames(settings.glass_opacity)?);
-            }
-            let reference = &references[&glass_key];
             for v in users {
                 done += 1;
                 let step = format!(
@@ -153,6 +149,11 @@ impl Sweep<'_> {
                 let t = Instant::now();
                 let baked = trisort_merger::merge(std::slice::from_ref(&rec), &v.merge)?;
                 let merge_seconds = t.elapsed().as_secs_f64();
+                // The reference lights like the bake: with its environment.
+                if let Entry::Vacant(slot) = references.entry(glass_key) {
+                    slot.insert(self.reference_frames(settings.glass_opacity, &baked.environment)?);
+                }
+                let reference = &references[&glass_key];
                 let mut m = measure(
                     self.gpu,
                     &baked,
@@ -175,6 +176,7 @@ impl Sweep<'_> {
                             self.config,
                             self.frames,
                             settings.glass_opacity,
+                            &baked.environment,
                         )?);
                     }
                     m.robustness = robustness::measure(
@@ -317,8 +319,13 @@ impl Sweep<'_> {
         Ok((rec, seconds))
     }
 
-    /// The exact reference's frames at the playback settings with glass opacity `glass`.
-    fn reference_frames(&self, glass: f32) -> Result<Vec<Vec<u8>>, BenchError> {
+    /// The exact reference's frames at the playback settings with glass opacity `glass`, lit
+    /// by `environment`.
+    fn reference_frames(
+        &self,
+        glass: f32,
+        environment: &trisort_format::Environment,
+    ) -> Result<Vec<Vec<u8>>, BenchError> {
         let config = self.config;
         (self.progress)(&format!(
             "sweep: exact reference at {}x{}, {} samples, glass {}: {} frames",
@@ -332,6 +339,7 @@ impl Sweep<'_> {
             self.gpu,
             &self.scene.geometry,
             &self.timeline.frames,
+            trisort_gpu::Lighting::pbr(environment),
             ReferenceConfig {
                 size: config.size,
                 samples: config.samples,

@@ -92,10 +92,11 @@ fn fs_oit_list(
     @builtin(sample_mask) coverage: u32,
     @builtin(primitive_index) primitive: u32,
 ) -> @location(0) vec4<f32> {
+    let uv = player_uv(v);
     if ((coverage & (1u << sample)) == 0u) {
         discard;
     }
-    let c = player_colour(v, front_facing);
+    let c = player_colour(v, front_facing, uv);
     // Fully transparent fragments (glass at opacity 0) change nothing: `over` keeps the
     // destination exactly.
     if (c.a <= 0.0) {

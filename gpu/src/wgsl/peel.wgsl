@@ -24,6 +24,7 @@ struct PeelVarying {
     @location(0) @interpolate(flat) material: u32,
     // Alpha from textures is evaluated at the pixel centre, as the player evaluates it.
     @location(1) @interpolate(perspective, center) uv: vec2<f32>,
+    @location(2) @interpolate(perspective, center) uv1: vec2<f32>,
 }
 
 @vertex
@@ -32,6 +33,7 @@ fn vs_peel(v: VertexIn) -> PeelVarying {
     out.position = transform_position(v.position, v.node);
     out.material = v.material;
     out.uv = v.uv;
+    out.uv1 = v.uv1;
     return out;
 }
 
@@ -72,7 +74,7 @@ fn fs_peel(
     if (culled(in.material, front_facing)) {
         discard;
     }
-    let base = surface_base(in.material, in.uv);
+    let base = surface_base(in.material, in.uv, in.uv1);
     if (base.a < 0.0) {
         discard;
     }

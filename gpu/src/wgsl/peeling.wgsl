@@ -52,7 +52,7 @@ fn fs_peeling(
     if (culled(v.material, front_facing)) {
         discard;
     }
-    if (surface_base(v.material, v.uv).a < 0.0) {
+    if (surface_base(v.material, v.uv, v.uv1).a < 0.0) {
         discard;
     }
     let z = v.position.z;
@@ -102,6 +102,7 @@ fn fs_peeling_composite(
     @builtin(front_facing) front_facing: bool,
     @builtin(primitive_index) primitive: u32,
 ) -> PeelingCompositeOut {
+    let uv = player_uv(v);
     let coord = vec2<i32>(v.position.xy);
     let id = primitive + 1u;
     var mask = 0u;
@@ -114,7 +115,7 @@ fn fs_peeling_composite(
         discard;
     }
     var out: PeelingCompositeOut;
-    out.color = player_colour(v, front_facing);
+    out.color = player_colour(v, front_facing, uv);
     out.mask = mask;
     return out;
 }

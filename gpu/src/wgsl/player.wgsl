@@ -9,6 +9,11 @@ struct PlayerVarying {
     // Alpha from textures is evaluated at the pixel centre, as the recorder does.
     @location(1) @interpolate(perspective, center) uv: vec2<f32>,
     @location(2) normal: vec3<f32>,
+    @location(3) @interpolate(perspective, center) uv1: vec2<f32>,
+    // View-space tangent (xyz) and handedness (w).
+    @location(4) tangent: vec4<f32>,
+    // View-space position.
+    @location(5) view_position: vec3<f32>,
 }
 
 @vertex
@@ -18,19 +23,28 @@ fn vs_player(v: VertexIn) -> PlayerVarying {
     out.material = v.material;
     out.uv = v.uv;
     out.normal = transform_normal(v.normal, v.node);
+    out.uv1 = v.uv1;
+    out.tangent = vec4<f32>(transform_normal(v.tangent.xyz, v.node), v.tangent.w);
+    out.view_position = view_position(v.position, v.node);
     return out;
 }
 
+// The texture coordinates and their derivatives: call at the top of a fragment entry point,
+// before anything that may discard (uniform control flow).
+fn player_uv(v: PlayerVarying) -> SurfaceUv {
+    return surface_uv(v.uv, v.uv1);
+}
+
 // Lit colour with straight alpha in [0, 1]; discards culled back faces and MASK cut-outs.
-fn player_colour(v: PlayerVarying, front_facing: bool) -> vec4<f32> {
+fn player_colour(v: PlayerVarying, front_facing: bool, uv: SurfaceUv) -> vec4<f32> {
     if (culled(v.material, front_facing)) {
         discard;
     }
-    let base = surface_base(v.material, v.uv);
+    let base = surface_base(v.material, v.uv, v.uv1);
     if (base.a < 0.0) {
         discard;
     }
-    let c = shade(v.material, base, v.normal, front_facing);
+    let c = shade(v.material, base, ShadeIn(v.normal, v.tangent, v.view_position, front_facing, uv));
     return vec4<f32>(c.rgb, clamp(c.a, 0.0, 1.0));
 }
 
@@ -38,13 +52,15 @@ fn player_colour(v: PlayerVarying, front_facing: bool) -> vec4<f32> {
 // one-minus-src-alpha).
 @fragment
 fn fs_player_straight(v: PlayerVarying, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    return player_colour(v, front_facing);
+    let uv = player_uv(v);
+    return player_colour(v, front_facing, uv);
 }
 
 // `saturate`: premultiplied alpha; the blend state composites under what is already drawn
 // (one-minus-dst-alpha, one).
 @fragment
 fn fs_player_premultiplied(v: PlayerVarying, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
-    let c = player_colour(v, front_facing);
+    let uv = player_uv(v);
+    let c = player_colour(v, front_facing, uv);
     return vec4<f32>(c.rgb * c.a, c.a);
 }

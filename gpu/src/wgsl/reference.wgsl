@@ -41,12 +41,13 @@ struct ReferenceOut {
 // `player_colour` at the samples where triangle `primitive` is the layer's fragment; discards
 // where it is at none.
 fn layer_colour(v: PlayerVarying, front_facing: bool, primitive: u32) -> ReferenceOut {
+    let uv = player_uv(v);
     let mask = layer_mask(v.position, primitive);
     if (mask == 0u) {
         discard;
     }
     var out: ReferenceOut;
-    out.color = player_colour(v, front_facing);
+    out.color = player_colour(v, front_facing, uv);
     out.mask = mask;
     return out;
 }

@@ -1,6 +1,7 @@
 // Binding prelude of the data-texture tier (GLES 3.0 / WebGL2: no storage buffers in the
 // vertex stage). Node matrices of every frame and the materials are Rgba32Float texels read
-// with textureLoad, DATA_WIDTH texels a row, four texels (columns or fields) per item; this
+// with textureLoad, DATA_WIDTH texels a row, four texels (columns) a node matrix and
+// MATERIAL_TEXELS (fields) a material; this
 // frame's first node is `node_base.x`, a uniform bound by dynamic offset.
 @group(0) @binding(1) var<uniform> node_base: vec4<u32>;
 @group(0) @binding(2) var material_texels: texture_2d<f32>;
@@ -21,7 +22,16 @@ fn node_matrix(node: u32) -> mat4x4<f32> {
     return mat4x4<f32>(node_texel(i), node_texel(i + 1u), node_texel(i + 2u), node_texel(i + 3u));
 }
 
+// MATERIAL_TEXELS texels a material (the fields of `MaterialGpu` in order).
+const MATERIAL_TEXELS: u32 = 20u;
+
 fn material_at(index: u32) -> MaterialGpu {
-    let i = index * 4u;
-    return MaterialGpu(material_texel(i), material_texel(i + 1u), material_texel(i + 2u), material_texel(i + 3u));
+    let i = index * MATERIAL_TEXELS;
+    return MaterialGpu(
+        material_texel(i), material_texel(i + 1u), material_texel(i + 2u), material_texel(i + 3u),
+        material_texel(i + 4u), material_texel(i + 5u), material_texel(i + 6u), material_texel(i + 7u),
+        material_texel(i + 8u), material_texel(i + 9u), material_texel(i + 10u), material_texel(i + 11u),
+        material_texel(i + 12u), material_texel(i + 13u), material_texel(i + 14u), material_texel(i + 15u),
+        material_texel(i + 16u), material_texel(i + 17u), material_texel(i + 18u), material_texel(i + 19u),
+    );
 }

@@ -126,8 +126,8 @@ pub fn drawn_copies(baked: &Baked, draws: &[DrawIndexedIndirectArgs]) -> Vec<u32
         .collect()
 }
 
-/// The lit colour of a flat quad facing the camera (the shared `shade` with a view-space
-/// normal of +Z and no emission), straight alpha.
+/// The lit colour of a flat quad facing the camera under `--shading basic` (the shared
+/// `shade_basic` with a view-space normal of +Z and no emission), straight alpha.
 pub fn lit(base: [f32; 4]) -> [f64; 4] {
     let l = trisort_gpu::scene_gpu::LIGHT;
     let len = ((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]) as f64).sqrt();

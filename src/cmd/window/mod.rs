@@ -42,6 +42,8 @@ use crate::common::{print_json, FrameRange};
 mod gfx;
 use gfx::{Gfx, PlaySettings};
 
+use super::play::ShadingArgs;
+
 /// The error when no window can be opened.
 pub const NO_DISPLAY: &str =
     "no display: --window needs X11 or Wayland; use --out-dir for PNG frames";
@@ -68,6 +70,8 @@ pub struct WindowArgs<'a> {
     pub fps: Option<f64>,
     /// Material variant to play (default: the file's default materials).
     pub variant: Option<String>,
+    /// Surface model and tone map.
+    pub shading: ShadingArgs,
     /// For tests and automation: quit after presenting this many frames.
     pub exit_after: Option<u64>,
     /// Print the summary as JSON.
@@ -127,6 +131,7 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
         samples: a.samples.unwrap_or(baked.settings.samples).max(1),
         mode: a.mode,
         glass_opacity: a.glass_opacity,
+        shading: a.shading,
         period: Duration::from_secs_f64(1.0 / fps),
         variant: a.variant,
         exit_after: a.exit_after,
@@ -186,6 +191,7 @@ struct Viewer {
     samples: u32,
     mode: Mode,
     glass_opacity: Option<f32>,
+    shading: ShadingArgs,
     period: Duration,
     /// Material variant, applied to every player built.
     variant: Option<String>,
@@ -421,6 +427,8 @@ impl Viewer {
             samples: self.samples,
             mode: self.mode,
             glass_opacity: self.glass_opacity,
+            shading: self.shading.shading,
+            tone_map: self.shading.tonemap,
         };
         let gfx = Gfx::open(window, event_loop.owned_display_handle(), &self.baked, play)
             .with_context(|| format!("playing {}", self.path.display()))?;

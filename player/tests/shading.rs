@@ -1,0 +1,263 @@
+//! What the surface function draws (real renders on the test GPU): each map of the PBR model
+//! changes pixels, the environment, exposure and tone map are used, and `--shading basic`
+//! draws the one light plus ambient of before, ignoring every map.
+
+use trisort_format::{Baked, Environment, Material, Sun, Texture, TextureSlot};
+use trisort_gpu::{Gpu, Shading, ToneMap};
+use trisort_player::headless::{HeadlessConfig, HeadlessRenderer};
+use trisort_player::Mode;
+use trisort_testkit::gpu;
+
+use crate::support::{lit, pixel, quads, srgb8, SIZE};
+
+/// [`quads`] with the red and green quads invisible (blend, alpha 0) and the blue quad (the
+/// whole view in frame 1) grey, dielectric, half rough, with uv (both sets) running over
+/// [0, 1]² across the view (x right, y down) and a +X tangent, under a dim uniform environment and a bright sun from the upper right front.
+fn textured() -> Baked {
+    let mut b = quads();
+    let g = &mut b.geometry;
+    for m in &mut g.materials[..2] {
+        m.base_color[3] = 0.0;
+    }
+    g.materials[2] = Material {
+        base_color: [0.5, 0.5, 0.5, 1.0],
+        metallic: 0.0,
+        roughness: 0.5,
+        ..Default::default()
+    };
+    for v in g.vertices.iter_mut().filter(|v| v.material == 2) {
+        // The view spans x, y ∈ [−1.1, 1.1] at the quad's depth.
+        v.uv = [
+            (v.position[0] / 1.1 + 1.0) / 2.0,
+            (1.0 - v.position[1] / 1.1) / 2.0,
+        ];
+        v.uv1 = v.uv;
+        v.tangent = [1.0, 0.0, 0.0, 1.0];
+    }
+    let mut env = Environment::uniform(0.2);
+    env.sun = Some(Sun {
+        direction: [0.4, 0.5, 1.0],
+        color: [2.0, 2.0, 2.0],
+    });
+    b.environment = env;
+    b
+}
+
+/// A `size`² linear or sRGB texture of one colour, with its mip chain.
+fn flat_texture(rgba: [u8; 4], size: u32, srgb: bool) -> Texture {
+    let level = |s: u32| rgba.repeat((s * s) as usize);
+    Texture {
+        name: String::new(),
+        width: size,
+        height: size,
+        rgba8: level(size),
+        srgb,
+        mips: (1..32 - size.leading_zeros())
+            .map(|k| level((size >> k).max(1)))
+            .collect(),
+    }
+}
+
+/// The slot of texture `texture` on uv set 0, untransformed.
+fn slot(texture: u32) -> Option<TextureSlot> {
+    Some(TextureSlot {
+        texture,
+        tex_coord: 0,
+        transform: Default::default(),
+    })
+}
+
+/// Frame 1 of `baked` (the grey quad over the whole view) at 4× in blend mode.
+fn render(gpu: &Gpu, baked: &Baked, shading: Shading, tone_map: ToneMap) -> Vec<u8> {
+    let config = HeadlessConfig {
+        samples: 4,
+        mode: Mode::Blend,
+        shading,
+        tone_map,
+        ..HeadlessConfig::recorded(baked)
+    };
+    HeadlessRenderer::new(gpu, baked, &config)
+        .expect("renderer")
+        .render(1)
+        .expect("frame")
+        .rgba8
+}
+
+fn pbr(gpu: &Gpu, baked: &Baked) -> Vec<u8> {
+    render(gpu, baked, Shading::Pbr, ToneMap::Neutral)
+}
+
+/// The largest channel difference of two images.
+fn max_diff(a: &[u8], b: &[u8]) -> u8 {
+    a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap()
+}
+
+/// `baked` changed by `change`.
+fn with(baked: &Baked, change: impl FnOnce(&mut Baked)) -> Baked {
+    let mut b = baked.clone();
+    change(&mut b);
+    b
+}
+
+#[test]
+fn every_map_of_the_pbr_model_changes_pixels() {
+    let Some(gpu) = gpu() else { return };
+    let plain = textured();
+    let base = pbr(&gpu, &plain);
+    // The quad is lit: not the background, not black, not saturated.
+    let centre = pixel(&base, SIZE / 2, SIZE / 2);
+    assert!(centre.iter().all(|&c| c > 20 && c < 250), "{centre:?}");
+    let metal = with(&plain, |b| {
+        b.geometry.materials[2].metallic = 1.0;
+        b.geometry.materials[2].roughness = 1.0;
+    });
+    let glowing = with(&plain, |b| {
+        b.geometry.materials[2].emissive = [1.0, 1.0, 1.0]
+    });
+    // A rough base under a sun behind the camera: the smooth coat's highlight is in view.
+    let rough = with(&plain, |b| {
+        b.geometry.materials[2].roughness = 1.0;
+        if let Some(sun) = &mut b.environment.sun {
+            sun.direction = [0.02, 0.03, 1.0];
+        }
+    });
+    // Each map against the same material without it.
+    let cases: Vec<(&str, &Baked, Baked)> = vec![
+        (
+            "normal map (tilted to -X)",
+            &plain,
+            with(&plain, |b| {
+                b.geometry.textures = vec![flat_texture([38, 128, 218, 255], 4, false)];
+                b.geometry.materials[2].normal_texture = slot(0);
+            }),
+        ),
+        (
+            "metallic-roughness texture (smooth metal)",
+            &metal,
+            with(&metal, |b| {
+                b.geometry.textures = vec![flat_texture([0, 20, 255, 255], 4, false)];
+                b.geometry.materials[2].metallic_roughness_texture = slot(0);
+            }),
+        ),
+        (
+            "emissive texture (red)",
+            &glowing,
+            with(&glowing, |b| {
+                b.geometry.textures = vec![flat_texture([255, 0, 0, 255], 4, true)];
+                b.geometry.materials[2].emissive_texture = slot(0);
+            }),
+        ),
+        (
+            "occlusion texture (dark)",
+            &plain,
+            with(&plain, |b| {
+                b.geometry.textures = vec![flat_texture([30, 0, 0, 255], 4, false)];
+                b.geometry.materials[2].occlusion_texture = slot(0);
+            }),
+        ),
+        (
+            "clearcoat",
+            &rough,
+            with(&rough, |b| {
+                b.geometry.materials[2].clearcoat = 1.0;
+                b.geometry.materials[2].clearcoat_roughness = 0.05;
+            }),
+        ),
+        (
+            "base-colour texture on uv set 1, scaled by its transform",
+            &plain,
+            with(&plain, |b| {
+                let mut t = flat_texture([255, 255, 255, 255], 8, true);
+                // A black left half: the transform's scale of 2 repeats it twice.
+                for (i, px) in t.rgba8.chunks_mut(4).enumerate() {
+                    if i % 8 < 4 {
+                        px[..3].copy_from_slice(&[0, 0, 0]);
+                    }
+                }
+                // No stored chain: the upload makes one.
+                t.mips.clear();
+                b.geometry.textures = vec![t];
+                let m = &mut b.geometry.materials[2];
+                m.base_color_texture = Some(0);
+                m.base_color_tex_coord = 1;
+                m.base_color_transform.scale = [2.0, 1.0];
+            }),
+        ),
+    ];
+    for (name, without, mapped) in &cases {
+        let d = max_diff(&pbr(&gpu, mapped), &pbr(&gpu, without));
+        assert!(d >= 8, "{name}: the image changes by only {d}/255");
+    }
+    // The colour texture through its transform: uv.x 0.125 and 0.625 map to the black halves
+    // of two repeats, 0.375 and 0.875 to the white ones.
+    let image = pbr(&gpu, &cases[5].2);
+    let row = SIZE / 2;
+    let at = |u: f32| pixel(&image, (u * SIZE as f32) as u32, row);
+    for u in [0.125, 0.625] {
+        for w in [0.375, 0.875] {
+            assert!(at(u)[1] + 40 < at(w)[1], "{:?} {:?}", at(u), at(w));
+        }
+    }
+}
+
+#[test]
+fn light_comes_from_the_environment_exposure_and_tone_map() {
+    let Some(gpu) = gpu() else { return };
+    let plain = textured();
+    let base = pbr(&gpu, &plain);
+    let brighter = with(&plain, |b| b.environment.exposure = 2.0);
+    let sunless = with(&plain, |b| b.environment.sun = None);
+    let tinted = with(&plain, |b| {
+        // Irradiance from +Y only (the quad faces +Z: half of that reaches it).
+        b.environment.sh[2] = [0.0, 0.0, 1.0];
+    });
+    for (name, b) in [
+        ("exposure 2", &brighter),
+        ("no sun", &sunless),
+        ("SH", &tinted),
+    ] {
+        let d = max_diff(&pbr(&gpu, b), &base);
+        assert!(d >= 8, "{name}: the image changes by only {d}/255");
+    }
+    let aces = render(&gpu, &plain, Shading::Pbr, ToneMap::Aces);
+    assert!(max_diff(&aces, &base) >= 4, "ACES draws as Neutral does");
+}
+
+#[test]
+fn basic_shading_draws_the_old_model_and_ignores_the_maps() {
+    let Some(gpu) = gpu() else { return };
+    let plain = textured();
+    let mapped = with(&plain, |b| {
+        b.geometry.textures = vec![
+            flat_texture([38, 128, 218, 255], 4, false),
+            flat_texture([255, 0, 0, 255], 4, true),
+        ];
+        let m = &mut b.geometry.materials[2];
+        m.normal_texture = slot(0);
+        m.metallic_roughness_texture = slot(0);
+        m.emissive_texture = slot(1);
+        m.clearcoat = 1.0;
+        b.environment.exposure = 3.0;
+    });
+    let old = render(&gpu, &plain, Shading::Basic, ToneMap::Neutral);
+    assert_eq!(
+        render(&gpu, &mapped, Shading::Basic, ToneMap::Neutral),
+        old,
+        "basic shading ignores maps, clearcoat and the environment"
+    );
+    assert_eq!(
+        render(&gpu, &plain, Shading::Basic, ToneMap::Aces),
+        old,
+        "basic shading has no tone map"
+    );
+    // One light plus ambient, as before physically based shading.
+    let want = srgb8(lit([0.5, 0.5, 0.5, 1.0])[..3].try_into().unwrap());
+    for (x, y) in [(2, 2), (SIZE / 2, SIZE / 2), (SIZE - 3, SIZE - 3)] {
+        let got = pixel(&old, x, y);
+        assert!(
+            got.iter().zip(want).all(|(a, b)| a.abs_diff(b) <= 1),
+            "({x}, {y}): {got:?}, want {want:?}"
+        );
+    }
+    assert!(max_diff(&pbr(&gpu, &plain), &old) >= 8);
+}
