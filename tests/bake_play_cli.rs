@@ -125,6 +125,14 @@ fn demo_exports_a_scene_that_imports_back_with_the_same_triangles() {
         "{text}"
     );
     assert!(!pngs(&dir.path().join("out/frames")).is_empty());
+    // The demo shows its glass (issue 17 part 4): baked and played at opacity 0.35.
+    assert!(text.contains("glass at opacity 0.35"), "{text}");
+    let baked: trisort_format::Baked = trisort_format::container::read_file(
+        trisort_format::FileKind::Baked,
+        &dir.path().join("out/demo.baked"),
+    )
+    .unwrap();
+    assert_eq!(baked.settings.glass_opacity, 0.35);
     let exported = run_json(dir.path(), &["inspect", "car.glb"]);
     let builtin = run_json(dir.path(), &["inspect", "demo:10000"]);
     assert_eq!(exported["triangles"], builtin["triangles"]);

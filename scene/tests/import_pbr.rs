@@ -149,6 +149,16 @@ fn car_concept_reads_every_pbr_slot_clearcoat_tangents_and_uv1() {
         .notes
         .iter()
         .any(|n| n.contains("KHR_texture_transform")));
+    // The one 2048x2048 image is stored from its 1024x1024 level, and the note says the bytes.
+    let capped = scene
+        .notes
+        .iter()
+        .find(|n| n.contains("(2048x2048) is stored from mip level 1 (1024x1024"))
+        .expect("a note on the capped image");
+    assert!(
+        capped.contains("5592404 bytes with its mips instead of 22369620"),
+        "{capped}"
+    );
 }
 
 #[test]

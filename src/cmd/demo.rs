@@ -44,6 +44,11 @@ pub const DEMO_GLASS_OPACITY: f32 = 0.35;
 
 pub fn run(a: DemoArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
+    let settings = RecordSettings {
+        glass_opacity: a.glass_opacity,
+        ..RecordSettings::new(a.size, a.samples)
+    };
+    settings.validate()?;
     let triangles = a
         .triangles
         .unwrap_or(trisort_scene::demo_car::DEFAULT_TRIANGLES);
@@ -62,11 +67,6 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         a.glass_opacity,
         path.frames.len()
     );
-    let settings = RecordSettings {
-        glass_opacity: a.glass_opacity,
-        ..RecordSettings::new(a.size, a.samples)
-    };
-    settings.validate()?;
     let record = RecordOpts::new(settings, path.fps);
     crate::common::working_scene(
         &mut scene,
