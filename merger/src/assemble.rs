@@ -102,7 +102,8 @@ impl Assembled {
             frame_states: first.frame_states.clone(),
             removed_edges,
             fps: first.fps,
-            environment: trisort_format::Environment::uniform(1.0),
+            // The built-in studio; a caller with another light replaces it.
+            environment: trisort_format::Environment::studio(),
         }
     }
 }

@@ -229,7 +229,9 @@ pub enum MergeError {
 /// order). With several combinations, ILB and IBL compact run first and the others are
 /// abandoned once their copies exceed 1.5 × the better of those two (`PRUNE_FACTOR`). Output ids are G-local. The result is
 /// deterministic — the same inputs give the same bytes whatever the thread count — so
-/// `stats.seconds` is left 0 (callers measure and report the time).
+/// `stats.seconds` is left 0 (callers measure and report the time). The file is lit by the
+/// built-in studio ([`trisort_format::Environment::studio`]); a caller that lights it
+/// otherwise (`--environment`) replaces [`Baked::environment`].
 ///
 /// Errors when the recordings are not frame ranges of one path recorded with graphs (see
 /// [`MergeError`]). Frames the recorder marked truncated are merged as recorded (their graph

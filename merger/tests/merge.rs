@@ -175,6 +175,24 @@ fn turntable_half_turn_validates() {
     assert_all_valid(std::slice::from_ref(&rec), "turntable");
 }
 
+/// A merged file is lit by the built-in studio (prefiltered levels and a sun), which passes
+/// the structure check a reader runs.
+#[test]
+fn merged_files_are_lit_by_the_studio() {
+    let rec = turntable(&Turntable {
+        objects: 2,
+        sides: 6,
+        frames: 3,
+        ..Turntable::default()
+    });
+    let baked = merge(std::slice::from_ref(&rec), &MergeOptions::default()).expect("merge");
+    baked.check_structure().expect("structure");
+    let env = &baked.environment;
+    assert_eq!(env.name, "studio");
+    assert_eq!(*env, trisort_format::Environment::studio());
+    assert!(env.levels.len() > 1 && env.sun.is_some());
+}
+
 /// Three triangles overlapping cyclically in one frame: the lightest edge is removed and its
 /// weight reported as unordered samples.
 #[test]
