@@ -11,6 +11,7 @@ mod bench_cli;
 mod c_host;
 mod cli_basics;
 mod compressed_gltf;
+mod environment_cli;
 mod export_order;
 mod extremes;
 mod extremes_no_lost_work;

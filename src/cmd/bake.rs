@@ -51,6 +51,8 @@ pub fn bake(
     merge: &MergeOpts,
     output: &Path,
 ) -> Result<(Recording, Baked, f64, f64)> {
+    // Before anything is written: a bad light leaves no output.
+    let environment = merge.environment()?;
     let t0 = Instant::now();
     let rec_path = recording_path(output);
     let rec = record_to_file(gpu, scene, timeline, record, Phase::Graphs, None, &rec_path)?;
@@ -59,6 +61,7 @@ pub fn bake(
     let baked = merge_to_file(
         std::slice::from_ref(&rec),
         &merge.options(),
+        environment,
         output,
         &[rec_path.display().to_string()],
     )?;

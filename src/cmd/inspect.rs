@@ -111,6 +111,8 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
             Some((v.name.clone(), serde_json::Value::from(e.to_string())))
         }).collect::<serde_json::Map<_, _>>(),
         "split_intersections": baked.settings.split_intersections,
+        // The light stored in the file (`bake --environment`).
+        "environment": crate::cmd::merge::environment_json(&baked.environment),
         // The recording device; `mixed: …` (each device with its frames) when the recordings
         // were merged with `merge --allow-mixed-devices`.
         "device": baked.device.adapter, "driver": baked.device.driver,

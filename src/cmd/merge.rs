@@ -6,7 +6,9 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
-use trisort_format::{Baked, Bridge, Choice, FileKind, Layout, Recording, Seeding, Strategy};
+use trisort_format::{
+    Baked, Bridge, Choice, Environment, FileKind, Layout, Recording, Seeding, Strategy,
+};
 use trisort_merger::MergeOptions;
 
 use crate::common::{choice_parser, option_parser, print_json};
@@ -39,7 +41,15 @@ pub struct MergeOpts {
     #[arg(long, value_parser = option_parser::<Seeding>(),
           default_value_t = MergeOptions::default().seeding)]
     pub seeding: Seeding,
+    /// The light stored in the baked file, which players shade with: `studio` (the built-in
+    /// studio with a sun) or an equirectangular Radiance .hdr file (row 0 at the zenith),
+    /// prefiltered at bake time (a file named `studio`: `./studio`).
+    #[arg(long, value_name = "studio|FILE.hdr", default_value = STUDIO)]
+    pub environment: String,
 }
+
+/// `--environment`'s name of the built-in studio.
+const STUDIO: &str = "studio";
 
 impl MergeOpts {
     /// The command line's defaults: [`MergeOptions::default`].
@@ -52,7 +62,19 @@ impl MergeOpts {
             depth_only: o.depth_only,
             segment: o.segment.unwrap_or(0),
             seeding: o.seeding,
+            environment: STUDIO.to_string(),
         }
+    }
+
+    /// The `--environment` light: the built-in studio, or the .hdr file loaded and prefiltered
+    /// (an error naming the file when it cannot be).
+    pub fn environment(&self) -> Result<Environment> {
+        if self.environment == STUDIO {
+            return Ok(Environment::studio());
+        }
+        Ok(trisort_scene::load_hdr(std::path::Path::new(
+            &self.environment,
+        ))?)
     }
 
     /// The merger's options (`--segment 0`: no segments).
@@ -118,7 +140,22 @@ pub fn baked_json(b: &Baked, seconds: f64) -> serde_json::Value {
         "exact_components": s.exact_components,
         "heuristic_components": s.heuristic_components,
         "heuristic_unordered_samples": s.heuristic_unordered_samples,
+        "environment": environment_json(&b.environment),
         "seconds": seconds,
+    })
+}
+
+/// The `environment` of `--json`: its name, level 0's size, levels, bytes of texels and sun
+/// (`null` without one; else `direction` towards the light and `color`), and exposure.
+pub fn environment_json(e: &Environment) -> serde_json::Value {
+    json!({
+        "name": e.name,
+        "width": e.width,
+        "height": e.height,
+        "levels": e.levels.len(),
+        "bytes": e.texel_bytes(),
+        "sun": e.sun.map(|s| json!({"direction": s.direction, "color": s.color})),
+        "exposure": e.exposure,
     })
 }
 
@@ -197,20 +234,22 @@ pub fn check_compatible(
     Ok(warnings)
 }
 
-/// Merges and writes atomically.
+/// Merges, lights the result with `environment` and writes atomically.
 pub fn merge_to_file(
     recs: &[Recording],
     opts: &MergeOptions,
+    environment: Environment,
     output: &std::path::Path,
     names: &[String],
 ) -> Result<Baked> {
-    merge_to_file_with(recs, opts, output, names, false)
+    merge_to_file_with(recs, opts, environment, output, names, false)
 }
 
 /// [`merge_to_file`], merging recordings of different devices when `allow_mixed_devices`.
 fn merge_to_file_with(
     recs: &[Recording],
     opts: &MergeOptions,
+    environment: Environment,
     output: &std::path::Path,
     names: &[String],
     allow_mixed_devices: bool,
@@ -221,7 +260,8 @@ fn merge_to_file_with(
         trisort_merger::merge(recs, opts)
     };
     // Errors name recordings by index; say which file that is.
-    let baked = merged.map_err(|e| anyhow::anyhow!("{}", name_files(&e.to_string(), names)))?;
+    let mut baked = merged.map_err(|e| anyhow::anyhow!("{}", name_files(&e.to_string(), names)))?;
+    baked.environment = environment;
     trisort_format::write_file_atomic(FileKind::Baked, output, &baked)
         .with_context(|| format!("writing {}", output.display()))?;
     Ok(baked)
@@ -239,6 +279,8 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
         }
     }
     check_compatible(&recs, &a.recordings, a.allow_mixed_devices)?;
+    // Before anything is written: a bad light leaves no output.
+    let environment = a.opts.environment()?;
     let mut names: Vec<String> = a
         .recordings
         .iter()
@@ -256,6 +298,7 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
     let baked = merge_to_file_with(
         &recs,
         &a.opts.options(),
+        environment,
         &a.output,
         &names,
         a.allow_mixed_devices,
