@@ -43,6 +43,14 @@ pub enum EnvironmentError {
         /// What the decoder said.
         problem: String,
     },
+    /// The HDR image uses a feature the decoder lacks (an orientation other than `-Y h +X w`).
+    #[error("{}: unsupported HDR image: {problem}", file.display())]
+    Unsupported {
+        /// The file.
+        file: PathBuf,
+        /// What the decoder said.
+        problem: String,
+    },
     /// The image decoded but cannot be an environment (too large, empty, a non-finite or
     /// negative texel).
     #[error("{}: unusable as an environment: {problem}", file.display())]
@@ -61,7 +69,8 @@ pub enum EnvironmentError {
 ///
 /// Files starting `#?RADIANCE` are read strictly, other `#?` signatures (`#?RGBE`) leniently.
 /// Errors name the file: missing or unreadable, not an HDR image, a truncated or corrupt one,
-/// more than [`MAX_HDR_TEXELS`] texels, or texels that are not finite and non-negative.
+/// one stored in another orientation than `-Y h +X w` (rows top down), more than
+/// [`MAX_HDR_TEXELS`] texels, or texels that are not finite and non-negative.
 pub fn load_hdr(path: &Path) -> Result<Environment, EnvironmentError> {
     let file = || path.to_path_buf();
     let bytes = std::fs::read(path).map_err(|source| EnvironmentError::Io {
@@ -79,9 +88,15 @@ pub fn load_hdr(path: &Path) -> Result<Environment, EnvironmentError> {
             },
         });
     }
-    let corrupt = |e: image::ImageError| EnvironmentError::Corrupt {
-        file: file(),
-        problem: e.to_string(),
+    let corrupt = |e: image::ImageError| match e {
+        image::ImageError::Unsupported(_) => EnvironmentError::Unsupported {
+            file: file(),
+            problem: e.to_string(),
+        },
+        _ => EnvironmentError::Corrupt {
+            file: file(),
+            problem: e.to_string(),
+        },
     };
     let strict = bytes.starts_with(b"#?RADIANCE");
     let decoder = HdrDecoder::with_strictness(Cursor::new(&bytes[..]), strict).map_err(corrupt)?;
@@ -188,6 +203,18 @@ mod tests {
         std::fs::write(&header_only, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n").unwrap();
         let e = load_hdr(&header_only).unwrap_err().to_string();
         assert!(e.contains("truncated or corrupt"), "{e}");
+
+        let flipped = dir.path().join("flipped.hdr");
+        std::fs::write(
+            &flipped,
+            b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n+Y 8 +X 16\n",
+        )
+        .unwrap();
+        let e = load_hdr(&flipped).unwrap_err().to_string();
+        assert!(
+            e.contains("unsupported HDR image") && e.contains("+Y +X"),
+            "{e}"
+        );
 
         let huge = dir.path().join("huge.hdr");
         std::fs::write(

@@ -42,8 +42,9 @@ pub struct MergeOpts {
           default_value_t = MergeOptions::default().seeding)]
     pub seeding: Seeding,
     /// The light stored in the baked file, which players shade with: `studio` (the built-in
-    /// studio with a sun) or an equirectangular Radiance .hdr file (row 0 at the zenith),
-    /// prefiltered at bake time (a file named `studio`: `./studio`).
+    /// studio with a sun) or an equirectangular Radiance .hdr file (row 0 at the zenith,
+    /// column 0 looking along +X, the middle column along −X), prefiltered at bake time (a
+    /// file named `studio`: `./studio`).
     #[arg(long, value_name = "studio|FILE.hdr", default_value = STUDIO)]
     pub environment: String,
 }
