@@ -261,3 +261,70 @@ fn basic_shading_draws_the_old_model_and_ignores_the_maps() {
     }
     assert!(max_diff(&pbr(&gpu, &plain), &old) >= 8);
 }
+
+#[test]
+fn colour_textures_use_their_stored_mips_and_alpha_stays_at_level_0() {
+    let Some(gpu) = gpu() else { return };
+    // Level 0 white, every smaller level black: what shows tells which level was sampled.
+    let mut t = flat_texture([255, 255, 255, 255], 16, true);
+    for level in &mut t.mips {
+        for px in level.chunks_mut(4) {
+            px[..3].copy_from_slice(&[0, 0, 0]);
+        }
+    }
+    let textured = |repeat: f32| {
+        with(&textured(), |b| {
+            b.geometry.textures = vec![t.clone()];
+            let m = &mut b.geometry.materials[2];
+            m.base_color = [1.0; 4];
+            m.base_color_texture = Some(0);
+            m.base_color_transform.scale = [repeat, repeat];
+        })
+    };
+    let centre = |image: &[u8]| pixel(image, SIZE / 2, SIZE / 2);
+    // 16 texels over 32 pixels: magnified, level 0.
+    let near = textured(1.0);
+    // 16 × 16 texels over 32 pixels: 8 texels a pixel, level 3.
+    let far = textured(16.0);
+    let (n, f) = (centre(&pbr(&gpu, &near)), centre(&pbr(&gpu, &far)));
+    assert!(n.iter().all(|&c| c > 100), "magnified: {n:?}");
+    assert!(f.iter().all(|&c| c < 30), "minified: {f:?}");
+    // The basic model colours with `surface_base`, the level-0 texel that decides alpha.
+    let basic = render(&gpu, &far, Shading::Basic, ToneMap::Neutral);
+    let b = centre(&basic);
+    assert!(b.iter().all(|&c| c > 100), "basic: {b:?}");
+}
+
+/// [`textured`] with every map at once (normal, metallic-roughness, occlusion, emissive, a
+/// base-colour checker on uv set 1 through a rotating transform) and clearcoat: both texture
+/// arrays hold layers of different sizes.
+pub fn every_map() -> Baked {
+    with(&textured(), |b| {
+        let mut checker = flat_texture([255, 255, 255, 255], 8, true);
+        for (i, px) in checker.rgba8.chunks_mut(4).enumerate() {
+            if (i % 8 + i / 8) % 2 == 0 {
+                px[..3].copy_from_slice(&[200, 40, 0]);
+            }
+        }
+        checker.mips.clear();
+        b.geometry.textures = vec![
+            flat_texture([90, 160, 220, 255], 4, false),
+            flat_texture([0, 90, 200, 255], 2, false),
+            flat_texture([255, 120, 0, 255], 4, true),
+            checker,
+            flat_texture([140, 0, 0, 255], 16, false),
+        ];
+        let m = &mut b.geometry.materials[2];
+        m.normal_texture = slot(0);
+        m.metallic_roughness_texture = slot(1);
+        m.emissive_texture = slot(2);
+        m.emissive = [0.5, 0.5, 0.5];
+        m.base_color_texture = Some(3);
+        m.base_color_tex_coord = 1;
+        m.base_color_transform.rotation = 0.4;
+        m.base_color_transform.offset = [0.1, 0.2];
+        m.occlusion_texture = slot(4);
+        m.clearcoat = 0.7;
+        m.clearcoat_roughness = 0.2;
+    })
+}

@@ -64,22 +64,28 @@ fn webgl2_limits_pick_data_textures_and_direct_draws_and_the_same_bytes() {
         return;
     };
     assert_eq!(web.device.limits().max_storage_buffers_per_shader_stage, 0);
-    let baked = quads();
-    let (b, d, full_frames) = all_frames(&full, &baked);
-    assert_eq!(b, Bindings::Storage);
-    if full
-        .adapter
-        .get_downlevel_capabilities()
-        .flags
-        .contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION)
-    {
-        assert_eq!(d, DrawPath::MultiDrawIndirect);
-    }
-    let (b, d, web_frames) = all_frames(&web, &baked);
-    assert_eq!((b, d), (Bindings::Textures, DrawPath::Direct));
-    assert_eq!(full_frames.len(), web_frames.len());
-    for (k, (a, b)) in full_frames.iter().zip(&web_frames).enumerate() {
-        assert!(a == b, "image {k} differs between the tiers");
+    // The plain quads, and a material with every texture slot (both arrays, 20 texels of
+    // material data on the texture tier).
+    for (name, baked) in [
+        ("quads", quads()),
+        ("every map", crate::shading::every_map()),
+    ] {
+        let (b, d, full_frames) = all_frames(&full, &baked);
+        assert_eq!(b, Bindings::Storage);
+        if full
+            .adapter
+            .get_downlevel_capabilities()
+            .flags
+            .contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION)
+        {
+            assert_eq!(d, DrawPath::MultiDrawIndirect);
+        }
+        let (b, d, web_frames) = all_frames(&web, &baked);
+        assert_eq!((b, d), (Bindings::Textures, DrawPath::Direct));
+        assert_eq!(full_frames.len(), web_frames.len());
+        for (k, (a, b)) in full_frames.iter().zip(&web_frames).enumerate() {
+            assert!(a == b, "{name}: image {k} differs between the tiers");
+        }
     }
 }
 
@@ -92,12 +98,16 @@ fn gl_draws_the_same_bytes_on_both_tiers() {
         return;
     };
     assert_eq!(web.info.backend, wgpu::Backend::Gl);
-    let baked = quads();
-    let (_, _, gl_frames) = all_frames(&gl, &baked);
-    let (b, d, web_frames) = all_frames(&web, &baked);
-    assert_eq!((b, d), (Bindings::Textures, DrawPath::Direct));
-    for (k, (a, b)) in gl_frames.iter().zip(&web_frames).enumerate() {
-        assert!(a == b, "image {k} differs between the GL tiers");
+    for (name, baked) in [
+        ("quads", quads()),
+        ("every map", crate::shading::every_map()),
+    ] {
+        let (_, _, gl_frames) = all_frames(&gl, &baked);
+        let (b, d, web_frames) = all_frames(&web, &baked);
+        assert_eq!((b, d), (Bindings::Textures, DrawPath::Direct));
+        for (k, (a, b)) in gl_frames.iter().zip(&web_frames).enumerate() {
+            assert!(a == b, "{name}: image {k} differs between the GL tiers");
+        }
     }
 }
 

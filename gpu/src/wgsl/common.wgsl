@@ -115,7 +115,11 @@ fn slot_uv(u_row: vec4<f32>, v_row: vec4<f32>, uv: vec2<f32>, uv1: vec2<f32>) ->
 // alpha), blend materials their alpha. Returns alpha < 0 when a MASK fragment is cut away.
 // This alone decides visibility (recorder, player, reference): level 0 at the pixel centre.
 fn surface_base(material: u32, uv: vec2<f32>, uv1: vec2<f32>) -> vec4<f32> {
-    let m = material_at(material);
+    return surface_base_of(material_at(material), uv, uv1);
+}
+
+// `surface_base` of a material already read (`material_at`).
+fn surface_base_of(m: MaterialGpu, uv: vec2<f32>, uv1: vec2<f32>) -> vec4<f32> {
     var color = m.base_color;
     if (m.params.w >= 0.0) {
         let layer = i32(m.params.w);
@@ -143,7 +147,12 @@ fn surface_base(material: u32, uv: vec2<f32>, uv1: vec2<f32>) -> vec4<f32> {
 
 // Whether a fragment is discarded for facing: single-sided materials drop back faces.
 fn culled(material: u32, front_facing: bool) -> bool {
-    return material_at(material).params.z < 0.5 && !front_facing;
+    return culled_of(material_at(material), front_facing);
+}
+
+// `culled` of a material already read.
+fn culled_of(m: MaterialGpu, front_facing: bool) -> bool {
+    return m.params.z < 0.5 && !front_facing;
 }
 
 // Texture coordinates and their screen-space derivatives, taken at the top of a fragment
@@ -283,22 +292,21 @@ fn tone_map_aces(c: vec3<f32>) -> vec3<f32> {
 
 // `basic` shading: one view-space directional light plus ambient, plus the emissive factor,
 // no tone map (what trisort drew before PBR; the C host draws this).
-fn shade_basic(material: u32, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
+fn shade_basic(m: MaterialGpu, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
     var n = normalize(s.normal + vec3<f32>(0.0, 0.0, 1e-12));
     if (!s.front_facing) {
         n = -n;
     }
     let diffuse = max(dot(n, normalize(frame.light.xyz)), 0.0);
     let lit = base.rgb * (frame.light.w + (1.0 - frame.light.w) * diffuse)
-        + material_at(material).emissive.rgb;
+        + m.emissive.rgb;
     return vec4<f32>(lit, base.a);
 }
 
 // `pbr` shading: glTF metallic-roughness with normal, occlusion and emissive maps and a
 // clearcoat layer, lit by the environment (prefiltered radiance × analytic split sum,
 // spherical-harmonic irradiance) and the optional sun; exposed and tone mapped into [0, 1].
-fn shade_pbr(material: u32, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
-    let m = material_at(material);
+fn shade_pbr(m: MaterialGpu, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
     let white = vec4<f32>(1.0);
     // Colour at the mips the derivatives ask for; `base` (level 0) keeps the alpha.
     var albedo = m.base_color.rgb;
@@ -388,11 +396,11 @@ fn shade_pbr(material: u32, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
     return vec4<f32>(clamp(colour, vec3<f32>(0.0), vec3<f32>(1.0)), base.a);
 }
 
-// Lit colour (linear, straight alpha) of a fragment whose `surface_base` is `base`: `basic`
-// or `pbr` as the lighting says.
-fn shade(material: u32, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
+// Lit colour (linear, straight alpha) of a fragment of material `m` (`material_at`, read once
+// per fragment) whose `surface_base` is `base`: `basic` or `pbr` as the lighting says.
+fn shade(m: MaterialGpu, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
     if (lighting.params.y > 0.5) {
-        return shade_pbr(material, base, s);
+        return shade_pbr(m, base, s);
     }
-    return shade_basic(material, base, s);
+    return shade_basic(m, base, s);
 }

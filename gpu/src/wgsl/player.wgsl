@@ -37,14 +37,16 @@ fn player_uv(v: PlayerVarying) -> SurfaceUv {
 
 // Lit colour with straight alpha in [0, 1]; discards culled back faces and MASK cut-outs.
 fn player_colour(v: PlayerVarying, front_facing: bool, uv: SurfaceUv) -> vec4<f32> {
-    if (culled(v.material, front_facing)) {
+    // The material's fields are read once (on the data-texture tier, one texel each).
+    let m = material_at(v.material);
+    if (culled_of(m, front_facing)) {
         discard;
     }
-    let base = surface_base(v.material, v.uv, v.uv1);
+    let base = surface_base_of(m, v.uv, v.uv1);
     if (base.a < 0.0) {
         discard;
     }
-    let c = shade(v.material, base, ShadeIn(v.normal, v.tangent, v.view_position, front_facing, uv));
+    let c = shade(m, base, ShadeIn(v.normal, v.tangent, v.view_position, front_facing, uv));
     return vec4<f32>(c.rgb, clamp(c.a, 0.0, 1.0));
 }
 
