@@ -40,13 +40,14 @@ impl Assembled {
         self.windows.iter().map(|w| w.count).max().unwrap_or(0)
     }
 
-    /// The Baked file.
+    /// The Baked file, lit by `environment`.
     pub fn into_baked(
         self,
         first: &Recording,
         recording_hashes: Vec<trisort_format::Hash>,
         graphs: &[FrameGraph],
         opts: &MergeOptions,
+        environment: trisort_format::Environment,
     ) -> Baked {
         let frames = self.windows.len().max(1) as f64;
         let mut drawn_not_visible = 0u64;
@@ -102,8 +103,7 @@ impl Assembled {
             frame_states: first.frame_states.clone(),
             removed_edges,
             fps: first.fps,
-            // The built-in studio; a caller with another light replaces it.
-            environment: trisort_format::Environment::studio(),
+            environment,
         }
     }
 }

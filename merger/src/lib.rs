@@ -230,8 +230,8 @@ pub enum MergeError {
 /// abandoned once their copies exceed 1.5 × the better of those two (`PRUNE_FACTOR`). Output ids are G-local. The result is
 /// deterministic — the same inputs give the same bytes whatever the thread count — so
 /// `stats.seconds` is left 0 (callers measure and report the time). The file is lit by the
-/// built-in studio ([`trisort_format::Environment::studio`]); a caller that lights it
-/// otherwise (`--environment`) replaces [`Baked::environment`].
+/// built-in studio ([`trisort_format::Environment::studio`]); [`merge_lit`] lights it
+/// otherwise.
 ///
 /// Errors when the recordings are not frame ranges of one path recorded with graphs (see
 /// [`MergeError`]). Frames the recorder marked truncated are merged as recorded (their graph
@@ -239,7 +239,7 @@ pub enum MergeError {
 /// driver or backend) are refused ([`MergeError::Differs`]): their graphs come from different
 /// rasterizers, so the bake would be exact on neither; see [`merge_mixed_devices`].
 pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, MergeError> {
-    merge_checked(recordings, opts, false)
+    merge_checked(recordings, opts, false, None)
 }
 
 /// [`merge`], accepting recordings made on different devices (everything else must still
@@ -249,13 +249,25 @@ pub fn merge_mixed_devices(
     recordings: &[Recording],
     opts: &MergeOptions,
 ) -> Result<Baked, MergeError> {
-    merge_checked(recordings, opts, true)
+    merge_checked(recordings, opts, true, None)
+}
+
+/// [`merge`], or [`merge_mixed_devices`] when `allow_mixed_devices`, with the file lit by
+/// `environment` (`--environment`) instead of the built-in studio, which is then not built.
+pub fn merge_lit(
+    recordings: &[Recording],
+    opts: &MergeOptions,
+    allow_mixed_devices: bool,
+    environment: trisort_format::Environment,
+) -> Result<Baked, MergeError> {
+    merge_checked(recordings, opts, allow_mixed_devices, Some(environment))
 }
 
 fn merge_checked(
     recordings: &[Recording],
     opts: &MergeOptions,
     allow_mixed_devices: bool,
+    environment: Option<trisort_format::Environment>,
 ) -> Result<Baked, MergeError> {
     if opts.segment == Some(0) {
         return Err(MergeError::ZeroSegment);
@@ -308,7 +320,8 @@ fn merge_checked(
         .par_iter()
         .map(|r| r.content_hash())
         .collect();
-    let mut baked = best.into_baked(first, recording_hashes, &graphs, opts);
+    let environment = environment.unwrap_or_else(trisort_format::Environment::studio);
+    let mut baked = best.into_baked(first, recording_hashes, &graphs, opts, environment);
     baked.device = shards::device_of(&input.recordings);
     Ok(baked)
 }

@@ -176,7 +176,7 @@ fn turntable_half_turn_validates() {
 }
 
 /// A merged file is lit by the built-in studio (prefiltered levels and a sun), which passes
-/// the structure check a reader runs.
+/// the structure check a reader runs, or by the light given to `merge_lit`.
 #[test]
 fn merged_files_are_lit_by_the_studio() {
     let rec = turntable(&Turntable {
@@ -191,6 +191,23 @@ fn merged_files_are_lit_by_the_studio() {
     assert_eq!(env.name, "studio");
     assert_eq!(*env, trisort_format::Environment::studio());
     assert!(env.levels.len() > 1 && env.sun.is_some());
+    // merge_lit stores the light it is given and changes nothing else.
+    let uniform = trisort_format::Environment::uniform(0.5);
+    let lit = trisort_merger::merge_lit(
+        std::slice::from_ref(&rec),
+        &MergeOptions::default(),
+        false,
+        uniform.clone(),
+    )
+    .expect("merge");
+    assert_eq!(lit.environment, uniform);
+    assert_eq!(
+        Baked {
+            environment: uniform,
+            ..baked
+        },
+        lit
+    );
 }
 
 /// Three triangles overlapping cyclically in one frame: the lightest edge is removed and its

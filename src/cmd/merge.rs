@@ -255,14 +255,9 @@ fn merge_to_file_with(
     names: &[String],
     allow_mixed_devices: bool,
 ) -> Result<Baked> {
-    let merged = if allow_mixed_devices {
-        trisort_merger::merge_mixed_devices(recs, opts)
-    } else {
-        trisort_merger::merge(recs, opts)
-    };
+    let merged = trisort_merger::merge_lit(recs, opts, allow_mixed_devices, environment);
     // Errors name recordings by index; say which file that is.
-    let mut baked = merged.map_err(|e| anyhow::anyhow!("{}", name_files(&e.to_string(), names)))?;
-    baked.environment = environment;
+    let baked = merged.map_err(|e| anyhow::anyhow!("{}", name_files(&e.to_string(), names)))?;
     trisort_format::write_file_atomic(FileKind::Baked, output, &baked)
         .with_context(|| format!("writing {}", output.display()))?;
     Ok(baked)
