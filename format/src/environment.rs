@@ -189,7 +189,7 @@ impl Environment {
             width: WORKING_WIDTH,
             height: WORKING_HEIGHT,
             levels,
-            sh: base.irradiance_sh(),
+            sh: dering(base.irradiance_sh(), base.min_radiance()),
             sun: None,
             exposure: 1.0,
         })
@@ -501,6 +501,72 @@ impl Image {
     }
 }
 
+impl Image {
+    /// The darkest value of each channel.
+    fn min_radiance(&self) -> [f32; 3] {
+        let mut min = [f32::MAX; 3];
+        for t in self.rgb.chunks_exact(3) {
+            for c in 0..3 {
+                min[c] = min[c].min(t[c]);
+            }
+        }
+        min
+    }
+}
+
+/// Removes the ringing of order-2 harmonics where the light is concentrated (a sun): true
+/// irradiance / π is a weighted mean of the radiance, so it is never below the darkest texel
+/// (`floor`, per channel), but SH9 of a small bright source dips far below it, even below 0,
+/// facing away from the source. When the harmonics dip below `floor` by more than 1 % of the
+/// mean radiance, bands 1 and 2 are scaled by `exp(−t·l(l+1))` with the smallest `t` (found by
+/// bisection, one `t` for all channels so colours do not shift) that lifts them to `floor`
+/// everywhere; band 0, the mean, is kept. Lights without such dips are returned unchanged.
+fn dering(sh: [[f32; 3]; 9], floor: [f32; 3]) -> [[f32; 3]; 9] {
+    // Directions to check: a 64 × 32 grid and the poles.
+    let mut directions: Vec<[f32; 3]> = (0..32 * 64)
+        .map(|i| texel_direction(i % 64, i / 64, 64, 32))
+        .collect();
+    directions.extend([[0.0, 1.0, 0.0], [0.0, -1.0, 0.0]]);
+    let windowed = |t: f32| {
+        let mut out = sh;
+        for (i, coef) in out.iter_mut().enumerate() {
+            let l = match i {
+                0 => 0.0,
+                1..=3 => 1.0,
+                _ => 2.0,
+            };
+            let w = (-t * l * (l + 1.0)).exp();
+            *coef = coef.map(|v| v * w);
+        }
+        out
+    };
+    let slack: [f32; 3] = sh[0].map(|c| 0.01 * c * 0.282_094_8);
+    let dips = |sh: &[[f32; 3]; 9]| {
+        let env = Environment {
+            sh: *sh,
+            ..Environment::uniform(0.0)
+        };
+        directions.iter().any(|&d| {
+            let e = env.irradiance(d);
+            (0..3).any(|c| e[c] < floor[c] - slack[c])
+        })
+    };
+    if !dips(&sh) {
+        return sh;
+    }
+    // exp(−16·2) leaves bands 1 and 2 at ~1e-7: the mean alone, which never dips.
+    let (mut lo, mut hi) = (0.0f32, 16.0f32);
+    for _ in 0..32 {
+        let mid = 0.5 * (lo + hi);
+        if dips(&windowed(mid)) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    windowed(hi)
+}
+
 /// Per target index: the source indices it covers and their weights (summing to 1).
 fn box_weights(src: u32, dst: u32) -> Vec<Vec<(usize, f32)>> {
     let scale = src as f64 / dst as f64;
@@ -775,6 +841,37 @@ mod tests {
                 env.texel(k, 0, 0)[0] > env.texel(k, w - 1, h - 1)[0],
                 "level {k}"
             );
+        }
+    }
+
+    #[test]
+    fn a_sun_does_not_ring_the_irradiance_below_the_sky() {
+        let sun = normalize([0.5, 0.5, 0.2]);
+        let sky = |d: [f32; 3]| {
+            if dot(d, sun) > 0.999 {
+                [20000.0, 18000.0, 15000.0]
+            } else {
+                [0.5, 0.6, 0.8]
+            }
+        };
+        let rgb = image(512, 256, sky);
+        let env = Environment::from_equirect("sun", 512, 256, &rgb).unwrap();
+        // Without deringing SH9 gives about −1.2 facing away from this sun.
+        let floor = [0.5, 0.6, 0.8];
+        for d in directions() {
+            let e = env.irradiance(d);
+            for c in 0..3 {
+                assert!(
+                    e[c] >= floor[c] * 0.99 - 0.01 * env.sh[0][c] * 0.282_094_8,
+                    "{d:?}: {e:?}"
+                );
+            }
+        }
+        assert!(env.irradiance(sun)[0] > 2.0 * env.irradiance(sun.map(|c| -c))[0]);
+        // The mean (band 0) is kept.
+        let m0 = env.level_mean(0);
+        for (sh, mean) in env.sh[0].iter().zip(m0) {
+            assert!(close(sh * 0.282_094_8, mean, 0.01));
         }
     }
 
