@@ -70,6 +70,8 @@ const SAMPLES_PER_TEXEL: (u32, u32) = (64, 4096);
 /// Level k ≥ 1 is filtered at this many times its width and height (at most level 0's),
 /// then averaged down, so that a coarse level keeps the light's mean.
 const SUPERSAMPLE: u32 = 2;
+/// Brightest texel [`Environment::from_equirect`] accepts: sums of 2^26 of them stay finite.
+const MAX_RADIANCE: f32 = 1e30;
 /// Largest finite binary16: brighter texels are stored as this.
 const HALF_MAX: f32 = 65504.0;
 /// binary16 bits of 1.0.
@@ -131,11 +133,12 @@ impl Environment {
     /// roughness `k / (LEVELS − 1)` by GGX importance sampling (normal = view = reflection,
     /// Hammersley points, each sample read from a mip of level 0 whose texels match the
     /// sample's solid angle, weighted by N·L); [`Environment::sh`] is the cosine-convolved
-    /// irradiance of level 0. Texels brighter than binary16's largest value (65504) are stored
+    /// irradiance of level 0, deringed where a concentrated source (a sun) would make it dip
+    /// below the darkest texel. Texels brighter than binary16's largest value (65504) are stored
     /// as that. The result is the same bytes on every run (one thread, fixed order).
     ///
     /// Fails, saying why, on an empty image, a length that is not `width × height × 3`, or a
-    /// texel that is NaN, infinite or negative.
+    /// texel that is NaN, infinite, negative or above 10³⁰.
     pub fn from_equirect(
         name: &str,
         width: u32,
@@ -152,12 +155,16 @@ impl Environment {
                 rgb.len()
             ));
         }
-        if let Some(i) = rgb.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+        if let Some(i) = rgb
+            .iter()
+            .position(|v| !(v.is_finite() && (0.0..=MAX_RADIANCE).contains(v)))
+        {
             let texel = i as u64 / 3;
             let what = match rgb[i] {
                 v if v.is_nan() => "NaN".to_string(),
                 v if v.is_infinite() => "infinite".to_string(),
-                v => format!("negative ({v})"),
+                v if v < 0.0 => format!("negative ({v})"),
+                v => format!("{v:e}, above {MAX_RADIANCE:e} (sums of it would overflow)"),
             };
             return Err(format!(
                 "texel ({}, {}) has a {} channel that is {what}: an environment needs finite, \
@@ -1055,6 +1062,14 @@ mod tests {
         rgb[3 * 5 + 1] = -0.5;
         let e = Environment::from_equirect("x", 4, 2, &rgb).unwrap_err();
         assert!(e.contains("negative (-0.5)"), "{e}");
+        rgb[3 * 5 + 1] = 3e38;
+        let e = Environment::from_equirect("x", 4, 2, &rgb).unwrap_err();
+        assert!(e.contains("3e38, above 1e30"), "{e}");
+        rgb[3 * 5 + 1] = 1e30;
+        Environment::from_equirect("x", 4, 2, &rgb)
+            .unwrap()
+            .check_structure()
+            .unwrap();
         let e = Environment::from_equirect("x", 4, 2, &rgb[..5]).unwrap_err();
         assert!(e.contains("has 5 values"), "{e}");
         let e = Environment::from_equirect("x", 0, 2, &[]).unwrap_err();
