@@ -135,7 +135,9 @@ impl Environment {
     /// sample's solid angle, weighted by N·L); [`Environment::sh`] is the cosine-convolved
     /// irradiance of level 0, deringed where a concentrated source (a sun) would make it dip
     /// below the darkest texel. Texels brighter than binary16's largest value (65504) are stored
-    /// as that. The result is the same bytes on every run (one thread, fixed order).
+    /// as that. The result is the same bytes on every run on one platform (one thread, fixed
+    /// order; `sin`, `acos`… come from the platform's math library, which may round the last
+    /// bit differently elsewhere).
     ///
     /// Fails, saying why, on an empty image, a length that is not `width × height × 3`, or a
     /// texel that is NaN, infinite, negative or above 10³⁰.
@@ -240,7 +242,7 @@ impl Environment {
         self.levels.iter().map(|l| l.len() as u64 * 2).sum()
     }
 
-    /// The RGB radiance stored at texel (x, y) of level `k`.
+    /// The RGB radiance stored at texel (x, y) of level `k` (panics outside the level).
     pub fn texel(&self, k: usize, x: u32, y: u32) -> [f32; 3] {
         let (w, _) = self.level_size(k);
         let i = (y as usize * w as usize + x as usize) * 4;
