@@ -30,7 +30,7 @@ pub fn vertex_layout() -> wgpu::VertexBufferLayout<'static> {
 pub struct FrameUniform {
     /// Projection matrix.
     pub proj: [[f32; 4]; 4],
-    /// View-space light direction (xyz) and ambient (w).
+    /// View-space light direction (xyz) and ambient (w) of [`Shading::Basic`].
     pub light: [f32; 4],
     /// Glass opacity, width, height, sample count.
     pub params: [f32; 4],
@@ -221,7 +221,8 @@ impl LightingUniform {
     }
 }
 
-/// The view-space light of every pipeline: towards upper left behind the viewer; ambient 0.35.
+/// The view-space light of [`Shading::Basic`]: towards upper left behind the viewer; ambient
+/// 0.35.
 pub const LIGHT: [f32; 4] = [-0.3, 0.6, 0.75, 0.35];
 
 /// How frames are drawn: image size, sample count and glass opacity.
