@@ -885,11 +885,30 @@ fn box_filter(prev: &[u8], pw: u32, ph: u32, w: u32, h: u32) -> Vec<u8> {
     out
 }
 
+/// A `w` × `h` RGBA8 level of `size` repeated over a layer level of `layer` texels from the
+/// top-left corner (cropped where the texture is larger: texels beyond the device limit, a
+/// documented limitation). Filtering across the right and bottom edges of the texture's corner
+/// (linear filtering at level 0, and every coarser level's footprint) then reads the texels
+/// its repeat would, not the unused rest of the layer.
+fn tiled(level: &[u8], (w, h): (u32, u32), (lw, lh): (u32, u32)) -> Vec<u8> {
+    let mut data = Vec::with_capacity((lw * lh * 4) as usize);
+    for y in 0..lh {
+        let row = &level[((y % h) * w * 4) as usize..][..(w * 4) as usize];
+        let mut x = 0;
+        while x < lw {
+            let n = (lw - x).min(w);
+            data.extend_from_slice(&row[..(n * 4) as usize]);
+            x += n;
+        }
+    }
+    data
+}
+
 /// Uploads the material textures into two arrays, sRGB (`Rgba8UnormSrgb`) and linear
 /// (`Rgba8Unorm`), each texture in the array of its [`trisort_format::Texture::srgb`] flag. A
 /// layer is as large as its array's largest texture (clamped to the device's limit), with a
 /// full mip chain; a smaller texture fills the top-left corner of every level with its own
-/// level of the same index. An empty array gets one white texel; on GL an array has two layers
+/// level of the same index, repeated over the rest of the level ([`tiled`]). An empty array gets one white texel; on GL an array has two layers
 /// at least (see the comment inside).
 fn upload_textures(device: &wgpu::Device, queue: &wgpu::Queue, geometry: &Geometry) -> Textures {
     let mut places = vec![
@@ -999,13 +1018,8 @@ fn upload_array(
         let t = &geometry.textures[i];
         for (k, (lw, lh, level)) in texture_levels(t, levels).iter().enumerate() {
             let (aw, ah) = ((tw >> k).max(1), (th >> k).max(1));
-            // Texels beyond the device limit are cropped (documented limitation).
-            let (w, h) = ((*lw).min(aw), (*lh).min(ah));
-            let mut data = Vec::with_capacity((w * h * 4) as usize);
-            for y in 0..h as usize {
-                data.extend_from_slice(&level[y * *lw as usize * 4..][..w as usize * 4]);
-            }
-            write(k as u32, layer as u32, w, h, &data);
+            let data = tiled(level, (*lw, *lh), (aw, ah));
+            write(k as u32, layer as u32, aw, ah, &data);
         }
         places[i] = TexturePlace {
             linear,

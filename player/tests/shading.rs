@@ -328,3 +328,33 @@ pub fn every_map() -> Baked {
         m.clearcoat_roughness = 0.2;
     })
 }
+
+#[test]
+fn a_small_texture_in_a_larger_layer_repeats_without_the_rest_of_the_layer() {
+    let Some(gpu) = gpu() else { return };
+    let untextured = with(&textured(), |b| {
+        b.geometry.materials[2].base_color = [1.0; 4];
+        // A larger texture in the same (sRGB) array makes the layers 16²: the white 4² one
+        // fills a corner of each level.
+        b.geometry.textures = vec![
+            flat_texture([255, 255, 255, 255], 4, true),
+            flat_texture([0, 0, 0, 255], 16, true),
+        ];
+    });
+    let plain = pbr(&gpu, &untextured);
+    // About 7 and 30 repeats over the view, off the pixel grid: linear filtering at level 0
+    // and the footprints of coarser levels cross the corner's edges at every repeat.
+    for repeat in [7.3, 29.7] {
+        let tiled = with(&untextured, |b| {
+            let m = &mut b.geometry.materials[2];
+            m.base_color_texture = Some(0);
+            m.base_color_transform.scale = [repeat, repeat];
+            m.base_color_transform.offset = [0.37, 0.21];
+        });
+        let d = max_diff(&pbr(&gpu, &tiled), &plain);
+        assert!(
+            d <= 2,
+            "{repeat} repeats: {d}/255 from the untextured white"
+        );
+    }
+}
