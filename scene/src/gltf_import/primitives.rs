@@ -236,7 +236,11 @@ impl Importer<'_> {
                 if flat.len() != 4 * n {
                     return Err(count_mismatch(&acc, "TANGENT", flat.len() / 4));
                 }
-                Some(flat.chunks_exact(4).map(tangent).collect())
+                Some(
+                    flat.chunks_exact(4)
+                        .map(|c| unit_tangent([c[0], c[1], c[2], c[3]]))
+                        .collect(),
+                )
             }
             _ => None,
         };
@@ -381,10 +385,14 @@ fn flat(
     }
 }
 
-/// A file tangent: xyz scaled to unit length (zero when zero or not finite), w the sign of
-/// the file's w (±1; glTF requires ±1).
-fn tangent(t: &[f32]) -> [f32; 4] {
+/// A tangent as a vertex stores it (the file's or MikkTSpace's): xyz scaled to unit length, w
+/// the sign of the given w (±1; glTF requires ±1); all zero (no tangent) when xyz is zero or
+/// not finite.
+pub(super) fn unit_tangent(t: [f32; 4]) -> [f32; 4] {
     let [x, y, z] = unit([t[0], t[1], t[2]]);
+    if [x, y, z] == [0.0; 3] {
+        return [0.0; 4];
+    }
     [x, y, z, if t[3] < 0.0 { -1.0 } else { 1.0 }]
 }
 

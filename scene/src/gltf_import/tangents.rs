@@ -1,5 +1,7 @@
 //! MikkTSpace tangents (the `mikktspace` crate) for normal-mapped primitives without TANGENT.
 
+use super::primitives::unit_tangent;
+
 /// A triangle list as MikkTSpace reads it; tangents are written per triangle corner.
 struct Faces<'a> {
     positions: &'a [[f32; 3]],
@@ -62,18 +64,5 @@ pub(super) fn generate(
     // `false` only for an empty list or one MikkTSpace cannot allocate for; corners it did not
     // reach stay zero either way.
     let _ = mikktspace::generate_tangents(&mut faces);
-    faces
-        .corners
-        .into_iter()
-        .map(|t| {
-            let xyz = glam::Vec3::new(t[0], t[1], t[2]);
-            let len = xyz.length();
-            if len > 0.0 && len.is_finite() {
-                let u = xyz / len;
-                [u.x, u.y, u.z, if t[3] < 0.0 { -1.0 } else { 1.0 }]
-            } else {
-                [0.0; 4]
-            }
-        })
-        .collect()
+    faces.corners.into_iter().map(unit_tangent).collect()
 }
