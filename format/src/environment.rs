@@ -280,7 +280,8 @@ impl Environment {
         e
     }
 
-    /// Checks what a reader relies on: at least one level, each of its size, finite values.
+    /// Checks what a reader relies on: at least one level, each of its size, finite values, no
+    /// negative light (texels, sun colour, exposure).
     pub fn check_structure(&self) -> Result<(), String> {
         if self.width == 0 || self.height == 0 || self.levels.is_empty() {
             return Err("the environment has no texels".into());
@@ -299,6 +300,10 @@ impl Environment {
             if level.iter().any(|&b| b & 0x7c00 == 0x7c00) {
                 return Err(format!("environment level {k} has a non-finite texel"));
             }
+            // Sign bit on anything but −0: negative radiance.
+            if level.iter().any(|&b| b > 0x8000) {
+                return Err(format!("environment level {k} has a negative texel"));
+            }
         }
         let sun = self
             .sun
@@ -313,6 +318,19 @@ impl Environment {
             .all(|x| x.is_finite())
         {
             return Err("the environment has a non-finite value".into());
+        }
+        // Negative light would darken what it shines on; shading has no meaning for it.
+        if self.exposure < 0.0 {
+            return Err(format!(
+                "the environment's exposure is negative ({})",
+                self.exposure
+            ));
+        }
+        if let Some(sun) = self.sun.filter(|s| s.color.iter().any(|&c| c < 0.0)) {
+            return Err(format!(
+                "the environment's sun has a negative colour {:?}",
+                sun.color
+            ));
         }
         Ok(())
     }
@@ -1095,5 +1113,28 @@ mod tests {
             .check_structure()
             .unwrap_err()
             .contains("non-finite texel"));
+    }
+
+    #[test]
+    fn check_structure_refuses_negative_light() {
+        let mut env = Environment::uniform(1.0);
+        env.levels[0][1] = 0x8000; // −0 is zero light
+        env.check_structure().unwrap();
+        env.levels[0][1] = half_bits(-0.5);
+        let e = env.check_structure().unwrap_err();
+        assert!(e.contains("level 0 has a negative texel"), "{e}");
+        let mut env = Environment::uniform(1.0);
+        env.exposure = 0.0;
+        env.check_structure().unwrap();
+        env.exposure = -1.0;
+        let e = env.check_structure().unwrap_err();
+        assert!(e.contains("exposure is negative (-1)"), "{e}");
+        let mut env = Environment::uniform(1.0);
+        env.sun = Some(Sun {
+            direction: [0.0, 1.0, 0.0],
+            color: [1.0, -0.25, 1.0],
+        });
+        let e = env.check_structure().unwrap_err();
+        assert!(e.contains("sun has a negative colour"), "{e}");
     }
 }
