@@ -317,7 +317,7 @@ int main(int argc, char **argv) {
     crc_init();
     open_gles();
 
-    /* Vertex streams: interleaved, 40 bytes a vertex. */
+    /* Vertex streams: interleaved, 64 bytes a vertex (sizeof(TrisortVertex)). */
     check(trisort_vertices(h, NULL, 0, &nv), "trisort_vertices");
     vertices = xmalloc(nv * sizeof *vertices);
     check(trisort_vertices(h, vertices, nv, &nv), "trisort_vertices");
