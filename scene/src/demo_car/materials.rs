@@ -23,7 +23,6 @@ pub(super) fn materials() -> Vec<Material> {
         // Metallic flake paint under a smooth clearcoat.
         Material {
             metallic: 0.6,
-            roughness: 0.35,
             clearcoat: 1.0,
             clearcoat_roughness: 0.03,
             ..dielectric("paint", [0.60, 0.04, 0.03], 0.35)
