@@ -5,9 +5,9 @@ use serde::{Deserialize, Serialize};
 
 /// One vertex, laid out as the vertex buffer of every pipeline (recorder, player, reference).
 ///
-/// `position` and `normal` are in the local space of `node`: the node whose (possibly animated)
-/// world transform moves this vertex. All three vertices of a triangle share `material` and
-/// `node`.
+/// `position`, `normal` and `tangent` are in the local space of `node`: the node whose
+/// (possibly animated) world transform moves this vertex. All three vertices of a triangle
+/// share `material` and `node`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable, Serialize, Deserialize)]
 pub struct Vertex {
@@ -16,7 +16,8 @@ pub struct Vertex {
     /// Unit normal in the node's local space (zero when the source had none and it could not
     /// be derived).
     pub normal: [f32; 3],
-    /// Texture coordinate (TEXCOORD_0); zero for untextured materials.
+    /// First texture coordinate (TEXCOORD_0), for texture slots whose `tex_coord` is 0; zero
+    /// where no texture slot samples it or the source has none.
     pub uv: [f32; 2],
     /// Index into [`Geometry::materials`].
     pub material: u32,
@@ -27,7 +28,7 @@ pub struct Vertex {
     /// (MikkTSpace) for materials with a normal texture; zero where there is none.
     pub tangent: [f32; 4],
     /// Second texture coordinate (TEXCOORD_1), for texture slots whose `tex_coord` is 1; zero
-    /// where the source has none.
+    /// where no texture slot samples it or the source has none.
     pub uv1: [f32; 2],
 }
 
