@@ -12,8 +12,9 @@ use crate::support::{lit, pixel, quads, srgb8, SIZE};
 
 /// [`quads`] with the red and green quads invisible (blend, alpha 0) and the blue quad (the
 /// whole view in frame 1) grey, dielectric, half rough, with uv (both sets) running over
-/// [0, 1]² across the view (x right, y down) and a +X tangent, under a dim uniform environment and a bright sun from the upper right front.
-fn textured() -> Baked {
+/// [0, 1]² across the view (x right, y down) and a +X tangent, under a dim uniform environment
+/// and a bright sun from the upper right front.
+pub(crate) fn textured() -> Baked {
     let mut b = quads();
     let g = &mut b.geometry;
     for m in &mut g.materials[..2] {
@@ -44,7 +45,7 @@ fn textured() -> Baked {
 }
 
 /// A `size`² linear or sRGB texture of one colour, with its mip chain.
-fn flat_texture(rgba: [u8; 4], size: u32, srgb: bool) -> Texture {
+pub(crate) fn flat_texture(rgba: [u8; 4], size: u32, srgb: bool) -> Texture {
     let level = |s: u32| rgba.repeat((s * s) as usize);
     Texture {
         name: String::new(),
@@ -59,7 +60,7 @@ fn flat_texture(rgba: [u8; 4], size: u32, srgb: bool) -> Texture {
 }
 
 /// The slot of texture `texture` on uv set 0, untransformed.
-fn slot(texture: u32) -> Option<TextureSlot> {
+pub(crate) fn slot(texture: u32) -> Option<TextureSlot> {
     Some(TextureSlot {
         texture,
         tex_coord: 0,
@@ -83,17 +84,17 @@ fn render(gpu: &Gpu, baked: &Baked, shading: Shading, tone_map: ToneMap) -> Vec<
         .rgba8
 }
 
-fn pbr(gpu: &Gpu, baked: &Baked) -> Vec<u8> {
+pub(crate) fn pbr(gpu: &Gpu, baked: &Baked) -> Vec<u8> {
     render(gpu, baked, Shading::Pbr, ToneMap::Neutral)
 }
 
 /// The largest channel difference of two images.
-fn max_diff(a: &[u8], b: &[u8]) -> u8 {
+pub(crate) fn max_diff(a: &[u8], b: &[u8]) -> u8 {
     a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap()
 }
 
 /// `baked` changed by `change`.
-fn with(baked: &Baked, change: impl FnOnce(&mut Baked)) -> Baked {
+pub(crate) fn with(baked: &Baked, change: impl FnOnce(&mut Baked)) -> Baked {
     let mut b = baked.clone();
     change(&mut b);
     b

@@ -1,6 +1,6 @@
 //! The player's integration tests, one binary: the baked file as the player reads it
-//! (`baked_file`, no GPU), what it draws (`play`), how it shades (`shading`) and its WebGL2
-//! tier (`tiers`).
+//! (`baked_file`, no GPU), what it draws (`play`), how it shades (`shading`; the frame its
+//! normal maps are read in: `tangent_frame`) and its WebGL2 tier (`tiers`).
 
 mod support;
 
@@ -8,5 +8,6 @@ mod baked_file;
 mod play;
 mod self_check;
 mod shading;
+mod tangent_frame;
 mod tiers;
 mod variants;

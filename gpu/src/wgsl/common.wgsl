@@ -96,6 +96,20 @@ fn transform_normal(normal: vec3<f32>, node: u32) -> vec3<f32> {
     return (m * vec4<f32>(normal, 0.0)).xyz;
 }
 
+// −1 where a node's matrix mirrors (its upper 3×3 has a negative determinant), else 1. The
+// matrix is view × world and the view only rotates, so this is the world transform's sign.
+// Vertex attributes stay in node-local space (the importer only reverses the winding of
+// mirrored instances, so front faces and `transform_normal` are already right there), but a
+// bitangent built as cross(n, t) in view space comes out reversed under a mirror: the tangent's
+// handedness is multiplied by this once, in the vertex stage.
+fn node_handedness(node: u32) -> f32 {
+    let m = node_matrix(node);
+    if (dot(cross(m[0].xyz, m[1].xyz), m[2].xyz) < 0.0) {
+        return -1.0;
+    }
+    return 1.0;
+}
+
 // View-space position (the camera at the origin).
 fn view_position(position: vec3<f32>, node: u32) -> vec3<f32> {
     return (node_matrix(node) * vec4<f32>(position, 1.0)).xyz;
@@ -197,6 +211,38 @@ fn sample_slot(
         return textureSampleGrad(linear_textures, material_sampler, tuv, layer, gx, gy);
     }
     return textureSampleGrad(srgb_textures, material_sampler, tuv, layer, gx, gy);
+}
+
+// A normal texture's tangent-space xy (x along +u, y along −v: glTF's "+Y up" in the image)
+// brought into the mesh's tangent frame, which follows the mesh's uv, when the slot's
+// KHR_texture_transform (rows `u_row`, `v_row`: u' = L·uv + o) turns the texture's axes
+// against it. In the (u, −v) frame the linear part is L' = F·L·F (F = diag(1, −1)); its
+// orthogonal polar factor Q (the rotation, or the reflection for a mirroring scale, nearest
+// to L') maps the mesh's axes to the texture's, and the xy of a map pre-rotated by Q in the
+// image comes back as Qᵀ·xy. Scale is left out on purpose: a non-uniform scale stretches the
+// bumps but the map keeps its slopes (what tiling a detail map means to its author; the exact
+// gradient rule Lᵀ would make a map tiled ten times ten times steeper), and Q of R·S is R for
+// any positive scales S. A singular L leaves xy as it is.
+fn normal_xy_in_mesh_frame(u_row: vec4<f32>, v_row: vec4<f32>, xy: vec2<f32>) -> vec2<f32> {
+    let a = u_row.x;
+    let b = -u_row.y;
+    let c = -v_row.x;
+    let d = v_row.y;
+    // Rows of Q: (p, r) and s·(−r, p), s = ±1 the sign of det L'.
+    var s = 1.0;
+    var p = a + d;
+    var r = b - c;
+    if (a * d - b * c < 0.0) {
+        s = -1.0;
+        p = a - d;
+        r = b + c;
+    }
+    let len = sqrt(p * p + r * r);
+    if (len < 1e-20) {
+        return xy;
+    }
+    // Qᵀ·xy = x·row0 + y·row1.
+    return (xy.x * vec2<f32>(p, r) + xy.y * s * vec2<f32>(-r, p)) / len;
 }
 
 // Everything `shade` needs about the fragment besides its material and base colour.
@@ -317,21 +363,26 @@ fn shade_pbr(m: MaterialGpu, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
     let metallic = clamp(m.pbr.x * mr.b, 0.0, 1.0);
     let rough = clamp(m.pbr.y * mr.g, 0.03, 1.0);
 
+    // The front face's frame; a back face (double-sided) reverses the mapped normal whole, as
+    // glTF asks (negating only the geometric normal would mirror the map's x on back faces).
     var ng = normalize(s.normal + vec3<f32>(0.0, 0.0, 1e-12));
-    if (!s.front_facing) {
-        ng = -ng;
-    }
     var n = ng;
     if (m.normal_u.w >= 0.0 && dot(s.tangent.xyz, s.tangent.xyz) > 1e-12) {
         let tex = sample_slot(m.normal_u, m.normal_v, m.normal_scale, s.uv, white).xyz;
-        let tn = vec3<f32>((tex.xy * 2.0 - 1.0) * m.pbr.z, tex.z * 2.0 - 1.0);
+        let xy = normal_xy_in_mesh_frame(m.normal_u, m.normal_v, tex.xy * 2.0 - 1.0);
+        let tn = vec3<f32>(xy * m.pbr.z, tex.z * 2.0 - 1.0);
         let t = normalize(s.tangent.xyz - ng * dot(ng, s.tangent.xyz) + vec3<f32>(1e-12, 0.0, 0.0));
+        // Handedness × the node's mirror sign (`vs_player`).
         var sign = 1.0;
         if (s.tangent.w < 0.0) {
             sign = -1.0;
         }
         let b = cross(ng, t) * sign;
         n = normalize(t * tn.x + b * tn.y + ng * max(tn.z, 1e-4));
+    }
+    if (!s.front_facing) {
+        ng = -ng;
+        n = -n;
     }
     let v = normalize(-s.position + vec3<f32>(0.0, 0.0, 1e-12));
     let n_dot_v = clamp(dot(n, v), 1e-4, 1.0);

@@ -10,7 +10,7 @@ struct PlayerVarying {
     @location(1) @interpolate(perspective, center) uv: vec2<f32>,
     @location(2) normal: vec3<f32>,
     @location(3) @interpolate(perspective, center) uv1: vec2<f32>,
-    // View-space tangent (xyz) and handedness (w).
+    // View-space tangent (xyz) and handedness (w) times the node's mirror sign.
     @location(4) tangent: vec4<f32>,
     // View-space position.
     @location(5) view_position: vec3<f32>,
@@ -24,7 +24,10 @@ fn vs_player(v: VertexIn) -> PlayerVarying {
     out.uv = v.uv;
     out.normal = transform_normal(v.normal, v.node);
     out.uv1 = v.uv1;
-    out.tangent = vec4<f32>(transform_normal(v.tangent.xyz, v.node), v.tangent.w);
+    out.tangent = vec4<f32>(
+        transform_normal(v.tangent.xyz, v.node),
+        v.tangent.w * node_handedness(v.node),
+    );
     out.view_position = view_position(v.position, v.node);
     return out;
 }
