@@ -821,6 +821,24 @@ pub fn frame_uniform(state: &FrameState, view: View) -> FrameUniform {
 
 /// Where a texture lies on the GPU: its array (sRGB or linear), layer, and the uv scale of the
 /// corner it fills at level 0.
+///
+/// One scale serves every level, which is exact at level 0 (and so for the alpha that decides
+/// visibility, always sampled there) but only approximate at a coarser level `k` of a texture
+/// `w` texels wide in a layer `tw` wide: the shader maps uv ∈ [0, 1) onto
+/// `P = (w / tw)·(tw >> k)` texels of the layer's level, while the texture's own level repeats
+/// there ([`tiled`]) every `max(1, w >> k)` texels. Both lie in `(w / 2^k − 1, w / 2^k]`, so
+/// across one repeat the sampled point drifts from the texture's by less than one texel *of
+/// level k* (growing linearly from uv 0), and steps back by as much where uv wraps
+/// (likewise along v with the heights). Level k is chosen where a pixel spans about one of
+/// its texels, so this misplaces already pixel-sized detail by under about a pixel, and never
+/// reads anything but the texture (the repeat fills the whole layer). It is zero when `2^k` divides both `w` and
+/// `tw`, and where the texture's level is one texel along an axis (constant along it): a
+/// power-of-two texture in a power-of-two layer, and the array's largest texture (`w = tw`),
+/// are exact at every level. Example: 300 texels in a 1024 layer are exact to level 2 and
+/// drift by up to half a texel at level 3 (37.5 against a period of 37). Exact coarse levels
+/// for the rest would need the shader to pick the level itself and scale per level (two
+/// `textureSampleLevel` calls instead of one `textureSampleGrad`), or each level resampled
+/// onto the stretched period at upload (a blur of its own); neither is worth it for this bound.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct TexturePlace {
     linear: bool,
