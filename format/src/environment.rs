@@ -270,14 +270,7 @@ impl Environment {
     /// Irradiance / π for a surface with unit normal `n` (world space), from
     /// [`Environment::sh`]: what a white Lambertian surface reflects, sun not included.
     pub fn irradiance(&self, n: [f32; 3]) -> [f32; 3] {
-        let y = sh_basis(n);
-        let mut e = [0.0; 3];
-        for (coef, yi) in self.sh.iter().zip(y) {
-            for c in 0..3 {
-                e[c] += coef[c] * yi;
-            }
-        }
-        e
+        sh_irradiance(&self.sh, n)
     }
 
     /// Checks what a reader relies on: at least one level, each of its size, finite values, no
@@ -334,6 +327,17 @@ impl Environment {
         }
         Ok(())
     }
+}
+
+/// `Σ sh[i] · Y_i(n)` per channel ([`Environment::irradiance`] of coefficients `sh`).
+fn sh_irradiance(sh: &[[f32; 3]; 9], n: [f32; 3]) -> [f32; 3] {
+    let mut e = [0.0; 3];
+    for (coef, yi) in sh.iter().zip(sh_basis(n)) {
+        for c in 0..3 {
+            e[c] += coef[c] * yi;
+        }
+    }
+    e
 }
 
 /// binary16 bits of `v` (round to nearest even; overflow to infinity).
@@ -569,12 +573,8 @@ fn dering(sh: [[f32; 3]; 9], floor: [f32; 3]) -> [[f32; 3]; 9] {
     };
     let slack: [f32; 3] = sh[0].map(|c| 0.01 * c * 0.282_094_8);
     let dips = |sh: &[[f32; 3]; 9]| {
-        let env = Environment {
-            sh: *sh,
-            ..Environment::uniform(0.0)
-        };
         directions.iter().any(|&d| {
-            let e = env.irradiance(d);
+            let e = sh_irradiance(sh, d);
             (0..3).any(|c| e[c] < floor[c] - slack[c])
         })
     };
