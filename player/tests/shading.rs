@@ -359,3 +359,47 @@ fn a_small_texture_in_a_larger_layer_repeats_without_the_rest_of_the_layer() {
         );
     }
 }
+
+#[test]
+fn glass_shows_what_it_reflects_not_its_base_colour() {
+    let Some(gpu) = gpu() else { return };
+    // The grey quad as smooth dielectric glass at opacity 0.35 over the background.
+    let glass = |rgb: [f32; 3]| {
+        with(&textured(), |b| {
+            b.settings.glass_opacity = 0.35;
+            let m = &mut b.geometry.materials[2];
+            m.base_color = [rgb[0], rgb[1], rgb[2], 1.0];
+            m.metallic = 0.0;
+            m.roughness = 0.1;
+            m.transmission = 1.0;
+        })
+    };
+    let white = pbr(&gpu, &glass([1.0, 1.0, 1.0]));
+    let red = pbr(&gpu, &glass([1.0, 0.0, 0.0]));
+    // Transmission replaces the diffuse lobe: the base colour does not show (a diffuse white
+    // glass drew a veil of its own colour over what lies behind it).
+    assert!(max_diff(&white, &red) <= 1, "{}", max_diff(&white, &red));
+    // The same surface opaque does show its diffuse colour.
+    let opaque = |rgb: [f32; 3]| with(&glass(rgb), |b| b.geometry.materials[2].transmission = 0.0);
+    let shown = max_diff(
+        &pbr(&gpu, &opaque([1.0, 1.0, 1.0])),
+        &pbr(&gpu, &opaque([1.0, 0.0, 0.0])),
+    );
+    assert!(shown > 40, "{shown}");
+    // Reflection reaches the screen at full strength: the glass quad is brighter than the
+    // background blended with the glass's reflection scaled down by its opacity would be,
+    // and a brighter environment makes it brighter.
+    let dim = pbr(
+        &gpu,
+        &with(&glass([1.0; 3]), |b| {
+            b.environment = Environment::uniform(0.05);
+        }),
+    );
+    let centre = |img: &[u8]| pixel(img, SIZE / 2, SIZE / 2);
+    assert!(
+        centre(&white)[0] > centre(&dim)[0],
+        "{:?} vs {:?}",
+        centre(&white),
+        centre(&dim)
+    );
+}

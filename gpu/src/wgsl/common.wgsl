@@ -389,7 +389,10 @@ fn shade_pbr(m: MaterialGpu, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
     let to_world = frame.view_to_world;
 
     let f0 = mix(vec3<f32>(0.04), albedo, metallic);
-    let diffuse_colour = albedo * (1.0 - metallic);
+    // Transmission (glass) replaces the diffuse lobe: light passes through instead of
+    // scattering, so glass shows only what it reflects (and what blends through it).
+    let transmission = clamp(m.emissive.a, 0.0, 1.0);
+    let diffuse_colour = albedo * (1.0 - metallic) * (1.0 - transmission);
     let occlusion = 1.0 + m.pbr.w
         * (sample_slot(m.occlusion_u, m.occlusion_v, m.occlusion_scale, s.uv, white).r - 1.0);
 
@@ -444,7 +447,15 @@ fn shade_pbr(m: MaterialGpu, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
     } else {
         colour = tone_map_neutral(colour);
     }
-    return vec4<f32>(clamp(colour, vec3<f32>(0.0), vec3<f32>(1.0)), base.a);
+    colour = clamp(colour, vec3<f32>(0.0), vec3<f32>(1.0));
+    // Glass is drawn at the glass opacity, and blending scales its colour by that opacity; what
+    // glass shows is reflection added over what lies behind, so its colour is divided by the
+    // opacity (up to white) to reach the screen at full strength. The base colour's tint of the
+    // light passing through is not modelled (over-blending cannot multiply what lies behind).
+    if (transmission > 0.0 && base.a > 0.0) {
+        colour = min(colour / base.a, vec3<f32>(1.0));
+    }
+    return vec4<f32>(colour, base.a);
 }
 
 // Lit colour (linear, straight alpha) of a fragment of material `m` (`material_at`, read once
