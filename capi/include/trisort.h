@@ -10,7 +10,12 @@
 // The ABI version of this library: bumped whenever a function, a struct or an enum of the
 // header changes incompatibly. Hosts compare [`trisort_abi_version`] with the header's
 // `TRISORT_ABI_VERSION`.
-#define TRISORT_ABI_VERSION 2
+//
+// 3 added [`TrisortStatus::Absent`], the environment ([`trisort_environment_info`],
+// [`trisort_environment_name`], [`trisort_environment_level`]), material variants
+// ([`trisort_variant_count`], [`trisort_variant_name`], [`trisort_variant_materials`]) and
+// the frame rate ([`trisort_fps`]); the functions of 2 are unchanged.
+#define TRISORT_ABI_VERSION 3
 
 // The ORDER file version this build writes and reads.
 #define TRISORT_ORDER_VERSION 1
@@ -34,6 +39,9 @@ typedef enum TrisortStatus {
   TRISORT_STATUS_UNSUPPORTED = 6,
   // An internal error (a panic, caught): please report it.
   TRISORT_STATUS_PANIC = 7,
+  // The file holds no such thing: no frame rate ([`trisort_fps`]), no material variant of
+  // that name ([`trisort_variant_materials`]). The message says what is missing.
+  TRISORT_STATUS_ABSENT = 8,
 } TrisortStatus;
 
 // How frames are drawn (the player's `--mode`).
@@ -220,6 +228,39 @@ typedef struct TrisortTextureInfo {
   // `max(1, width >> k)` × `max(1, height >> k)`).
   uint32_t level_count;
 } TrisortTextureInfo;
+
+// The light a baked file is shaded with (trisort's image-based light and optional sun), in
+// world space (+Y up, glTF's convention).
+//
+// The radiance is an equirectangular image ([`trisort_environment_level`]): texel (x, y) of
+// level 0 looks along `(sin θ cos φ, cos θ, sin θ sin φ)` with `φ = 2π (x + 0.5) / width`
+// and `θ = π (y + 0.5) / height` (row 0 at the zenith). Level k has `max(1, width >> k)` ×
+// `max(1, height >> k)` texels and holds the radiance prefiltered for GGX perceptual
+// roughness `k / (level_count - 1)` (level 0: the mirror image; with one level, roughness 0).
+typedef struct TrisortEnvironmentInfo {
+  // Width of level 0 in texels.
+  uint32_t width;
+  // Height of level 0 in texels.
+  uint32_t height;
+  // Prefiltered levels stored, level 0 included.
+  uint32_t level_count;
+  // Irradiance / π as order-2 spherical harmonics: 9 RGB coefficients in the order Y00,
+  // Y1-1, Y10, Y11, Y2-2, Y2-1, Y20, Y21, Y22. A Lambertian surface of albedo ρ and
+  // world-space unit normal n = (x, y, z) reflects `ρ · Σ sh[i] · Y_i(n)`, with `Y_i`:
+  // `0.282095`, `0.488603·y`, `0.488603·z`, `0.488603·x`, `1.092548·xy`, `1.092548·yz`,
+  // `0.315392·(3z² − 1)`, `1.092548·xz`, `0.546274·(x² − y²)` (these formulas on glTF's
+  // axes as they are).
+  float sh[9][3];
+  // Whether a directional light (sun) is added to the environment; when false,
+  // `sun_direction` and `sun_color` are zero.
+  bool has_sun;
+  // World-space unit direction *towards* the sun.
+  float sun_direction[3];
+  // The sun's linear RGB radiance (colour × intensity).
+  float sun_color[3];
+  // Exposure: a multiplier on all light (environment and sun) before tone mapping.
+  float exposure;
+} TrisortEnvironmentInfo;
 
 // Figures of an ORDER file.
 typedef struct TrisortOrderInfo {
@@ -431,6 +472,92 @@ enum TrisortStatus trisort_texture_level(const struct TrisortBaked *h,
                                          uint8_t *out,
                                          size_t cap,
                                          size_t *len);
+
+// Stores the frame rate the file's path was recorded at (what a player plays at by default)
+// in `*out`. When the file stores none (its recordings did not know it), writes 0 to `*out`
+// and returns [`TrisortStatus::Absent`]; a stored rate is always finite and positive.
+//
+// # Safety
+// `h` is an open handle; `out` is valid for one write.
+enum TrisortStatus trisort_fps(const struct TrisortBaked *h, double *out);
+
+// Stores the figures of the light the file is shaded with in `*out` (its name:
+// [`trisort_environment_name`]; its texels: [`trisort_environment_level`]).
+//
+// # Safety
+// `h` is an open handle; `out` is valid for one write.
+enum TrisortStatus trisort_environment_info(const struct TrisortBaked *h,
+                                            struct TrisortEnvironmentInfo *out);
+
+// Copies the environment's name (`studio` for the built-in light, else the HDR file's
+// name) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes (see the module
+// conventions on strings).
+//
+// # Safety
+// `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
+// valid for one write.
+enum TrisortStatus trisort_environment_name(const struct TrisortBaked *h,
+                                            char *out,
+                                            size_t cap,
+                                            size_t *len);
+
+// Stores the size of prefiltered level `level` of the environment in `*width` and `*height`
+// (either may be null) and copies its texels: RGBA as IEEE binary16 bits (`uint16_t` each,
+// alpha 1; upload as `GL_RGBA16F` with `GL_HALF_FLOAT`), rows from the zenith down, layout as
+// on [`TrisortEnvironmentInfo`]. `cap` and `len` count `uint16_t` values (4 per texel).
+//
+// # Safety
+// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
+// `len` as in the module conventions.
+enum TrisortStatus trisort_environment_level(const struct TrisortBaked *h,
+                                             uint32_t level,
+                                             uint32_t *width,
+                                             uint32_t *height,
+                                             uint16_t *out,
+                                             size_t cap,
+                                             size_t *len);
+
+// Stores the number of material variants (glTF `KHR_materials_variants`) in `*out`: 0
+// without the extension.
+//
+// # Safety
+// `h` is an open handle; `out` is valid for one write.
+enum TrisortStatus trisort_variant_count(const struct TrisortBaked *h, uint32_t *out);
+
+// Copies the name of material variant `variant` (file order, below
+// [`trisort_variant_count`]) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes
+// (see the module conventions on strings). Names come from the glTF file: they may be empty
+// and need not be unique.
+//
+// # Safety
+// `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
+// valid for one write.
+enum TrisortStatus trisort_variant_name(const struct TrisortBaked *h,
+                                        uint32_t variant,
+                                        char *out,
+                                        size_t cap,
+                                        size_t *len);
+
+// Copies the material table under the material variant named `name` (NUL-terminated UTF-8;
+// null: the default materials, as [`trisort_materials`]): entry k is what material slot k
+// (a vertex's `material`) shows under the variant, so a host switches variants by
+// re-uploading this table alone. Where names repeat, the first variant of the name is used
+// (as the player's `--variant`).
+//
+// Refusals, with a message naming the file and the variant: [`TrisortStatus::Absent`] when
+// no variant has this name (the message lists the file's variants);
+// [`TrisortStatus::Unsupported`] when the variant changes something that decides visibility
+// (alpha mode, double-sidedness, transmission, a cut-out or blended material's alpha or
+// cutoff...), so the baked order would not be exact for it.
+//
+// # Safety
+// `h` is an open handle; `name` is null or a NUL-terminated string; `out`, `cap`, `len` as
+// in the module conventions.
+enum TrisortStatus trisort_variant_materials(const struct TrisortBaked *h,
+                                             const char *name,
+                                             struct TrisortMaterial *out,
+                                             size_t cap,
+                                             size_t *len);
 
 // Builds the order-only export of the baked file at `baked_path`, whose scene is the glTF
 // file `scene_path`, and writes it to `out_path` (atomically). The same as

@@ -11,6 +11,8 @@
 //!   takes `out`, its capacity `cap` in elements and `len`: it stores the element count in
 //!   `*len` (when `len` is not null); with `out` null it only reports it, with `cap` too small
 //!   it returns [`TrisortStatus::BufferTooSmall`] and copies nothing.
+//! - Strings (names) are copied the same way as UTF-8 bytes plus a terminating NUL: `*len`
+//!   is the length in bytes without the NUL, and `cap` must be at least `*len + 1`.
 //! - Matrices are 16 floats, column major.
 
 use std::cell::RefCell;
@@ -20,7 +22,8 @@ use std::path::{Path, PathBuf};
 
 use glam::DMat4;
 use trisort_format::{
-    container, AlphaMode, Baked, FileKind, Texture, TextureSlot, TextureTransform,
+    container, AlphaMode, Baked, FileKind, Material, Texture, TextureSlot, TextureTransform,
+    VariantError,
 };
 
 use crate::order::{Order, OrderRange, OrderSource};
@@ -28,7 +31,12 @@ use crate::order::{Order, OrderRange, OrderSource};
 /// The ABI version of this library: bumped whenever a function, a struct or an enum of the
 /// header changes incompatibly. Hosts compare [`trisort_abi_version`] with the header's
 /// `TRISORT_ABI_VERSION`.
-pub const TRISORT_ABI_VERSION: u32 = 2;
+///
+/// 3 added [`TrisortStatus::Absent`], the environment ([`trisort_environment_info`],
+/// [`trisort_environment_name`], [`trisort_environment_level`]), material variants
+/// ([`trisort_variant_count`], [`trisort_variant_name`], [`trisort_variant_materials`]) and
+/// the frame rate ([`trisort_fps`]); the functions of 2 are unchanged.
+pub const TRISORT_ABI_VERSION: u32 = 3;
 
 /// The result of a call.
 #[repr(C)]
@@ -51,11 +59,16 @@ pub enum TrisortStatus {
     Unsupported = 6,
     /// An internal error (a panic, caught): please report it.
     Panic = 7,
+    /// The file holds no such thing: no frame rate ([`trisort_fps`]), no material variant of
+    /// that name ([`trisort_variant_materials`]). The message says what is missing.
+    Absent = 8,
 }
 
 /// A baked file opened by [`trisort_open_path`] or [`trisort_open_bytes`].
 pub struct TrisortBaked {
     baked: Baked,
+    /// Where it was opened from (`<bytes>` for [`trisort_open_bytes`]), for messages.
+    path: PathBuf,
 }
 
 /// An ORDER file opened by [`trisort_order_open_path`] or [`trisort_order_open_bytes`].
@@ -259,6 +272,41 @@ pub struct TrisortTextureInfo {
     pub level_count: u32,
 }
 
+/// The light a baked file is shaded with (trisort's image-based light and optional sun), in
+/// world space (+Y up, glTF's convention).
+///
+/// The radiance is an equirectangular image ([`trisort_environment_level`]): texel (x, y) of
+/// level 0 looks along `(sin θ cos φ, cos θ, sin θ sin φ)` with `φ = 2π (x + 0.5) / width`
+/// and `θ = π (y + 0.5) / height` (row 0 at the zenith). Level k has `max(1, width >> k)` ×
+/// `max(1, height >> k)` texels and holds the radiance prefiltered for GGX perceptual
+/// roughness `k / (level_count - 1)` (level 0: the mirror image; with one level, roughness 0).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TrisortEnvironmentInfo {
+    /// Width of level 0 in texels.
+    pub width: u32,
+    /// Height of level 0 in texels.
+    pub height: u32,
+    /// Prefiltered levels stored, level 0 included.
+    pub level_count: u32,
+    /// Irradiance / π as order-2 spherical harmonics: 9 RGB coefficients in the order Y00,
+    /// Y1-1, Y10, Y11, Y2-2, Y2-1, Y20, Y21, Y22. A Lambertian surface of albedo ρ and
+    /// world-space unit normal n = (x, y, z) reflects `ρ · Σ sh[i] · Y_i(n)`, with `Y_i`:
+    /// `0.282095`, `0.488603·y`, `0.488603·z`, `0.488603·x`, `1.092548·xy`, `1.092548·yz`,
+    /// `0.315392·(3z² − 1)`, `1.092548·xz`, `0.546274·(x² − y²)` (these formulas on glTF's
+    /// axes as they are).
+    pub sh: [[f32; 3]; 9],
+    /// Whether a directional light (sun) is added to the environment; when false,
+    /// `sun_direction` and `sun_color` are zero.
+    pub has_sun: bool,
+    /// World-space unit direction *towards* the sun.
+    pub sun_direction: [f32; 3],
+    /// The sun's linear RGB radiance (colour × intensity).
+    pub sun_color: [f32; 3],
+    /// Exposure: a multiplier on all light (environment and sun) before tone mapping.
+    pub exposure: f32,
+}
+
 /// glTF alpha mode.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -425,6 +473,40 @@ unsafe fn store<T>(out: *mut T, value: T, what: &str) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Copies `s` as a NUL-terminated string under the conventions of the module documentation
+/// (`*len`: bytes without the NUL; `cap` must hold them and the NUL).
+///
+/// # Safety
+/// `out` is null or valid for `cap` byte writes; `len` is null or valid for one write.
+unsafe fn copy_string(
+    s: &str,
+    out: *mut c_char,
+    cap: usize,
+    len: *mut usize,
+) -> Result<(), Failure> {
+    if !len.is_null() {
+        *len = s.len();
+    }
+    if out.is_null() {
+        if len.is_null() {
+            return Err(null("both out and len are"));
+        }
+        return Ok(());
+    }
+    if cap <= s.len() {
+        return Err(Failure(
+            TrisortStatus::BufferTooSmall,
+            format!(
+                "buffer holds {cap} bytes, {} needed (the string and its NUL)",
+                s.len() + 1
+            ),
+        ));
+    }
+    std::ptr::copy_nonoverlapping(s.as_ptr(), out.cast::<u8>(), s.len());
+    *out.add(s.len()) = 0;
+    Ok(())
+}
+
 /// `frame` as an index into `frames` frames, or an out-of-range failure.
 fn frame_index(frames: usize, frame: u32) -> Result<usize, Failure> {
     if (frame as usize) < frames {
@@ -477,7 +559,10 @@ fn open_baked(bytes: &[u8], path: &Path) -> Result<Box<TrisortBaked>, Failure> {
             format!("{}: inconsistent baked file: {problem}", path.display()),
         )
     })?;
-    Ok(Box::new(TrisortBaked { baked }))
+    Ok(Box::new(TrisortBaked {
+        baked,
+        path: path.to_path_buf(),
+    }))
 }
 
 /// The library's ABI version ([`TRISORT_ABI_VERSION`] of the library actually linked).
@@ -856,6 +941,38 @@ pub unsafe extern "C" fn trisort_frame_node_matrices(
     })
 }
 
+/// A material as the C API returns it.
+fn material_of(m: &Material) -> TrisortMaterial {
+    TrisortMaterial {
+        base_color: m.base_color,
+        emissive: m.emissive,
+        alpha_cutoff: m.alpha_cutoff,
+        transmission: m.transmission,
+        base_color_texture: m.base_color_texture.map_or(-1, |t| t as i32),
+        alpha_mode: match m.alpha_mode {
+            AlphaMode::Opaque => TrisortAlphaMode::Opaque,
+            AlphaMode::Mask => TrisortAlphaMode::Mask,
+            AlphaMode::Blend => TrisortAlphaMode::Blend,
+        },
+        double_sided: m.double_sided,
+        base_color_slot: TrisortTextureSlot::new(
+            m.base_color_texture,
+            m.base_color_tex_coord,
+            &m.base_color_transform,
+        ),
+        metallic: m.metallic,
+        roughness: m.roughness,
+        metallic_roughness: TrisortTextureSlot::of(&m.metallic_roughness_texture),
+        normal: TrisortTextureSlot::of(&m.normal_texture),
+        normal_scale: m.normal_scale,
+        occlusion: TrisortTextureSlot::of(&m.occlusion_texture),
+        occlusion_strength: m.occlusion_strength,
+        emissive_texture: TrisortTextureSlot::of(&m.emissive_texture),
+        clearcoat: m.clearcoat,
+        clearcoat_roughness: m.clearcoat_roughness,
+    }
+}
+
 /// Copies the materials.
 ///
 /// # Safety
@@ -869,39 +986,7 @@ pub unsafe extern "C" fn trisort_materials(
 ) -> TrisortStatus {
     guard(|| {
         let b = &handle(h, "handle")?.baked;
-        let m: Vec<TrisortMaterial> = b
-            .geometry
-            .materials
-            .iter()
-            .map(|m| TrisortMaterial {
-                base_color: m.base_color,
-                emissive: m.emissive,
-                alpha_cutoff: m.alpha_cutoff,
-                transmission: m.transmission,
-                base_color_texture: m.base_color_texture.map_or(-1, |t| t as i32),
-                alpha_mode: match m.alpha_mode {
-                    AlphaMode::Opaque => TrisortAlphaMode::Opaque,
-                    AlphaMode::Mask => TrisortAlphaMode::Mask,
-                    AlphaMode::Blend => TrisortAlphaMode::Blend,
-                },
-                double_sided: m.double_sided,
-                base_color_slot: TrisortTextureSlot::new(
-                    m.base_color_texture,
-                    m.base_color_tex_coord,
-                    &m.base_color_transform,
-                ),
-                metallic: m.metallic,
-                roughness: m.roughness,
-                metallic_roughness: TrisortTextureSlot::of(&m.metallic_roughness_texture),
-                normal: TrisortTextureSlot::of(&m.normal_texture),
-                normal_scale: m.normal_scale,
-                occlusion: TrisortTextureSlot::of(&m.occlusion_texture),
-                occlusion_strength: m.occlusion_strength,
-                emissive_texture: TrisortTextureSlot::of(&m.emissive_texture),
-                clearcoat: m.clearcoat,
-                clearcoat_roughness: m.clearcoat_roughness,
-            })
-            .collect();
+        let m: Vec<TrisortMaterial> = b.geometry.materials.iter().map(material_of).collect();
         copy_out(&m, out, cap, len)
     })
 }
@@ -1004,6 +1089,210 @@ pub unsafe extern "C" fn trisort_texture_level(
             *height = ht;
         }
         copy_out(texels, out, cap, len)
+    })
+}
+
+/// Stores the frame rate the file's path was recorded at (what a player plays at by default)
+/// in `*out`. When the file stores none (its recordings did not know it), writes 0 to `*out`
+/// and returns [`TrisortStatus::Absent`]; a stored rate is always finite and positive.
+///
+/// # Safety
+/// `h` is an open handle; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_fps(h: *const TrisortBaked, out: *mut f64) -> TrisortStatus {
+    guard(|| {
+        let h = handle(h, "handle")?;
+        store(out, h.baked.fps.unwrap_or(0.0), "out")?;
+        match h.baked.fps {
+            Some(_) => Ok(()),
+            None => Err(Failure(
+                TrisortStatus::Absent,
+                format!("{}: the file stores no frame rate", h.path.display()),
+            )),
+        }
+    })
+}
+
+/// Stores the figures of the light the file is shaded with in `*out` (its name:
+/// [`trisort_environment_name`]; its texels: [`trisort_environment_level`]).
+///
+/// # Safety
+/// `h` is an open handle; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_environment_info(
+    h: *const TrisortBaked,
+    out: *mut TrisortEnvironmentInfo,
+) -> TrisortStatus {
+    guard(|| {
+        let e = &handle(h, "handle")?.baked.environment;
+        let info = TrisortEnvironmentInfo {
+            width: e.width,
+            height: e.height,
+            level_count: e.levels.len() as u32,
+            sh: e.sh,
+            has_sun: e.sun.is_some(),
+            sun_direction: e.sun.map_or([0.0; 3], |s| s.direction),
+            sun_color: e.sun.map_or([0.0; 3], |s| s.color),
+            exposure: e.exposure,
+        };
+        store(out, info, "out")
+    })
+}
+
+/// Copies the environment's name (`studio` for the built-in light, else the HDR file's
+/// name) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes (see the module
+/// conventions on strings).
+///
+/// # Safety
+/// `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
+/// valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_environment_name(
+    h: *const TrisortBaked,
+    out: *mut c_char,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let e = &handle(h, "handle")?.baked.environment;
+        copy_string(&e.name, out, cap, len)
+    })
+}
+
+/// Stores the size of prefiltered level `level` of the environment in `*width` and `*height`
+/// (either may be null) and copies its texels: RGBA as IEEE binary16 bits (`uint16_t` each,
+/// alpha 1; upload as `GL_RGBA16F` with `GL_HALF_FLOAT`), rows from the zenith down, layout as
+/// on [`TrisortEnvironmentInfo`]. `cap` and `len` count `uint16_t` values (4 per texel).
+///
+/// # Safety
+/// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
+/// `len` as in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_environment_level(
+    h: *const TrisortBaked,
+    level: u32,
+    width: *mut u32,
+    height: *mut u32,
+    out: *mut u16,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let h = handle(h, "handle")?;
+        let e = &h.baked.environment;
+        let texels = e.levels.get(level as usize).ok_or_else(|| {
+            Failure(
+                TrisortStatus::OutOfRange,
+                format!(
+                    "{}: environment level {level} is out of range ({} levels)",
+                    h.path.display(),
+                    e.levels.len()
+                ),
+            )
+        })?;
+        if !width.is_null() {
+            *width = (e.width >> level).max(1);
+        }
+        if !height.is_null() {
+            *height = (e.height >> level).max(1);
+        }
+        copy_out(texels, out, cap, len)
+    })
+}
+
+/// Stores the number of material variants (glTF `KHR_materials_variants`) in `*out`: 0
+/// without the extension.
+///
+/// # Safety
+/// `h` is an open handle; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_variant_count(
+    h: *const TrisortBaked,
+    out: *mut u32,
+) -> TrisortStatus {
+    guard(|| {
+        let b = &handle(h, "handle")?.baked;
+        store(out, b.geometry.variants.len() as u32, "out")
+    })
+}
+
+/// Copies the name of material variant `variant` (file order, below
+/// [`trisort_variant_count`]) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes
+/// (see the module conventions on strings). Names come from the glTF file: they may be empty
+/// and need not be unique.
+///
+/// # Safety
+/// `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
+/// valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_variant_name(
+    h: *const TrisortBaked,
+    variant: u32,
+    out: *mut c_char,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let h = handle(h, "handle")?;
+        let variants = &h.baked.geometry.variants;
+        let v = variants.get(variant as usize).ok_or_else(|| {
+            Failure(
+                TrisortStatus::OutOfRange,
+                format!(
+                    "{}: material variant {variant} is out of range ({} variants)",
+                    h.path.display(),
+                    variants.len()
+                ),
+            )
+        })?;
+        copy_string(&v.name, out, cap, len)
+    })
+}
+
+/// Copies the material table under the material variant named `name` (NUL-terminated UTF-8;
+/// null: the default materials, as [`trisort_materials`]): entry k is what material slot k
+/// (a vertex's `material`) shows under the variant, so a host switches variants by
+/// re-uploading this table alone. Where names repeat, the first variant of the name is used
+/// (as the player's `--variant`).
+///
+/// Refusals, with a message naming the file and the variant: [`TrisortStatus::Absent`] when
+/// no variant has this name (the message lists the file's variants);
+/// [`TrisortStatus::Unsupported`] when the variant changes something that decides visibility
+/// (alpha mode, double-sidedness, transmission, a cut-out or blended material's alpha or
+/// cutoff...), so the baked order would not be exact for it.
+///
+/// # Safety
+/// `h` is an open handle; `name` is null or a NUL-terminated string; `out`, `cap`, `len` as
+/// in the module conventions.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_variant_materials(
+    h: *const TrisortBaked,
+    name: *const c_char,
+    out: *mut TrisortMaterial,
+    cap: usize,
+    len: *mut usize,
+) -> TrisortStatus {
+    guard(|| {
+        let h = handle(h, "handle")?;
+        let name = if name.is_null() {
+            None
+        } else {
+            Some(CStr::from_ptr(name).to_str().map_err(|_| {
+                Failure(
+                    TrisortStatus::Unsupported,
+                    format!("{}: the variant name is not valid UTF-8", h.path.display()),
+                )
+            })?)
+        };
+        let table = h.baked.geometry.variant_materials(name).map_err(|e| {
+            let status = match e {
+                VariantError::Unknown { .. } => TrisortStatus::Absent,
+                VariantError::ChangesVisibility { .. } => TrisortStatus::Unsupported,
+            };
+            Failure(status, format!("{}: {e}", h.path.display()))
+        })?;
+        let m: Vec<TrisortMaterial> = table.iter().map(material_of).collect();
+        copy_out(&m, out, cap, len)
     })
 }
 

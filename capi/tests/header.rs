@@ -36,7 +36,7 @@ fn header_is_current() {
 #[test]
 fn header_declares_the_abi_version_and_every_entry_point() {
     let h = generate();
-    assert!(h.contains("#define TRISORT_ABI_VERSION 2"), "{h}");
+    assert!(h.contains("#define TRISORT_ABI_VERSION 3"), "{h}");
     for f in [
         "trisort_abi_version",
         "trisort_last_error",
@@ -59,6 +59,13 @@ fn header_declares_the_abi_version_and_every_entry_point() {
         "trisort_export_order",
         "trisort_order_open_path",
         "trisort_order_triangles",
+        "trisort_fps",
+        "trisort_environment_info",
+        "trisort_environment_name",
+        "trisort_environment_level",
+        "trisort_variant_count",
+        "trisort_variant_name",
+        "trisort_variant_materials",
     ] {
         assert!(h.contains(&format!(" {f}(")), "{f} missing from the header");
     }

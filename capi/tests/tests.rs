@@ -3,3 +3,4 @@
 mod api;
 mod baked;
 mod header;
+mod light_variants;
