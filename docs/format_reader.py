@@ -203,19 +203,19 @@ def level_size(width, height, k):
     return max(1, width >> k), max(1, height >> k)
 
 
-def check_lengths(b):
+def check_lengths(b, version):
     """The lengths FORMAT.md states, checked again: every texture level and environment level
-    has the bytes (halves) its size needs, mip chains run to 1x1, slots name textures and
-    texture coordinate sets that exist."""
+    has the bytes (halves) its size needs, every texture (from version 4) has its full mip
+    chain down to 1x1, slots name textures and texture coordinate sets that exist."""
     g = b["geometry"]
     for k, t in enumerate(g["textures"]):
         w, h = t["width"], t["height"]
         if w == 0 or h == 0 or len(t["rgba8"]) != w * h * 4:
             raise Bad("texture %d: %dx%d with %d bytes" % (k, w, h, len(t["rgba8"])))
-        if t["mips"] and level_size(w, h, len(t["mips"])) != (1, 1):
-            raise Bad("texture %d: %d mip levels do not end at 1x1" % (k, len(t["mips"])))
-        if t["mips"] and level_size(w, h, len(t["mips"]) - 1) == (1, 1):
-            raise Bad("texture %d: mip levels go on past 1x1" % k)
+        full = max(w, h).bit_length() - 1
+        if version >= 4 and len(t["mips"]) != full:
+            raise Bad("texture %d %r (%dx%d): %d mip levels, the full chain down to 1x1 has %d"
+                      % (k, t["name"], w, h, len(t["mips"]), full))
         for level, mip in enumerate(t["mips"], start=1):
             lw, lh = level_size(w, h, level)
             if len(mip) != lw * lh * 4:
@@ -265,7 +265,7 @@ def baked_summary(data):
     b = read_baked(p, version)
     if p.at != len(p.data):
         raise Bad("%d trailing payload bytes" % (len(p.data) - p.at))
-    check_lengths(b)
+    check_lengths(b, version)
     g = b["geometry"]
     nidx = 3 * len(b["copies"])
     for d in b["draws"]:

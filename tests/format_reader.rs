@@ -104,8 +104,9 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("cut.baked"));
 }
 
-/// The reader checks the lengths FORMAT.md states: a mip level one byte short is refused
-/// (trisort's own check refuses it too), naming the texture and level.
+/// The reader checks the lengths FORMAT.md states: a mip level one byte short, or a texture
+/// without its full mip chain, is refused (trisort's own check refuses them too), naming the
+/// texture (and level).
 #[test]
 fn the_independent_reader_refuses_a_mip_level_of_the_wrong_length() {
     let Some(python) = python() else { return };
@@ -132,6 +133,24 @@ fn the_independent_reader_refuses_a_mip_level_of_the_wrong_length() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("short-mip.baked") && err.contains("texture 0 mip 3"),
+        "{err}"
+    );
+    // The chain is not optional: a texture stored without it is refused by both readers.
+    baked.geometry.textures[0].mips.clear();
+    let name = baked.geometry.textures[0].name.clone();
+    let ours = baked.geometry.check_structure().unwrap_err();
+    assert!(
+        ours.contains(&format!("texture 0 {name:?}")) && ours.contains("has 0 mip levels"),
+        "{ours}"
+    );
+    let bare = d.join("no-mips.baked");
+    write_bytes_atomic(&bare, &encode(FileKind::Baked, &baked)).unwrap();
+    let out = run_reader(python, &bare);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no-mips.baked")
+            && err.contains("0 mip levels, the full chain down to 1x1 has 6"),
         "{err}"
     );
 }

@@ -406,14 +406,8 @@ fn sub_pixel_texture_alpha_verifies_in_every_mode() {
             rgba8.extend_from_slice(&[(x * 4) as u8, 200, (y * 4) as u8, a]);
         }
     }
-    let texture = trisort_format::Texture {
-        name: "checker".into(),
-        width: n,
-        height: n,
-        rgba8,
-        srgb: true,
-        mips: Vec::new(),
-    };
+    let (texture, _) =
+        trisort_format::Texture::with_mips("checker".into(), n, n, rgba8, true, 1024);
     let textured = |mode| Material {
         base_color: [1.0, 1.0, 1.0, 1.0],
         base_color_texture: Some(0),

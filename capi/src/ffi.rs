@@ -267,8 +267,8 @@ pub struct TrisortTextureInfo {
     /// `GL_SRGB8_ALPHA8`) rather than linear data (metallic-roughness, normal, occlusion:
     /// `GL_RGBA8`).
     pub srgb: bool,
-    /// Levels stored, level 0 included: 1 without mips, else down to 1×1 (level k is
-    /// `max(1, width >> k)` × `max(1, height >> k)`).
+    /// Levels stored, level 0 included: the full chain down to 1×1 (level k is
+    /// `max(1, width >> k)` × `max(1, height >> k)`; 1 for a 1×1 texture).
     pub level_count: u32,
 }
 

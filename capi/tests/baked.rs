@@ -42,14 +42,8 @@ fn sample() -> Baked {
     });
     g.vertices[5].tangent = [1.0, 0.0, 0.0, -1.0];
     g.vertices[5].uv1 = [0.125, 0.875];
-    g.textures.push(Texture {
-        name: "t".into(),
-        width: 2,
-        height: 1,
-        rgba8: vec![1, 2, 3, 4, 5, 6, 7, 8],
-        srgb: true,
-        mips: Vec::new(),
-    });
+    let (colour, _) = Texture::with_mips("t".into(), 2, 1, (1..=8).collect(), true, 1024);
+    g.textures.push(colour);
     let (normals, _) = Texture::with_mips("n".into(), 4, 2, vec![128; 32], false, 1024);
     g.textures.push(normals);
     let copies = vec![0, 1, 2, 3, 4, 5, 6, 7, 2, 3];
@@ -268,7 +262,7 @@ fn matrices_materials_and_textures() {
         unsafe { trisort_texture_info(h, 0, &mut info) },
         TrisortStatus::Ok
     );
-    assert_eq!((info.srgb, info.level_count), (true, 1));
+    assert_eq!((info.srgb, info.level_count), (true, 2));
     assert_eq!(
         unsafe { trisort_texture_info(h, 1, &mut info) },
         TrisortStatus::Ok

@@ -206,7 +206,10 @@ pub struct Texture {
     /// is stored twice.
     pub srgb: bool,
     /// Mip levels 1, 2, … down to 1×1 (level k is `max(1, width >> k)` ×
-    /// `max(1, height >> k)`, RGBA8), generated at import; empty for a texture without mips.
+    /// `max(1, height >> k)`, RGBA8), generated at import ([`Texture::with_mips`]). Always the
+    /// full chain ([`Texture::mip_count`] levels; empty only for a 1×1 texture):
+    /// [`Geometry::check_structure`] requires it, and the GPU upload uses these levels as
+    /// stored, so the file is the one source of every texture's mips.
     pub mips: Vec<Vec<u8>>,
 }
 
@@ -460,7 +463,7 @@ impl Geometry {
     /// triangle vertices in range, vertex materials and nodes in range, finite positions,
     /// finite material factors and texture transforms, every texture slot naming an existing
     /// texture and texture coordinate set 0 or 1, every texture non-empty with the right byte
-    /// count for level 0 and each mip level (no mips, or the full chain), parents before
+    /// count for level 0 and for each level of its full mip chain down to 1×1, parents before
     /// children, finite rest transforms, variants mapping every material slot to an existing
     /// material. Returns the first problem found.
     pub fn check_structure(&self) -> Result<(), String> {
@@ -544,9 +547,11 @@ impl Geometry {
                 return Err(format!("texture {t} has the wrong number of bytes"));
             }
             let levels = Texture::mip_count(tex.width, tex.height);
-            if !tex.mips.is_empty() && tex.mips.len() != levels {
+            if tex.mips.len() != levels {
                 return Err(format!(
-                    "texture {t} ({}x{}) has {} mip levels, a full chain has {levels}",
+                    "texture {t} {:?} ({}x{}) has {} mip levels, a full chain has {levels} \
+                     (levels 1, 2, … down to 1x1, made at import)",
+                    tex.name,
                     tex.width,
                     tex.height,
                     tex.mips.len()
@@ -744,13 +749,9 @@ mod tests {
             double_sided: true,
             ..Material::default()
         };
-        let texture = |alpha: u8, rgb: u8| Texture {
-            name: String::new(),
-            width: 2,
-            height: 1,
-            rgba8: vec![rgb, rgb, rgb, alpha, 0, 0, 0, 255],
-            srgb: true,
-            mips: Vec::new(),
+        let texture = |alpha: u8, rgb: u8| {
+            let rgba8 = vec![rgb, rgb, rgb, alpha, 0, 0, 0, 255];
+            Texture::with_mips(String::new(), 2, 1, rgba8, true, Texture::MAX_SIZE).0
         };
         let masked = |name: &str, t: u32| Material {
             base_color_texture: Some(t),
@@ -1079,9 +1080,16 @@ mod tests {
             let err = g.check_structure().unwrap_err();
             assert!(err.contains(expected), "{err:?} lacks {expected:?}");
         }
-        // A texture without mips is valid.
+        // A texture without its mips is refused, naming it; a 1x1 texture has none to store.
         let mut g = textured();
         g.textures[0].mips.clear();
+        let err = g.check_structure().unwrap_err();
+        assert!(
+            err.contains("texture 0 \"t\" (4x2) has 0 mip levels, a full chain has 2"),
+            "{err}"
+        );
+        g.textures[0] = Texture::with_mips("dot".into(), 1, 1, vec![9; 4], true, 4).0;
+        assert!(g.textures[0].mips.is_empty());
         g.check_structure().unwrap();
     }
 

@@ -548,6 +548,9 @@ impl SceneGpu {
     /// space, with its mips): each layer is as large as the array's largest texture, and a
     /// smaller texture fills the top-left corner of every level (its uv scaled to fit), so one
     /// bind group serves every material. Node matrices are computed in f64 and cast once.
+    /// Every texture's mips are uploaded as the geometry stores them: the geometry must pass
+    /// [`Geometry::check_structure`] (which requires each texture's full chain), else this
+    /// may panic.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -856,51 +859,20 @@ struct Textures {
     bytes: u64,
 }
 
-/// Number of mip levels of a full chain for a `w` × `h` level 0.
-fn full_chain(w: u32, h: u32) -> u32 {
-    32 - w.max(h).max(1).leading_zeros()
+/// Number of mip levels of a full chain for a `w` × `h` level 0, level 0 included.
+fn chain_levels(w: u32, h: u32) -> u32 {
+    trisort_format::Texture::mip_count(w, h) as u32 + 1
 }
 
-/// Level `k` of `t` (RGBA8, `max(1, w >> k)` × `max(1, h >> k)`): level 0, a level of its
-/// chain, or for a level beyond it (or a texture stored without mips) a 2×2 box filter of the
-/// level above, made here (averaging the stored bytes, sRGB-encoded or not).
-fn texture_levels(t: &trisort_format::Texture, levels: u32) -> Vec<(u32, u32, Vec<u8>)> {
-    let mut out: Vec<(u32, u32, Vec<u8>)> = vec![(t.width, t.height, t.rgba8.clone())];
-    for k in 1..levels {
-        let (w, h) = ((t.width >> k).max(1), (t.height >> k).max(1));
-        let stored = t.mips.get(k as usize - 1);
-        let level = match stored {
-            Some(bytes) if bytes.len() == (w * h * 4) as usize => bytes.clone(),
-            _ => {
-                let (pw, ph, prev) = &out[k as usize - 1];
-                box_filter(prev, *pw, *ph, w, h)
-            }
-        };
-        out.push((w, h, level));
-    }
-    out
-}
-
-/// A `w` × `h` RGBA8 level from the `pw` × `ph` level above: each texel averages the 2×2 (or,
-/// along a side of 1, the 1×2 or 2×1) texels it covers.
-fn box_filter(prev: &[u8], pw: u32, ph: u32, w: u32, h: u32) -> Vec<u8> {
-    let mut out = Vec::with_capacity((w * h * 4) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let xs = [(2 * x).min(pw - 1), (2 * x + 1).min(pw - 1)];
-            let ys = [(2 * y).min(ph - 1), (2 * y + 1).min(ph - 1)];
-            for c in 0..4 {
-                let mut sum = 0u32;
-                for yy in ys {
-                    for xx in xs {
-                        sum += prev[((yy * pw + xx) * 4 + c) as usize] as u32;
-                    }
-                }
-                out.push(((sum + 2) / 4) as u8);
-            }
-        }
-    }
-    out
+/// Level `k` of `t` as its size and RGBA8 bytes: level 0, a level of its stored chain
+/// ([`trisort_format::Texture::mips`], full as [`Geometry::check_structure`] requires), or for
+/// a level beyond the chain (the array's largest texture has more levels) its last, 1×1
+/// level again, which is what averaging a 1×1 level would give.
+fn texture_level(t: &trisort_format::Texture, k: usize) -> ((u32, u32), &[u8]) {
+    let k = k.min(t.mips.len());
+    let size = trisort_format::Texture::level_size(t.width, t.height, k as u32);
+    let bytes = if k == 0 { &t.rgba8 } else { &t.mips[k - 1] };
+    (size, bytes)
 }
 
 /// A `w` × `h` RGBA8 level of `size` repeated over a layer level of `layer` texels from the
@@ -974,7 +946,7 @@ fn upload_array(
     });
     let max_dim = limits.max_texture_dimension_2d;
     let (tw, th) = (tw.min(max_dim), th.min(max_dim));
-    let levels = full_chain(tw, th);
+    let levels = chain_levels(tw, th);
     // wgpu's GL backend picks the GL texture target when the texture is made, from its
     // layer count alone: one layer becomes TEXTURE_2D, which a `texture_2d_array` binding
     // (sampler2DArray) then samples as an incomplete texture, black. Two layers at least on
@@ -1034,10 +1006,11 @@ fn upload_array(
     };
     for (layer, &i) in members.iter().enumerate() {
         let t = &geometry.textures[i];
-        for (k, (lw, lh, level)) in texture_levels(t, levels).iter().enumerate() {
+        for k in 0..levels {
+            let (size, level) = texture_level(t, k as usize);
             let (aw, ah) = ((tw >> k).max(1), (th >> k).max(1));
-            let data = tiled(level, (*lw, *lh), (aw, ah));
-            write(k as u32, layer as u32, aw, ah, &data);
+            let data = tiled(level, size, (aw, ah));
+            write(k, layer as u32, aw, ah, &data);
         }
         places[i] = TexturePlace {
             linear,
@@ -1097,7 +1070,7 @@ fn upload_environment(
         stored.push((1, 1, &white));
     }
     let (w0, h0) = (stored[0].0, stored[0].1);
-    let levels = (stored.len() as u32).min(full_chain(w0, h0));
+    let levels = (stored.len() as u32).min(chain_levels(w0, h0));
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("environment"),
         size: wgpu::Extent3d {

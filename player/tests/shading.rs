@@ -46,17 +46,27 @@ pub(crate) fn textured() -> Baked {
 
 /// A `size`² linear or sRGB texture of one colour, with its mip chain.
 pub(crate) fn flat_texture(rgba: [u8; 4], size: u32, srgb: bool) -> Texture {
-    let level = |s: u32| rgba.repeat((s * s) as usize);
-    Texture {
+    with_chain(Texture {
         name: String::new(),
         width: size,
         height: size,
-        rgba8: level(size),
+        rgba8: rgba.repeat((size * size) as usize),
         srgb,
-        mips: (1..32 - size.leading_zeros())
-            .map(|k| level((size >> k).max(1)))
-            .collect(),
-    }
+        mips: Vec::new(),
+    })
+}
+
+/// `t` with the mip chain the importer makes from its level 0 (after a test edits it).
+pub(crate) fn with_chain(t: Texture) -> Texture {
+    Texture::with_mips(
+        t.name,
+        t.width,
+        t.height,
+        t.rgba8,
+        t.srgb,
+        Texture::MAX_SIZE,
+    )
+    .0
 }
 
 /// The slot of texture `texture` on uv set 0, untransformed.
@@ -175,9 +185,7 @@ fn every_map_of_the_pbr_model_changes_pixels() {
                         px[..3].copy_from_slice(&[0, 0, 0]);
                     }
                 }
-                // No stored chain: the upload makes one.
-                t.mips.clear();
-                b.geometry.textures = vec![t];
+                b.geometry.textures = vec![with_chain(t)];
                 let m = &mut b.geometry.materials[2];
                 m.base_color_texture = Some(0);
                 m.base_color_tex_coord = 1;
@@ -307,7 +315,7 @@ pub fn every_map() -> Baked {
                 px[..3].copy_from_slice(&[200, 40, 0]);
             }
         }
-        checker.mips.clear();
+        let checker = with_chain(checker);
         b.geometry.textures = vec![
             flat_texture([90, 160, 220, 255], 4, false),
             flat_texture([0, 90, 200, 255], 2, false),

@@ -238,14 +238,17 @@ pub fn faces() -> Baked {
                 ..material(YELLOW, AlphaMode::Mask)
             },
         ],
-        textures: vec![trisort_format::Texture {
-            name: "half".into(),
-            width: 2,
-            height: 1,
-            rgba8: vec![255, 255, 255, 255, 255, 255, 255, 0],
-            srgb: true,
-            mips: Vec::new(),
-        }],
+        textures: vec![
+            trisort_format::Texture::with_mips(
+                "half".into(),
+                2,
+                1,
+                vec![255, 255, 255, 255, 255, 255, 255, 0],
+                true,
+                1024,
+            )
+            .0,
+        ],
         nodes: b.geometry.nodes.clone(),
         ..Default::default()
     };
