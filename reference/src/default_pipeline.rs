@@ -15,7 +15,7 @@ use trisort_gpu::{clear_colour, halves, quantize_rgba16f, COLOR_FORMAT};
 use trisort_player::{blend_state, Mode};
 use wgpu::util::DeviceExt;
 
-use crate::target::{Target, DEPTH_FORMAT};
+use crate::target::{lit_scene, Target, DEPTH_FORMAT};
 use crate::ReferenceError;
 
 /// Whether a scene triangle is drawn in the transparent pass: its material (that of its first
@@ -55,15 +55,7 @@ impl<'g> DefaultRenderer<'g> {
             COLOR_FORMAT,
             true,
         )?;
-        let scene = SceneGpu::with_lighting(
-            device,
-            &gpu.queue,
-            geometry,
-            frames,
-            view,
-            trisort_gpu::Bindings::Storage,
-            lighting,
-        );
+        let scene = lit_scene(gpu, geometry, frames, view, lighting);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("default pipeline"),
             source: wgpu::ShaderSource::Wgsl(trisort_gpu::compose(&[], trisort_gpu::PLAYER).into()),

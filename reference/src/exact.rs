@@ -29,14 +29,14 @@ use trisort_format::{
     Baked, DrawIndexedIndirectArgs, Environment, FrameState, FrameWindow, Geometry, RecordSettings,
     Recording,
 };
-use trisort_gpu::scene_gpu::{Bindings, Lighting, SceneGpu, ScenePipeline, View};
+use trisort_gpu::scene_gpu::{Lighting, SceneGpu, ScenePipeline, View};
 use trisort_gpu::Gpu;
 use trisort_gpu::{clear_colour, halves, quantize_rgba16f, BACKGROUND, COLOR_FORMAT};
 use trisort_player::{blend_state, Mode};
 use trisort_recorder::Peeler;
 use wgpu::util::DeviceExt;
 
-use crate::target::{check_pattern, Target};
+use crate::target::{check_pattern, lit_scene, Target};
 use crate::ReferenceError;
 
 /// The pattern and mode a reference frame is rendered at.
@@ -284,15 +284,7 @@ impl<'g> ExactReference<'g> {
         let view = config.view();
         let peeler = Peeler::new(gpu, geometry, &all, frames, view)?;
         let device = &gpu.device;
-        let scene = SceneGpu::with_lighting(
-            device,
-            &gpu.queue,
-            geometry,
-            frames,
-            view,
-            Bindings::Storage,
-            lighting,
-        );
+        let scene = lit_scene(gpu, geometry, frames, view, lighting);
         let storage = |binding| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::FRAGMENT,

@@ -42,7 +42,7 @@ use trisort_gpu::{
 };
 use wgpu::util::DeviceExt;
 
-use crate::target::scene_index;
+use crate::target::{lit_scene, scene_index};
 use crate::ReferenceError;
 
 /// Bytes of one node of the pool: colour (4 × f32), depth (f32), triangle id, next index.
@@ -386,15 +386,7 @@ impl<'g> OitRenderer<'g> {
             samples: config.samples,
             glass_opacity: config.glass_opacity,
         };
-        let scene = SceneGpu::with_lighting(
-            device,
-            &gpu.queue,
-            geometry,
-            frames,
-            view,
-            trisort_gpu::Bindings::Storage,
-            lighting,
-        );
+        let scene = lit_scene(gpu, geometry, frames, view, lighting);
         let index = scene_index(device, geometry, "oit indices");
         let lists = Lists::new(gpu, &config);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -47,7 +47,7 @@ use trisort_gpu::{clear_colour, FrameTarget, TargetConfig, COLOR_FORMAT, DEPTH_F
 use trisort_player::{blend_state, Mode};
 use wgpu::util::DeviceExt;
 
-use crate::target::{check_pattern, scene_index};
+use crate::target::{check_pattern, lit_scene, scene_index};
 use crate::ReferenceError;
 
 /// Format of the peel passes' id target (triangle id + 1, 0 = no fragment).
@@ -310,15 +310,7 @@ impl<'g> PeelingRenderer<'g> {
             samples,
             glass_opacity,
         };
-        let scene = SceneGpu::with_lighting(
-            device,
-            &gpu.queue,
-            geometry,
-            frames,
-            view,
-            trisort_gpu::Bindings::Storage,
-            lighting,
-        );
+        let scene = lit_scene(gpu, geometry, frames, view, lighting);
         let index = scene_index(device, geometry, "peeling indices");
 
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

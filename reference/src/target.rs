@@ -1,7 +1,8 @@
 //! An offscreen target like the player's headless one: an MSAA colour attachment (and depth
 //! where asked) resolved to one sample by the render pass, then read back.
 
-use trisort_format::Geometry;
+use trisort_format::{FrameState, Geometry};
+use trisort_gpu::scene_gpu::{Bindings, Lighting, SceneGpu, View};
 use trisort_gpu::{FrameTarget, Gpu, TargetConfig};
 use wgpu::util::DeviceExt;
 
@@ -63,6 +64,27 @@ pub(crate) fn check_pattern(size: (u32, u32), samples: u32) -> Result<(), Refere
         )));
     }
     Ok(())
+}
+
+/// The scene uploaded for a reference renderer: on the storage tier its shaders are composed
+/// for ([`trisort_gpu::compose`]), lit as `lighting` says (the baked file's environment, as
+/// the player lights it).
+pub(crate) fn lit_scene(
+    gpu: &Gpu,
+    geometry: &Geometry,
+    frames: &[FrameState],
+    view: View,
+    lighting: Lighting<'_>,
+) -> SceneGpu {
+    SceneGpu::with_lighting(
+        &gpu.device,
+        &gpu.queue,
+        geometry,
+        frames,
+        view,
+        Bindings::Storage,
+        lighting,
+    )
 }
 
 /// An index buffer of every triangle of `geometry` in scene order, so that `primitive_index`
