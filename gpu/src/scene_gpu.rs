@@ -575,6 +575,35 @@ impl SceneGpu {
         SceneGpu::with_lighting(device, queue, geometry, frames, view, bindings, lighting)
     }
 
+    /// [`SceneGpu::new`] for shaders that read only what decides visibility: `surface_base`'s
+    /// alpha and `culled` (the recorder's peel and conservative passes), never a material's
+    /// other maps nor the light. The linear texture array, which holds only the
+    /// metallic-roughness, normal and occlusion maps such shaders skip, is one white texel
+    /// unless some material's base-colour texture is linear (then it is uploaded as
+    /// [`SceneGpu::new`] uploads it). The sRGB array, every texture's place (layer and uv
+    /// scale), the material table, frames and the 1×1 uniform environment are those of
+    /// [`SceneGpu::new`], so such shaders draw the same bytes with a smaller upload
+    /// ([`SceneGpu::texture_bytes`]). A shader that shades through it reads that white texel
+    /// for every linear map.
+    pub fn for_visibility(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+    ) -> SceneGpu {
+        SceneGpu::upload(
+            device,
+            queue,
+            geometry,
+            frames,
+            view,
+            Bindings::Storage,
+            Lighting::default(),
+            true,
+        )
+    }
+
     /// [`SceneGpu::with_bindings`] lit as `lighting` says (the player and the reference pass
     /// the baked file's environment, so both light alike).
     pub fn with_lighting(
@@ -585,6 +614,24 @@ impl SceneGpu {
         view: View,
         bindings: Bindings,
         lighting: Lighting<'_>,
+    ) -> SceneGpu {
+        SceneGpu::upload(
+            device, queue, geometry, frames, view, bindings, lighting, false,
+        )
+    }
+
+    /// [`SceneGpu::with_lighting`], or with `visibility_only` [`SceneGpu::for_visibility`]'s
+    /// smaller texture upload.
+    #[allow(clippy::too_many_arguments)]
+    fn upload(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+        bindings: Bindings,
+        lighting: Lighting<'_>,
+        visibility_only: bool,
     ) -> SceneGpu {
         let limits = device.limits();
         let vertex_bytes: &[u8] = if geometry.vertices.is_empty() {
@@ -597,7 +644,7 @@ impl SceneGpu {
             contents: vertex_bytes,
             usage: wgpu::BufferUsages::VERTEX,
         });
-        let textures = upload_textures(device, queue, geometry);
+        let textures = upload_textures(device, queue, geometry, visibility_only);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("material textures"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -899,8 +946,15 @@ fn tiled(level: &[u8], (w, h): (u32, u32), (lw, lh): (u32, u32)) -> Vec<u8> {
 /// layer is as large as its array's largest texture (clamped to the device's limit), with a
 /// full mip chain; a smaller texture fills the top-left corner of every level with its own
 /// level of the same index, repeated over the rest of the level ([`tiled`]). An empty array gets one white texel; on GL an array has two layers
-/// at least (see the comment inside).
-fn upload_textures(device: &wgpu::Device, queue: &wgpu::Queue, geometry: &Geometry) -> Textures {
+/// at least (see the comment inside). With `visibility_only` ([`SceneGpu::for_visibility`])
+/// the linear array is left empty (its textures placed at its layer 0, the white texel) unless
+/// a material's base-colour texture is linear.
+fn upload_textures(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    geometry: &Geometry,
+    visibility_only: bool,
+) -> Textures {
     let mut places = vec![
         TexturePlace {
             linear: false,
@@ -911,10 +965,26 @@ fn upload_textures(device: &wgpu::Device, queue: &wgpu::Queue, geometry: &Geomet
     ];
     let mut bytes = 0;
     let mut views = Vec::new();
+    // What `surface_base` samples: base-colour textures, in the array of their colour space.
+    let linear_base = geometry.materials.iter().any(|m| {
+        m.base_color_texture
+            .and_then(|t| geometry.textures.get(t as usize))
+            .is_some_and(|t| !t.srgb)
+    });
     for linear in [false, true] {
-        let members: Vec<usize> = (0..geometry.textures.len())
+        let mut members: Vec<usize> = (0..geometry.textures.len())
             .filter(|&i| geometry.textures[i].srgb != linear)
             .collect();
+        if linear && visibility_only && !linear_base {
+            for &i in &members {
+                places[i] = TexturePlace {
+                    linear: true,
+                    layer: 0,
+                    scale: [1.0, 1.0],
+                };
+            }
+            members.clear();
+        }
         let (view, b) = upload_array(device, queue, geometry, &members, linear, &mut places);
         views.push(view);
         bytes += b;

@@ -263,7 +263,7 @@ impl<'g> Conservative<'g> {
         tolerance: f32,
     ) -> Result<Conservative<'g>, RecordError> {
         let device = &gpu.device;
-        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let scene = crate::peeler::visibility_scene(gpu, geometry, frames, view);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("conservative"),
             source: wgpu::ShaderSource::Wgsl(trisort_gpu::conservative_shader(view.samples).into()),

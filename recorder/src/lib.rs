@@ -35,7 +35,7 @@ use trisort_gpu::Gpu;
 pub use conservative::Conservative;
 use partial::{Graph, Visibility};
 #[doc(hidden)]
-pub use peeler::{readback_counters, with_interleaved_readback};
+pub use peeler::{readback_counters, with_full_texture_upload, with_interleaved_readback};
 pub use peeler::{Layer, Peeler};
 
 /// Errors while recording.

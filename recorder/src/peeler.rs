@@ -29,6 +29,36 @@ pub struct Layer {
 thread_local! {
     /// See [`with_interleaved_readback`].
     static INTERLEAVED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// See [`with_full_texture_upload`].
+    static FULL_UPLOAD: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f` with peelers and conservative passes built inside uploading every texture as a
+/// player does ([`SceneGpu::new`]) instead of only what visibility reads
+/// ([`SceneGpu::for_visibility`], which leaves out the linear maps). Kept only so that tests
+/// can show both upload the same recordings.
+#[doc(hidden)]
+pub fn with_full_texture_upload<R>(f: impl FnOnce() -> R) -> R {
+    let before = FULL_UPLOAD.with(|c| c.replace(true));
+    let r = f();
+    FULL_UPLOAD.with(|c| c.set(before));
+    r
+}
+
+/// The scene as the recorder's shaders read it, which is only what decides visibility:
+/// [`SceneGpu::for_visibility`] (or [`SceneGpu::new`] inside [`with_full_texture_upload`]).
+pub(crate) fn visibility_scene(
+    gpu: &Gpu,
+    geometry: &Geometry,
+    frames: &[FrameState],
+    view: View,
+) -> SceneGpu {
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    if FULL_UPLOAD.with(|c| c.get()) {
+        SceneGpu::new(device, queue, geometry, frames, view)
+    } else {
+        SceneGpu::for_visibility(device, queue, geometry, frames, view)
+    }
 }
 
 /// Runs `f` with the recorder's former readback on this thread: peelers built inside gather
@@ -288,7 +318,7 @@ impl<'g> Peeler<'g> {
     ) -> Result<Self, RecordError> {
         let device = &gpu.device;
         check_device(gpu, view)?;
-        let scene = SceneGpu::new(device, &gpu.queue, geometry, frames, view);
+        let scene = visibility_scene(gpu, geometry, frames, view);
         let source = match grow {
             None => trisort_gpu::peel_shader(view.samples),
             Some(_) => trisort_gpu::peel_grown_shader(view.samples),

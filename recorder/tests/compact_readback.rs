@@ -43,7 +43,8 @@ fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) 
     );
 }
 
-fn variants() -> Vec<RecordSettings> {
+/// Plain, robust and conservative at 4×, and plain at 1×, at 64×64.
+pub(crate) fn variants() -> Vec<RecordSettings> {
     let base = RecordSettings {
         width: 64,
         height: 64,
