@@ -541,8 +541,9 @@ pub fn begin_peel_pass<'e>(
 impl SceneGpu {
     /// Uploads the geometry, materials, textures and the uniforms of every frame, on the
     /// storage tier ([`SceneGpu::with_bindings`] with [`Bindings::Storage`]), lit by
-    /// [`Shading::Pbr`] under a uniform environment of radiance 1 (what the recorder and tools
-    /// that only need visibility use; players light with [`SceneGpu::with_lighting`]).
+    /// [`Shading::Pbr`] under a uniform environment of radiance 1 (for tools that draw without
+    /// the file's light; players light with [`SceneGpu::with_lighting`], and the recorder,
+    /// which reads only visibility, uploads less with [`SceneGpu::for_visibility`]).
     ///
     /// Textures share two arrays (sRGB and linear, each texture in the array of its colour
     /// space, with its mips): each layer is as large as the array's largest texture, and a
