@@ -88,6 +88,17 @@ impl Shading {
             Shading::Pbr => "pbr",
         }
     }
+
+    /// The pipeline-overridable constants that specialise a pipeline's surface function to
+    /// this model (`SHADING_MODEL` in `wgsl/common.wgsl`), so it compiles only this model's
+    /// code; for the fragment stage of pipelines whose module includes the common WGSL.
+    /// Without them the model is chosen at run time from the lighting uniform.
+    pub fn constants(self) -> &'static [(&'static str, f64)] {
+        match self {
+            Shading::Basic => &[("SHADING_MODEL", 0.0)],
+            Shading::Pbr => &[("SHADING_MODEL", 1.0)],
+        }
+    }
 }
 
 impl std::str::FromStr for Shading {
@@ -1386,8 +1397,19 @@ pub struct ScenePipeline<'a> {
 }
 
 impl ScenePipeline<'_> {
-    /// Creates the pipeline.
+    /// Creates the pipeline (a surface function, if it shades, choosing its model at run time).
     pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        self.build_with(device, &[])
+    }
+
+    /// Creates the pipeline with its surface function specialised to `shading`
+    /// ([`Shading::constants`]): for pipelines that shade, so they compile what the player's
+    /// pipeline compiles.
+    pub fn build_shaded(&self, device: &wgpu::Device, shading: Shading) -> wgpu::RenderPipeline {
+        self.build_with(device, shading.constants())
+    }
+
+    fn build_with(&self, device: &wgpu::Device, constants: &[(&str, f64)]) -> wgpu::RenderPipeline {
         let layouts: Vec<Option<&wgpu::BindGroupLayout>> =
             self.layouts.iter().map(|l| Some(*l)).collect();
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -1426,7 +1448,10 @@ impl ScenePipeline<'_> {
             fragment: Some(wgpu::FragmentState {
                 module: self.module,
                 entry_point: Some(self.fragment),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    ..Default::default()
+                },
                 targets: &[Some(self.target.clone())],
             }),
             multiview_mask: None,

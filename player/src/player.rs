@@ -445,7 +445,10 @@ fn create_pipeline(
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some(fragment_entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: config.shading.constants(),
+                ..Default::default()
+            },
             targets: &[Some(wgpu::ColorTargetState {
                 format: config.color_format,
                 blend: Some(blend_state(config.mode)),

@@ -55,6 +55,7 @@ impl<'g> DefaultRenderer<'g> {
             COLOR_FORMAT,
             true,
         )?;
+        let shading = lighting.shading;
         let scene = lit_scene(gpu, geometry, frames, view, lighting);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("default pipeline"),
@@ -79,7 +80,7 @@ impl<'g> DefaultRenderer<'g> {
                 depth: Some((DEPTH_FORMAT, wgpu::CompareFunction::Less, write)),
                 samples: view.samples,
             }
-            .build(device)
+            .build_shaded(device, shading)
         };
         let opaque_pipeline = pipeline(true);
         let transparent_pipeline = pipeline(false);

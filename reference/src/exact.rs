@@ -284,6 +284,7 @@ impl<'g> ExactReference<'g> {
         let view = config.view();
         let peeler = Peeler::new(gpu, geometry, &all, frames, view)?;
         let device = &gpu.device;
+        let shading = lighting.shading;
         let scene = lit_scene(gpu, geometry, frames, view, lighting);
         let storage = |binding| wgpu::BindGroupLayoutEntry {
             binding,
@@ -338,7 +339,7 @@ impl<'g> ExactReference<'g> {
             depth: None,
             samples: config.samples,
         }
-        .build(device);
+        .build_shaded(device, shading);
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("reference composite params"),
             contents: bytemuck::cast_slice(&[config.size.0, config.samples, 0, 0]),

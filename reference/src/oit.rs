@@ -386,6 +386,7 @@ impl<'g> OitRenderer<'g> {
             samples: config.samples,
             glass_opacity: config.glass_opacity,
         };
+        let shading = lighting.shading;
         let scene = lit_scene(gpu, geometry, frames, view, lighting);
         let index = scene_index(device, geometry, "oit indices");
         let lists = Lists::new(gpu, &config);
@@ -419,7 +420,7 @@ impl<'g> OitRenderer<'g> {
             depth: None,
             samples: config.samples,
         }
-        .build(device);
+        .build_shaded(device, shading);
         let resolve_pipeline = trisort_gpu::pipeline::fullscreen(
             device,
             "oit resolve",

@@ -310,6 +310,7 @@ impl<'g> PeelingRenderer<'g> {
             samples,
             glass_opacity,
         };
+        let shading = lighting.shading;
         let scene = lit_scene(gpu, geometry, frames, view, lighting);
         let index = scene_index(device, geometry, "peeling indices");
 
@@ -345,7 +346,7 @@ impl<'g> PeelingRenderer<'g> {
                 depth: Some((DEPTH_FORMAT, compare, true)),
                 samples,
             }
-            .build(device)
+            .build_shaded(device, shading)
         };
         let front = peel_pipeline("peeling front to back", wgpu::CompareFunction::Less);
         let back = peel_pipeline("peeling back to front", wgpu::CompareFunction::GreaterEqual);
@@ -365,7 +366,7 @@ impl<'g> PeelingRenderer<'g> {
             depth: None,
             samples,
         }
-        .build(device);
+        .build_shaded(device, shading);
 
         let params_stride = 256u64.max(device.limits().min_uniform_buffer_offset_alignment as u64);
         let mut params = vec![0u8; params_stride as usize * 4];

@@ -458,10 +458,17 @@ fn shade_pbr(m: MaterialGpu, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
     return vec4<f32>(colour, base.a);
 }
 
+// The surface model a pipeline is specialised to (`Shading::constants`): 0 basic, 1 pbr, 2 (the
+// default) as `lighting` says at run time. A specialised pipeline compiles only its model: a
+// CPU rasterizer (llvmpipe) runs both sides of a uniform branch, so the run-time choice made
+// the basic model cost as much as PBR there.
+override SHADING_MODEL: u32 = 2u;
+
 // Lit colour (linear, straight alpha) of a fragment of material `m` (`material_at`, read once
-// per fragment) whose `surface_base` is `base`: `basic` or `pbr` as the lighting says.
+// per fragment) whose `surface_base` is `base`: `basic` or `pbr` as the pipeline's
+// `SHADING_MODEL`, or the lighting, says.
 fn shade(m: MaterialGpu, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
-    if (lighting.params.y > 0.5) {
+    if (SHADING_MODEL == 1u || (SHADING_MODEL == 2u && lighting.params.y > 0.5)) {
         return shade_pbr(m, base, s);
     }
     return shade_basic(m, base, s);
