@@ -42,17 +42,18 @@ pub fn recording_path(output: &Path) -> PathBuf {
     output.with_file_name(name)
 }
 
-/// Records and merges; returns the recording, the baked file and the seconds of each step.
+/// Records and merges, storing `environment` (`MergeOpts::environment`, loaded by the caller
+/// before anything else so a bad light costs no work and leaves no output); returns the
+/// recording, the baked file and the seconds of each step.
 pub fn bake(
     gpu: &Gpu,
     scene: &trisort_scene::Scene,
     timeline: &trisort_paths::Timeline,
     record: &RecordOpts,
     merge: &MergeOpts,
+    environment: trisort_format::Environment,
     output: &Path,
 ) -> Result<(Recording, Baked, f64, f64)> {
-    // Before anything is written: a bad light leaves no output.
-    let environment = merge.environment()?;
     let t0 = Instant::now();
     let rec_path = recording_path(output);
     let rec = record_to_file(gpu, scene, timeline, record, Phase::Graphs, None, &rec_path)?;
@@ -69,11 +70,20 @@ pub fn bake(
 }
 
 pub fn run(a: BakeArgs) -> Result<ExitCode> {
+    // First: a bad light fails before the scene is loaded and split.
+    let environment = a.merge.environment()?;
     let (scene, timeline, split) =
         load_working(&a.scene, &a.path, a.record.fps, &a.record.settings())?;
     let gpu = crate::common::open_gpu()?;
-    let (rec, baked, record_s, merge_s) =
-        bake(&gpu, &scene, &timeline, &a.record, &a.merge, &a.output)?;
+    let (rec, baked, record_s, merge_s) = bake(
+        &gpu,
+        &scene,
+        &timeline,
+        &a.record,
+        &a.merge,
+        environment,
+        &a.output,
+    )?;
     if a.json {
         let mut v = recording_json(&rec, Some(record_s));
         let m = baked_json(&baked, merge_s);

@@ -185,7 +185,9 @@ fn bake_for(
         a.size.1,
         samples
     ));
-    let (recording, baked, record_s, merge_s) = bake(gpu, scene, timeline, &record, &merge, &path)?;
+    let environment = merge.environment()?;
+    let (recording, baked, record_s, merge_s) =
+        bake(gpu, scene, timeline, &record, &merge, environment, &path)?;
     let bytes = std::fs::metadata(&path)?.len();
     say(&format!(
         "baked {} in {:.1} s (record {record_s:.1} s, merge {merge_s:.1} s): {} index triangles, |G| = {}",

@@ -79,7 +79,16 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     let gpu = crate::common::open_gpu()?;
     println!("device: {}", gpu.describe());
     let baked_path = a.out_dir.join("demo.baked");
-    let (rec, baked, record_s, merge_s) = bake(&gpu, &scene, &path, &record, &merge, &baked_path)?;
+    let environment = merge.environment()?;
+    let (rec, baked, record_s, merge_s) = bake(
+        &gpu,
+        &scene,
+        &path,
+        &record,
+        &merge,
+        environment,
+        &baked_path,
+    )?;
     let report = trisort_verify::check_graph(std::slice::from_ref(&rec), &baked);
     let frames_dir = a.out_dir.join("frames");
     let t_play = Instant::now();
