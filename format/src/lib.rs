@@ -32,7 +32,7 @@ pub use geometry::{
 };
 pub use options::{
     Bridge, Choice, Choosable, DeviceBackend, DeviceLimits, Layout, Mode, OptionValue,
-    ParseOptionError, Seeding, Strategy,
+    ParseOptionError, Seeding, Shading, Strategy, ToneMap,
 };
 pub use recording::{
     DeviceInfo, Edge, FrameRecord, Phase, RecordSettings, Recording, Robust, SettingsError,

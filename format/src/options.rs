@@ -231,6 +231,30 @@ impl Mode {
 }
 
 option_enum! {
+    /// The surface model the shaders light with (`--shading`).
+    pub enum Shading: "shading" {
+        /// One view-space directional light plus ambient, plus the emissive factor, no tone
+        /// map: what trisort drew before physically based shading (the C host draws this).
+        Basic = "basic", "one light plus ambient, no tone map (what the C host draws)";
+        /// glTF metallic-roughness with normal, occlusion, emissive maps and clearcoat, lit by
+        /// the baked file's environment and sun, exposed and tone mapped.
+        #[default]
+        Pbr = "pbr", "glTF metallic-roughness lit by the baked file's environment, tone mapped";
+    }
+}
+
+option_enum! {
+    /// The tone mapping of [`Shading::Pbr`] (after exposure, before blending; `--tonemap`).
+    pub enum ToneMap: "tone map" {
+        /// Khronos PBR Neutral.
+        #[default]
+        Neutral = "neutral", "Khronos PBR Neutral";
+        /// ACES filmic (Narkowicz's fit).
+        Aces = "aces", "ACES filmic (Narkowicz's fit)";
+    }
+}
+
+option_enum! {
     /// Which GPU backend a device is opened on (`--backend`).
     pub enum DeviceBackend: "backend" {
         /// wgpu's choice (`WGPU_BACKEND` where set).

@@ -6,6 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use trisort_format::{
     AlphaMode, Environment, FrameState, Geometry, Material, TextureTransform, Vertex,
 };
+pub use trisort_format::{Shading, ToneMap};
 use wgpu::util::DeviceExt;
 
 /// Vertex buffer layout of [`Vertex`] (locations 0–6 of `VertexIn`: position, normal, uv,
@@ -65,94 +66,14 @@ pub struct LightingUniform {
     pub params: [f32; 4],
 }
 
-/// The surface model the shaders light with.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Shading {
-    /// One view-space directional light plus ambient, plus the emissive factor, no tone map:
-    /// what trisort drew before physically based shading (the C host draws this).
-    Basic,
-    /// glTF metallic-roughness with normal, occlusion, emissive maps and clearcoat, lit by the
-    /// baked file's environment and sun, exposed and tone mapped.
-    #[default]
-    Pbr,
-}
-
-impl Shading {
-    /// Every model, by name.
-    pub const ALL: [Shading; 2] = [Shading::Basic, Shading::Pbr];
-
-    /// A short name (`basic`, `pbr`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Shading::Basic => "basic",
-            Shading::Pbr => "pbr",
-        }
-    }
-
-    /// The pipeline-overridable constants that specialise a pipeline's surface function to
-    /// this model (`SHADING_MODEL` in `wgsl/common.wgsl`), so it compiles only this model's
-    /// code; for the fragment stage of pipelines whose module includes the common WGSL.
-    /// Without them the model is chosen at run time from the lighting uniform.
-    pub fn constants(self) -> &'static [(&'static str, f64)] {
-        match self {
-            Shading::Basic => &[("SHADING_MODEL", 0.0)],
-            Shading::Pbr => &[("SHADING_MODEL", 1.0)],
-        }
-    }
-}
-
-impl std::str::FromStr for Shading {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Shading, String> {
-        Shading::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown shading {s:?}: expected basic or pbr"))
-    }
-}
-
-impl std::fmt::Display for Shading {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// The tone mapping of [`Shading::Pbr`] (after exposure, before blending).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum ToneMap {
-    /// Khronos PBR Neutral.
-    #[default]
-    Neutral,
-    /// ACES filmic (Narkowicz's fit).
-    Aces,
-}
-
-impl ToneMap {
-    /// Every tone map, by name.
-    pub const ALL: [ToneMap; 2] = [ToneMap::Neutral, ToneMap::Aces];
-
-    /// A short name (`neutral`, `aces`).
-    pub fn name(self) -> &'static str {
-        match self {
-            ToneMap::Neutral => "neutral",
-            ToneMap::Aces => "aces",
-        }
-    }
-}
-
-impl std::str::FromStr for ToneMap {
-    type Err = String;
-    fn from_str(s: &str) -> Result<ToneMap, String> {
-        ToneMap::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown tone map {s:?}: expected neutral or aces"))
-    }
-}
-
-impl std::fmt::Display for ToneMap {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
+/// The pipeline-overridable constants that specialise a pipeline's surface function to
+/// `shading` (`SHADING_MODEL` in `wgsl/common.wgsl`), so it compiles only this model's code; for
+/// the fragment stage of pipelines whose module includes the common WGSL. Without them the
+/// model is chosen at run time from the lighting uniform.
+pub fn shading_constants(shading: Shading) -> &'static [(&'static str, f64)] {
+    match shading {
+        Shading::Basic => &[("SHADING_MODEL", 0.0)],
+        Shading::Pbr => &[("SHADING_MODEL", 1.0)],
     }
 }
 
@@ -1403,10 +1324,10 @@ impl ScenePipeline<'_> {
     }
 
     /// Creates the pipeline with its surface function specialised to `shading`
-    /// ([`Shading::constants`]): for pipelines that shade, so they compile what the player's
+    /// ([`shading_constants`]): for pipelines that shade, so they compile what the player's
     /// pipeline compiles.
     pub fn build_shaded(&self, device: &wgpu::Device, shading: Shading) -> wgpu::RenderPipeline {
-        self.build_with(device, shading.constants())
+        self.build_with(device, shading_constants(shading))
     }
 
     fn build_with(&self, device: &wgpu::Device, constants: &[(&str, f64)]) -> wgpu::RenderPipeline {

@@ -446,7 +446,7 @@ fn create_pipeline(
             module: &module,
             entry_point: Some(fragment_entry),
             compilation_options: wgpu::PipelineCompilationOptions {
-                constants: config.shading.constants(),
+                constants: trisort_gpu::scene_gpu::shading_constants(config.shading),
                 ..Default::default()
             },
             targets: &[Some(wgpu::ColorTargetState {

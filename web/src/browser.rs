@@ -65,9 +65,9 @@ impl WebPlayer {
     ) -> Result<WebPlayer, JsError> {
         let backend: BrowserBackend = backend.parse().map_err(|e: String| JsError::new(&e))?;
         let shading: trisort_gpu::Shading =
-            (shading.as_deref().unwrap_or("pbr").parse()).map_err(|e: String| JsError::new(&e))?;
-        let tone_map: trisort_gpu::ToneMap = (tonemap.as_deref().unwrap_or("neutral").parse())
-            .map_err(|e: String| JsError::new(&e))?;
+            (shading.as_deref().unwrap_or("pbr").parse()).map_err(js_error)?;
+        let tone_map: trisort_gpu::ToneMap =
+            (tonemap.as_deref().unwrap_or("neutral").parse()).map_err(js_error)?;
         let mode: Mode = mode.parse().map_err(js_error)?;
         let mut baked: Baked =
             trisort_player::baked_from_bytes(&bytes, Path::new(&name)).map_err(js_error)?;

@@ -458,7 +458,7 @@ fn shade_pbr(m: MaterialGpu, base: vec4<f32>, s: ShadeIn) -> vec4<f32> {
     return vec4<f32>(colour, base.a);
 }
 
-// The surface model a pipeline is specialised to (`Shading::constants`): 0 basic, 1 pbr, 2 (the
+// The surface model a pipeline is specialised to (`shading_constants`): 0 basic, 1 pbr, 2 (the
 // default) as `lighting` says at run time. A specialised pipeline compiles only its model: a
 // CPU rasterizer (llvmpipe) runs both sides of a uniform branch, so the run-time choice made
 // the basic model cost as much as PBR there.
