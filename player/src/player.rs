@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use trisort_format::{Baked, DrawIndexedIndirectArgs, FileKind, FrameWindow, Material};
-use trisort_gpu::scene_gpu::{vertex_layout, Bindings, SceneGpu, View};
+use trisort_gpu::scene_gpu::{Bindings, SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
 use crate::commands::{frame_commands, index_buffer, Order};
@@ -400,62 +400,29 @@ fn create_pipeline(
         label: Some("trisort player"),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("trisort player"),
-        bind_group_layouts: &[Some(scene_layout)],
-        immediate_size: 0,
-    });
-    let depth_stencil = config.depth_format.map(|format| {
-        let depth = config.mode == Mode::Depth;
-        wgpu::DepthStencilState {
-            format,
-            depth_write_enabled: Some(depth),
-            depth_compare: Some(if depth {
-                wgpu::CompareFunction::Less
-            } else {
-                wgpu::CompareFunction::Always
-            }),
-            stencil: Default::default(),
-            bias: Default::default(),
+    // The player's pipeline state (every reference renderer shares it through ScenePipeline):
+    // counter-clockwise fronts, no hardware culling (single-sided materials discard on
+    // `front_facing`), the mode's blend, depth only in depth mode.
+    let depth = config.depth_format.map(|format| {
+        if config.mode == Mode::Depth {
+            (format, wgpu::CompareFunction::Less, true)
+        } else {
+            (format, wgpu::CompareFunction::Always, false)
         }
     });
-    let fragment_entry = fragment_entry_point(config.mode);
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("trisort player"),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_player"),
-            compilation_options: Default::default(),
-            buffers: &[Some(vertex_layout())],
+    ScenePipeline {
+        label: "trisort player",
+        layouts: &[scene_layout],
+        module: &module,
+        vertex: "vs_player",
+        fragment: fragment_entry_point(config.mode),
+        target: wgpu::ColorTargetState {
+            format: config.color_format,
+            blend: Some(blend_state(config.mode)),
+            write_mask: wgpu::ColorWrites::ALL,
         },
-        primitive: wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            front_face: wgpu::FrontFace::Ccw,
-            // One pipeline for every material: single-sided ones discard on `front_facing`.
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil,
-        multisample: wgpu::MultisampleState {
-            count: config.sample_count,
-            mask: !0,
-            alpha_to_coverage_enabled: false,
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some(fragment_entry),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: trisort_gpu::scene_gpu::shading_constants(config.shading),
-                ..Default::default()
-            },
-            targets: &[Some(wgpu::ColorTargetState {
-                format: config.color_format,
-                blend: Some(blend_state(config.mode)),
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
+        depth,
+        samples: config.sample_count,
+    }
+    .build_shaded(device, config.shading)
 }
