@@ -7,9 +7,17 @@ use trisort_format::{Phase, RecordSettings, Recording, Robust};
 use trisort_recorder::{record, with_interleaved_readback, RecordJob};
 use trisort_scene::Scene;
 
-fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) {
+/// Records three frames spread around `scene`'s orbit with `settings`, once under `switch`
+/// (a hidden switch restoring a former path) and once as shipped, and asserts the serialised
+/// `Recording`s are byte-identical; `change` names what the switch changes, for the message.
+pub(crate) fn assert_switch_keeps_recording(
+    gpu: &trisort_gpu::Gpu,
+    scene: &Scene,
+    settings: RecordSettings,
+    switch: impl FnOnce(&dyn Fn() -> Recording) -> Recording,
+    change: &str,
+) {
     let timeline = trisort_paths::load("orbit", scene, &Default::default()).expect("orbit path");
-    // Three frames spread around the orbit.
     let step = (timeline.frames.len() / 3).max(1);
     let frames: Vec<_> = timeline
         .frames
@@ -29,7 +37,7 @@ fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) 
         known_visible: None,
     };
     let run = || record(gpu, &job, None, |_| {}).expect("recording succeeds");
-    let before: Recording = with_interleaved_readback(run);
+    let before: Recording = switch(&run);
     let after: Recording = run();
     // Not vacuous: something was seen, ordered and tied... or at least seen and ordered.
     assert!(after.frames.iter().all(|f| !f.visible.is_empty()));
@@ -37,9 +45,18 @@ fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) 
     let bytes = |r: &Recording| postcard::to_stdvec(r).expect("serialises");
     assert!(
         bytes(&before) == bytes(&after),
-        "{}: the compact readback changed the recording ({:?})",
+        "{}: {change} changed the recording ({settings:?})",
         scene.name,
-        settings.robust
+    );
+}
+
+fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) {
+    assert_switch_keeps_recording(
+        gpu,
+        scene,
+        settings,
+        |run| with_interleaved_readback(run),
+        "the compact readback",
     );
 }
 
