@@ -60,6 +60,27 @@ pub fn reference_shader() -> String {
 /// Depth peeling entry points (`vs_peel`, `fs_peel`); compose with [`peel_shader`].
 pub const PEEL: &str = include_str!("wgsl/peel.wgsl");
 
+/// The recorder's fragment capture (`vs_capture`, `fs_capture`): every fragment of every
+/// sample in one pass, pushed on per-sample lists; compose with [`capture_shader`].
+pub const CAPTURE: &str = include_str!("wgsl/capture.wgsl");
+
+/// The complete fragment-capture shader (needs `Features::PRIMITIVE_INDEX` and writable
+/// storage in fragment shaders); with `early_depth_test`, its fragment stage forces the depth
+/// test before it runs (needs `Features::SHADER_EARLY_DEPTH_TEST`).
+pub fn capture_shader(early_depth_test: bool) -> String {
+    compose(
+        &["primitive_index"],
+        &CAPTURE.replace(
+            "EARLY_DEPTH_TEST",
+            if early_depth_test {
+                "@early_depth_test(force)"
+            } else {
+                ""
+            },
+        ),
+    )
+}
+
 /// The compute pass that gathers a peel layer per sample; compose with [`gather_shader`].
 pub const GATHER: &str = include_str!("wgsl/gather.wgsl");
 

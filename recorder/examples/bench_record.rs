@@ -7,9 +7,10 @@
 //! Records every STRIDE-th frame of the path (a sample of its frames: G then comes from those
 //! frames only), and prints seconds per frame of each phase, peel passes per frame, bytes
 //! read back per frame, peak memory, and a peel pass's cost relative to a plain pass over the
-//! same triangles, measured in the same run. With `compare`, first the same with the former
-//! interleaved readback (`with_interleaved_readback`), then the current one, in one process,
-//! and checks that both recordings are identical.
+//! same triangles, measured in the same run. With `compare`, first the same by depth peeling
+//! (`with_peeling`: one pass per layer, the recorder until 2026-12-02), then as shipped (one
+//! capture pass a frame where the device can), in one process, and checks that both
+//! recordings are identical.
 
 use std::time::Instant;
 
@@ -18,7 +19,7 @@ use trisort_format::{Phase, RecordSettings};
 use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
 use trisort_recorder::{
-    bench::pass_cost, readback_counters, record, with_interleaved_readback, RecordJob,
+    bench::pass_cost, capture_counters, readback_counters, record, with_peeling, RecordJob,
 };
 
 fn peak_rss_mib() -> f64 {
@@ -45,6 +46,13 @@ fn cpu_seconds() -> f64 {
         return f64::NAN;
     }
     (f[11] + f[12]) / 100.0
+}
+
+/// Passes drawn (peel layers and capture passes) and bytes read back by this process so far.
+fn counters() -> (u64, u64) {
+    let (layers, bytes) = readback_counters();
+    let c = capture_counters();
+    (layers + c[0], bytes + c[3])
 }
 
 fn main() {
@@ -86,13 +94,13 @@ fn main() {
         glass_opacity: 0.0,
     };
     let run = || {
-        let mut last = (Instant::now(), readback_counters(), cpu_seconds());
+        let mut last = (Instant::now(), counters(), cpu_seconds());
         // Per frame of each phase: wall seconds, layers peeled (including the last, empty,
         // one), bytes read back, CPU seconds.
         let (mut p1, mut p2) = (vec![], vec![]);
         let t0 = Instant::now();
         let rec = record(&gpu, &job, None, |p| {
-            let now = (Instant::now(), readback_counters(), cpu_seconds());
+            let now = (Instant::now(), counters(), cpu_seconds());
             let d = (
                 (now.0 - last.0).as_secs_f64(),
                 (now.1 .0 - last.1 .0) as f64,
@@ -109,19 +117,12 @@ fn main() {
         .expect("record");
         let total = t0.elapsed().as_secs_f64();
         report(&rec, &p1, &p2, total, scene.geometry.triangles.len());
-        for f in [0u32, (frames.len() / 2) as u32] {
-            let c = pass_cost(&gpu, &scene.geometry, &frames, view, f, 5).expect("pass cost");
-            println!(
-                "frame {f}: peel layer {:.1} ms (render {:.1} ms + gather/readback), plain pass {:.1} ms: render ratio {:.2}x, with readback {:.2}x",
-                c.peel_ms, c.peel_render_ms, c.plain_ms, c.peel_render_ms / c.plain_ms, c.peel_ms / c.plain_ms
-            );
-        }
         rec
     };
     if compare {
-        println!("\nbefore: interleaved readback (16 bytes a sample, all fields)");
-        let before = with_interleaved_readback(run);
-        println!("\nafter: compact readback");
+        println!("\nbefore: depth peeling, one pass a layer");
+        let before = with_peeling(run);
+        println!("\nafter: one capture pass a frame");
         let after = run();
         let bytes = |r: &Recording| postcard::to_stdvec(r).expect("serialises");
         let same = bytes(&before) == bytes(&after);
@@ -131,6 +132,18 @@ fn main() {
         }
     } else {
         run();
+    }
+    println!("\npass costs (medians of 5 interleaved repeats):");
+    for f in [0u32, (frames.len() / 2) as u32] {
+        let c = pass_cost(&gpu, &scene.geometry, &frames, view, f, 5).expect("pass cost");
+        println!(
+            "frame {f}: peel layer {:.1} ms (render {:.1} ms + gather/readback), plain pass {:.1} ms: render ratio {:.2}x, with readback {:.2}x",
+            c.peel_ms, c.peel_render_ms, c.plain_ms, c.peel_render_ms / c.plain_ms, c.peel_ms / c.plain_ms
+        );
+        println!(
+            "frame {f}: capture pass {:.1} ms ({:.2}x plain), with readback and sorting {:.1} ms ({:.2}x plain)",
+            c.capture_render_ms, c.capture_render_ms / c.plain_ms, c.capture_ms, c.capture_ms / c.plain_ms
+        );
     }
     println!("peak RSS {:.0} MiB", peak_rss_mib());
 }

@@ -1,5 +1,5 @@
-//! Benchmark support: the cost of one peel pass against a plain pass over the same triangles,
-//! measured in the same run (ratios, not absolute times, are what transfer between machines).
+//! Benchmark support: the cost of one peel pass, and of the capture pass that replaces a
+//! frame's peel passes, against a plain pass over the same triangles, measured in the same run (ratios, not absolute times, are what transfer between machines).
 
 use std::time::Instant;
 
@@ -7,6 +7,7 @@ use trisort_format::{FrameState, Geometry};
 use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
 
+use crate::capture::Capture;
 use crate::peeler::Peeler;
 use crate::RecordError;
 
@@ -20,6 +21,14 @@ pub struct PassCost {
     pub peel_ms: f64,
     /// The same layer's render pass alone (no gather, no readback).
     pub peel_render_ms: f64,
+    /// The pass that replaces all of a frame's phase-1 peel passes where the device can
+    /// (`capture.wgsl`: the depth prepass of the always-opaque triangles, then every fragment
+    /// in front of them at every sample onto per-sample lists), over the same triangles,
+    /// without reading the lists back.
+    pub capture_render_ms: f64,
+    /// The same capture with reading back the lists and sorting every sample's fragments into
+    /// peel order (what phase 1 then walks).
+    pub capture_ms: f64,
     /// A plain pass: the same triangles, same vertex stage, depth test `Less`, one colour
     /// written per pixel (no per-sample shading, no discard test), same MSAA count.
     pub plain_ms: f64,
@@ -36,10 +45,13 @@ pub fn pass_cost(
 ) -> Result<PassCost, RecordError> {
     let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
     let peeler = Peeler::new(gpu, geometry, &all, frames, view)?.with_readback(true, false);
+    let mut capture = Capture::new(gpu, geometry, &all, frames, view, true)?;
     let (mut peel, mut render, mut plain) = (vec![], vec![], vec![]);
-    // Warm up pipelines.
+    let (mut captured, mut capture_render) = (vec![], vec![]);
+    // Warm up pipelines (and grow the capture's pool to the frame).
     peeler.time_render(frame, 1, false)?;
     peeler.time_render(frame, 1, true)?;
+    capture.frame(frame, |_| Ok(()))?;
     for _ in 0..repeats.max(1) {
         let t = Instant::now();
         let (before, _) = crate::readback_counters();
@@ -51,6 +63,16 @@ pub fn pass_cost(
         peel.push(t.elapsed().as_secs_f64() * 1000.0 / layers as f64);
         render.push(peeler.time_render(frame, 1, false)?);
         plain.push(peeler.time_render(frame, 1, true)?);
+        capture_render.push(capture.time_draw(frame)?);
+        let t = Instant::now();
+        let mut list = Vec::new();
+        capture.frame(frame, |band| {
+            for slot in 0..band.slots() {
+                band.sorted(slot, &mut list);
+            }
+            Ok(())
+        })?;
+        captured.push(t.elapsed().as_secs_f64() * 1000.0);
     }
     let median = |v: &mut Vec<f64>| {
         v.sort_by(|a, b| a.total_cmp(b));
@@ -60,5 +82,7 @@ pub fn pass_cost(
         peel_ms: median(&mut peel),
         peel_render_ms: median(&mut render),
         plain_ms: median(&mut plain),
+        capture_render_ms: median(&mut capture_render),
+        capture_ms: median(&mut captured),
     })
 }

@@ -8,13 +8,19 @@
 //! give an edge front → back weighted by the samples showing it (E_f); equal-depth neighbours
 //! are also listed as ties.
 //!
-//! Each layer is one render pass: triangles in ascending id order, depth test `Less`, the
-//! depth written explicitly, and fragments whose (depth, id) key is not greater than the
-//! previous layer's at that sample discarded (see `gpu/src/wgsl/peel.wgsl`). Samples that
-//! are finished are masked so later layers do no work there.
+//! The layers of a sample are its fragments in (depth, id) order. Where the device has writable
+//! storage in fragment shaders (every Vulkan device), one render pass captures every fragment
+//! of the frame on per-sample lists and the host sorts each list (`capture.rs`,
+//! `gpu/src/wgsl/capture.wgsl`). Elsewhere, and for the grown peel of conservative recording,
+//! each layer is one depth-peeling render pass: triangles in ascending id order, depth test
+//! `Less`, the depth written explicitly, and fragments whose (depth, id) key is not greater
+//! than the previous layer's at that sample discarded (see `gpu/src/wgsl/peel.wgsl`); samples
+//! that are finished are masked so later layers do no work there. Both give the same layers,
+//! so the same recordings (test `capture_matches_peeling`).
 #![deny(missing_docs)]
 
 pub mod bench;
+mod capture;
 mod conservative;
 #[cfg(test)]
 mod coverage_test;
@@ -32,6 +38,8 @@ use trisort_format::{
 use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
 
+#[doc(hidden)]
+pub use capture::{capture_counters, with_pool_limits};
 pub use conservative::Conservative;
 use partial::{Graph, Visibility};
 #[doc(hidden)]
@@ -119,53 +127,143 @@ fn view_of(s: &RecordSettings) -> View {
     }
 }
 
+thread_local! {
+    /// See [`with_peeling`].
+    static PEELING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f` with recordings made inside it by depth peeling, one pass per layer, even where the
+/// device can capture every fragment in one pass. Kept so that tests and the benchmark can show
+/// that both give the same recordings, and what capturing saves.
+#[doc(hidden)]
+pub fn with_peeling<R>(f: impl FnOnce() -> R) -> R {
+    let before = PEELING.with(|c| c.replace(true));
+    let r = f();
+    PEELING.with(|c| c.set(before));
+    r
+}
+
+/// Where a phase's layers come from: one capture pass a frame, or one peel pass a layer.
+enum Layers<'g> {
+    Capture(std::cell::RefCell<capture::Capture<'g>>),
+    Peel(Peeler<'g>),
+}
+
+impl<'g> Layers<'g> {
+    /// Capture where the device can (and [`with_peeling`] does not say otherwise), else a
+    /// peeler reading back `alpha` and `depth` as asked. Reading alpha means phase 1: its
+    /// capture leaves out what lies behind the nearest opaque fragment.
+    fn new(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        triangles: &[u32],
+        frames: &[FrameState],
+        view: View,
+        (alpha, depth): (bool, bool),
+    ) -> Result<Self, RecordError> {
+        if capture::supported(gpu) && !PEELING.with(|c| c.get()) && !peeler::interleaved() {
+            let c = capture::Capture::new(gpu, geometry, triangles, frames, view, alpha)?;
+            Ok(Layers::Capture(std::cell::RefCell::new(c)))
+        } else {
+            Ok(Layers::Peel(
+                Peeler::new(gpu, geometry, triangles, frames, view)?.with_readback(alpha, depth),
+            ))
+        }
+    }
+
+    fn set_frame_subpixel_offset(&self, frame: u32, offset: [f64; 2]) {
+        match self {
+            Layers::Capture(c) => c.borrow().set_frame_subpixel_offset(frame, offset),
+            Layers::Peel(p) => p.set_frame_subpixel_offset(frame, offset),
+        }
+    }
+
+    fn triangles(&self) -> usize {
+        match self {
+            Layers::Capture(c) => c.borrow().triangles(),
+            Layers::Peel(p) => p.triangles(),
+        }
+    }
+}
+
 /// Phase 1 of one frame: the visible set, layers used, and whether `max_layers` truncated it.
 /// With robust settings, the union over the sample patterns of [`Robust::offsets`] (layers
 /// add up) and the conservative pass's triangles.
 fn visibility_frame(
-    peeler: &Peeler,
+    source: &Layers,
     conservative: Option<&Conservative>,
     frame: u32,
     s: &RecordSettings,
 ) -> Result<Visibility, RecordError> {
-    let slots = peeler.slots();
     let mut visible = vec![];
     // Per drawn triangle (phase 1 draws every scene triangle, in id order): reached before
     // saturation. One flag a triangle instead of one entry a sample and layer to sort.
     let interleaved = peeler::interleaved();
-    let mut reached = vec![false; if interleaved { 0 } else { peeler.triangles() }];
+    let mut reached = vec![false; if interleaved { 0 } else { source.triangles() }];
     let residual = 1.0 - s.saturation;
     let (mut layers, mut truncated) = (0, false);
     let offsets = s.robust.offsets();
     for &offset in &offsets {
         if offsets.len() > 1 {
-            peeler.set_frame_subpixel_offset(frame, offset);
+            source.set_frame_subpixel_offset(frame, offset);
         }
-        let mut transmittance = vec![1.0f32; slots];
-        let (l, t) = peeler.peel(frame, s.max_layers, |_, layer, done| {
-            for i in 0..slots {
-                let id = layer.ids[i];
-                if id == 0 || done[i] != 0 {
-                    continue;
-                }
-                // Reached before saturation: visible (its own opacity does not matter).
-                if interleaved {
-                    visible.push(id - 1);
-                } else {
-                    reached[(id - 1) as usize] = true;
-                }
-                transmittance[i] *= 1.0 - layer.alpha[i];
-                if transmittance[i] <= residual {
-                    done[i] = 1;
-                }
+        let (l, t) = match source {
+            Layers::Capture(c) => {
+                // Each sample's fragments in peel order, walked as the peel's layers would be:
+                // until the sample saturates or `max_layers` fragments were taken.
+                let (mut most, mut left) = (0u32, false);
+                let mut list = Vec::new();
+                c.borrow_mut().frame(frame, |band| {
+                    for slot in 0..band.slots() {
+                        band.sorted(slot, &mut list);
+                        let (mut transmittance, mut taken) = (1.0f32, 0u32);
+                        for f in &list {
+                            if taken == s.max_layers {
+                                left = true;
+                                break;
+                            }
+                            reached[(f.id - 1) as usize] = true;
+                            taken += 1;
+                            transmittance *= 1.0 - f.alpha;
+                            if transmittance <= residual {
+                                break;
+                            }
+                        }
+                        most = most.max(taken);
+                    }
+                    Ok(())
+                })?;
+                (most, left)
             }
-            Ok(true)
-        })?;
+            Layers::Peel(peeler) => {
+                let slots = peeler.slots();
+                let mut transmittance = vec![1.0f32; slots];
+                peeler.peel(frame, s.max_layers, |_, layer, done| {
+                    for i in 0..slots {
+                        let id = layer.ids[i];
+                        if id == 0 || done[i] != 0 {
+                            continue;
+                        }
+                        // Reached before saturation: visible (its own opacity does not matter).
+                        if interleaved {
+                            visible.push(id - 1);
+                        } else {
+                            reached[(id - 1) as usize] = true;
+                        }
+                        transmittance[i] *= 1.0 - layer.alpha[i];
+                        if transmittance[i] <= residual {
+                            done[i] = 1;
+                        }
+                    }
+                    Ok(true)
+                })?
+            }
+        };
         layers += l;
         truncated |= t;
     }
     if offsets.len() > 1 {
-        peeler.set_frame_subpixel_offset(frame, [0.0, 0.0]);
+        source.set_frame_subpixel_offset(frame, [0.0, 0.0]);
     }
     visible.extend(
         reached
@@ -182,66 +280,108 @@ fn visibility_frame(
     Ok((visible, layers, truncated))
 }
 
+/// A frame's graph as it is gathered: per drawn triangle whether it was covered, and the
+/// edges and ties by scene ids with their weights.
+struct GraphParts<'a> {
+    /// Scene ids of the drawn list.
+    g: &'a [u32],
+    covered: Vec<bool>,
+    edges: HashMap<(u32, u32), u32>,
+    ties: HashMap<(u32, u32), u32>,
+}
+
+impl GraphParts<'_> {
+    /// Fragment `id` (+ 1) follows fragment `prev` (+ 1) at a sample, at depths `depth` and
+    /// `prev_depth`; `grown` edges go to `grown_edges` and carry no ties.
+    fn pair(
+        &mut self,
+        prev: u32,
+        id: u32,
+        depths: (f32, f32),
+        grown: Option<&mut HashMap<(u32, u32), u32>>,
+    ) {
+        let key = (self.g[(prev - 1) as usize], self.g[(id - 1) as usize]);
+        match grown {
+            // Depths extended past a triangle's edges: order, never ties.
+            Some(grown) => *grown.entry(key).or_default() += 1,
+            None => {
+                *self.edges.entry(key).or_default() += 1;
+                if depths.0 == depths.1 {
+                    *self.ties.entry(key).or_default() += 1;
+                }
+            }
+        }
+    }
+}
+
 /// Phase 2 of one frame over G (`g` = scene ids of the drawn list): covered set, edges, ties.
 /// With robust settings, the union over the sample patterns of [`Robust::offsets`] and, for
 /// conservative recording, the grown peel (`grown`, [`Peeler::grown`]): edge weights add up.
 fn graph_frame(
-    peeler: &Peeler,
+    source: &Layers,
     grown: Option<&Peeler>,
     frame: u32,
     g: &[u32],
     s: &RecordSettings,
 ) -> Result<Graph, RecordError> {
-    let slots = peeler.slots();
-    let mut covered = vec![false; g.len()];
-    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
-    let mut ties: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut parts = GraphParts {
+        g,
+        covered: vec![false; g.len()],
+        edges: HashMap::new(),
+        ties: HashMap::new(),
+    };
     let (mut layers, mut truncated) = (0, false);
     // Robust settings: the union over the sample patterns (edge weights add up).
     let offsets = s.robust.offsets();
     // The grown peel's edges, kept apart: they may only add order, never a cycle.
     let mut grown_edges: HashMap<(u32, u32), u32> = HashMap::new();
-    let passes = offsets
-        .iter()
-        .map(|&o| (peeler, o, offsets.len() > 1, false))
-        .chain(grown.map(|p| (p, [0.0, 0.0], false, true)));
-    for (peeler, offset, shift, is_grown) in passes {
-        if shift {
-            peeler.set_frame_subpixel_offset(frame, offset);
+    let max = s.max_layers as usize;
+    for &offset in &offsets {
+        if offsets.len() > 1 {
+            source.set_frame_subpixel_offset(frame, offset);
         }
-        let mut last_id = vec![0u32; slots];
-        let mut last_depth = vec![0f32; slots];
-        let (l, t) = peeler.peel(frame, s.max_layers, |_, layer, _| {
-            for i in 0..slots {
-                let id = layer.ids[i];
-                if id == 0 {
-                    continue;
-                }
-                covered[(id - 1) as usize] = true;
-                let prev = last_id[i];
-                if prev != 0 {
-                    let key = (g[(prev - 1) as usize], g[(id - 1) as usize]);
-                    if is_grown {
-                        // Depths extended past a triangle's edges: order, never ties.
-                        *grown_edges.entry(key).or_default() += 1;
-                    } else {
-                        *edges.entry(key).or_default() += 1;
-                        if layer.depth[i] == last_depth[i] {
-                            *ties.entry(key).or_default() += 1;
+        let (l, t) = match source {
+            Layers::Capture(c) => {
+                // Every sample's fragments in peel order, the first `max_layers` of them.
+                let (mut most, mut left) = (0usize, false);
+                let mut list = Vec::new();
+                c.borrow_mut().frame(frame, |band| {
+                    for slot in 0..band.slots() {
+                        band.sorted(slot, &mut list);
+                        left |= list.len() > max;
+                        let taken = &list[..list.len().min(max)];
+                        most = most.max(taken.len());
+                        for (k, f) in taken.iter().enumerate() {
+                            parts.covered[(f.id - 1) as usize] = true;
+                            if k > 0 {
+                                let p = &taken[k - 1];
+                                parts.pair(p.id, f.id, (p.depth, f.depth), None);
+                            }
                         }
                     }
-                }
-                last_id[i] = id;
-                last_depth[i] = layer.depth[i];
+                    Ok(())
+                })?;
+                (most as u32, left)
             }
-            Ok(true)
-        })?;
+            Layers::Peel(peeler) => peel_graph(peeler, frame, s, &mut parts, None)?,
+        };
         layers += l;
         truncated |= t;
     }
     if offsets.len() > 1 {
-        peeler.set_frame_subpixel_offset(frame, [0.0, 0.0]);
+        source.set_frame_subpixel_offset(frame, [0.0, 0.0]);
     }
+    if let Some(p) = grown {
+        let (l, t) = peel_graph(p, frame, s, &mut parts, Some(&mut grown_edges))?;
+        layers += l;
+        truncated |= t;
+    }
+    let GraphParts {
+        covered,
+        mut edges,
+        ties,
+        ..
+    } = parts;
     merge_grown_edges(&mut edges, grown_edges);
     let covered: Vec<u32> = covered
         .iter()
@@ -258,6 +398,41 @@ fn graph_frame(
         v
     };
     Ok((covered, to_edges(edges), to_edges(ties), layers, truncated))
+}
+
+/// Peels frame `frame` completely with `peeler` into `parts` (into `grown` for the grown
+/// peel's edges); returns layers peeled and whether `max_layers` truncated the peel.
+fn peel_graph(
+    peeler: &Peeler,
+    frame: u32,
+    s: &RecordSettings,
+    parts: &mut GraphParts,
+    mut grown: Option<&mut HashMap<(u32, u32), u32>>,
+) -> Result<(u32, bool), RecordError> {
+    let slots = peeler.slots();
+    let mut last_id = vec![0u32; slots];
+    let mut last_depth = vec![0f32; slots];
+    peeler.peel(frame, s.max_layers, |_, layer, _| {
+        for i in 0..slots {
+            let id = layer.ids[i];
+            if id == 0 {
+                continue;
+            }
+            parts.covered[(id - 1) as usize] = true;
+            let prev = last_id[i];
+            if prev != 0 {
+                parts.pair(
+                    prev,
+                    id,
+                    (last_depth[i], layer.depth[i]),
+                    grown.as_deref_mut(),
+                );
+            }
+            last_id[i] = id;
+            last_depth[i] = layer.depth[i];
+        }
+        Ok(true)
+    })
 }
 
 /// Adds the grown peel's edges to the patterns' `edges` (weights add up), except those that
@@ -327,8 +502,7 @@ pub fn record(
         let mut done = total - todo.len() as u32;
         if !todo.is_empty() {
             // Phase 1 needs ids and alpha, not depth.
-            let peeler = Peeler::new(gpu, job.geometry, &all_ids, job.frames, view)?
-                .with_readback(true, false);
+            let source = Layers::new(gpu, job.geometry, &all_ids, job.frames, view, (true, false))?;
             let conservative = if s.robust.conservative {
                 Some(Conservative::new(
                     gpu,
@@ -341,7 +515,7 @@ pub fn record(
                 None
             };
             for f in todo {
-                let v = visibility_frame(&peeler, conservative.as_ref(), f, &s)?;
+                let v = visibility_frame(&source, conservative.as_ref(), f, &s)?;
                 if let Some(p) = partial {
                     p.store_visibility(f, &v)?;
                 }
@@ -400,10 +574,14 @@ pub fn record(
                 None => {
                     if peeler.is_none() {
                         // Phase 2 needs ids and depth (ties), not alpha.
-                        peeler = Some(
-                            Peeler::new(gpu, job.geometry, &g, job.frames, view)?
-                                .with_readback(false, true),
-                        );
+                        peeler = Some(Layers::new(
+                            gpu,
+                            job.geometry,
+                            &g,
+                            job.frames,
+                            view,
+                            (false, true),
+                        )?);
                     }
                     if s.robust.conservative && grown.is_none() {
                         grown = Some(

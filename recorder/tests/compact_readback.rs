@@ -4,7 +4,7 @@
 //! and a real scene, plain, robust and conservative, at 4× and 1× MSAA.
 
 use trisort_format::{Phase, RecordSettings, Recording, Robust};
-use trisort_recorder::{record, with_interleaved_readback, RecordJob};
+use trisort_recorder::{record, with_interleaved_readback, with_peeling, RecordJob};
 use trisort_scene::Scene;
 
 /// Records three frames spread around `scene`'s orbit with `settings`, once under `switch`
@@ -50,14 +50,18 @@ pub(crate) fn assert_switch_keeps_recording(
     );
 }
 
+/// Both readbacks of the peeler: the recorder peels inside [`with_peeling`] (it captures
+/// where it can, which `capture` compares with peeling).
 fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) {
-    assert_switch_keeps_recording(
-        gpu,
-        scene,
-        settings,
-        |run| with_interleaved_readback(run),
-        "the compact readback",
-    );
+    with_peeling(|| {
+        assert_switch_keeps_recording(
+            gpu,
+            scene,
+            settings,
+            |run| with_interleaved_readback(run),
+            "the compact readback",
+        )
+    });
 }
 
 /// Plain, robust and conservative at 4×, and plain at 1×, at 64×64.

@@ -1,0 +1,95 @@
+// The recorder's fragment capture: one render pass keeps every fragment of every drawn
+// triangle at every sample, where depth peeling needs one pass per layer. Each layer of a peel
+// is, per sample, the next fragment in (depth, id) order, so the whole peel of a sample is its
+// captured fragments sorted by (depth, id): the host sorts each sample's list and walks it as
+// the peel would (phase 1 until saturation, phase 2 completely).
+//
+// Drawn like a peel pass: the same vertex transform (@invariant position), the same MSAA
+// pattern, shaded once per covered sample (`sample_index`), the same facing, MASK and alpha
+// rules (`surface_base` at the pixel centre), and the same id (`base_id + primitive_index`).
+// A peel keeps only fragments that pass its depth test `Less` against the cleared 1.0, so
+// fragments at depth 1 are left out here too. Phase 2 runs no depth test: every fragment is
+// kept. Phase 1 (visibility until saturation) may first draw the triangles that are opaque
+// wherever they are drawn into the depth buffer and then capture with `LessEqual` against it,
+// the test forced before the shader (EARLY_DEPTH_TEST): a sample's walk stops at its first
+// opaque fragment, and every fragment before it in (depth, id) order passes.
+//
+// Each kept fragment takes a node from the pool with an atomic counter and pushes it on its
+// sample's list (`atomicExchange` on the head). The counter counts every attempt, also past
+// the pool's end, so the host knows how large a pool the pass needed and draws again.
+
+struct Capture {
+    // Id of the first triangle of this draw (primitive_index restarts per draw).
+    base_id: u32,
+    // Image width and sample count.
+    width: u32,
+    samples: u32,
+    // Nodes in the pool.
+    capacity: u32,
+}
+
+// One fragment: depth bits, id + 1, opacity bits (clamped to [0, 1], as a peel layer stores
+// it), and the next node's index + 1 (0 ends the list).
+struct Node {
+    depth: u32,
+    id: u32,
+    alpha: u32,
+    next: u32,
+}
+
+@group(1) @binding(0) var<uniform> capture: Capture;
+// Per sample (pixel (x, y) sample s is (y * width + x) * samples + s): first node index + 1.
+@group(1) @binding(1) var<storage, read_write> heads: array<atomic<u32>>;
+// Fragments that asked for a node (may exceed the capacity).
+@group(1) @binding(2) var<storage, read_write> counter: array<atomic<u32>, 4>;
+@group(1) @binding(3) var<storage, read_write> nodes: array<Node>;
+
+struct CaptureVarying {
+    @invariant @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(flat) material: u32,
+    // Alpha from textures is evaluated at the pixel centre, as the peel and the player do.
+    @location(1) @interpolate(perspective, center) uv: vec2<f32>,
+    @location(2) @interpolate(perspective, center) uv1: vec2<f32>,
+}
+
+@vertex
+fn vs_capture(v: VertexIn) -> CaptureVarying {
+    var out: CaptureVarying;
+    out.position = transform_position(v.position, v.node);
+    out.material = v.material;
+    out.uv = v.uv;
+    out.uv1 = v.uv1;
+    return out;
+}
+
+EARLY_DEPTH_TEST
+@fragment
+fn fs_capture(
+    in: CaptureVarying,
+    @builtin(front_facing) front_facing: bool,
+    @builtin(sample_index) sample: u32,
+    @builtin(primitive_index) primitive: u32,
+) {
+    let m = material_at(in.material);
+    if (culled_of(m, front_facing)) {
+        return;
+    }
+    let base = surface_base_of(m, in.uv, in.uv1);
+    let z = in.position.z;
+    if (base.a < 0.0 || !(z < 1.0)) {
+        return;
+    }
+    let n = atomicAdd(&counter[0], 1u);
+    if (n >= capture.capacity) {
+        return;
+    }
+    let coord = vec2<u32>(in.position.xy);
+    let slot = (coord.y * capture.width + coord.x) * capture.samples + sample;
+    let next = atomicExchange(&heads[slot], n + 1u);
+    nodes[n] = Node(
+        bitcast<u32>(z),
+        capture.base_id + primitive + 1u,
+        bitcast<u32>(clamp(base.a, 0.0, 1.0)),
+        next,
+    );
+}

@@ -1,0 +1,659 @@
+//! Fragment capture: every fragment of a frame in one render pass (`gpu/src/wgsl/capture.wgsl`)
+//! instead of one depth-peeling pass per layer.
+//!
+//! A peel layer is, per sample, the next fragment in (depth, id) order among the fragments
+//! that pass the peel's facing, MASK and depth-1 rules; fragment keys are unique (a triangle
+//! covers a sample once), so the layers of a sample are exactly its captured fragments sorted
+//! by (depth, id). [`Capture::frame`] hands each sample's sorted list to the caller, which walks
+//! it as the peel's layer callbacks would: the recording is the same, byte for byte (tests
+//! `capture_matches_peeling`), and a frame costs one pass over its triangles instead of one per
+//! layer plus the last, empty, one.
+//!
+//! The node pool starts at a fragment a sample and grows to what a pass asked for (the
+//! counter counts every attempt); a frame whose fragments exceed one storage-buffer binding is
+//! captured in bands of rows (a scissor per band), each band drawing every triangle again.
+
+use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+
+use trisort_format::{AlphaMode, FrameState, Geometry};
+use trisort_gpu::scene_gpu::{vertex_layout, SceneGpu, View};
+use trisort_gpu::Gpu;
+use wgpu::util::DeviceExt;
+
+use crate::RecordError;
+
+/// One captured fragment: depth, id + 1 (a position in the drawn list, plus 1), opacity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Fragment {
+    pub depth: f32,
+    pub id: u32,
+    pub alpha: f32,
+}
+
+/// Bytes of one pool node (depth, id, alpha, next).
+const NODE_BYTES: u64 = 16;
+/// Most triangles drawn by one draw call (as the peeler: ids restart per draw).
+const CHUNK_TRIANGLES: u32 = 1 << 22;
+
+/// Whether the device can capture: writable storage in fragment shaders and primitive ids.
+pub(crate) fn supported(gpu: &Gpu) -> bool {
+    gpu.device
+        .features()
+        .contains(wgpu::Features::PRIMITIVE_INDEX)
+        && gpu
+            .adapter
+            .get_downlevel_capabilities()
+            .flags
+            .contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE)
+}
+
+/// The capture pipeline for one scene at one view.
+pub(crate) struct Capture<'g> {
+    gpu: &'g Gpu,
+    scene: SceneGpu,
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    index: wgpu::Buffer,
+    triangles: u32,
+    depth: wgpu::TextureView,
+    params: wgpu::Buffer,
+    params_stride: u64,
+    heads: wgpu::Buffer,
+    counter: wgpu::Buffer,
+    counter_staging: wgpu::Buffer,
+    /// The pool (grown on demand), its bind group and its readback buffer.
+    pool: Option<Pool>,
+    /// Phase 1's depth pass of the always-opaque triangles, drawn before the capture.
+    prepass: Option<Prepass>,
+    view: View,
+}
+
+/// The triangles among those drawn whose every fragment is opaque (alpha mode OPAQUE, not glass
+/// unless glass is recorded opaque), by facing rule, and the depth-only pipelines that draw them.
+struct Prepass {
+    /// Single-sided (back faces culled, as the peel discards them) and double-sided.
+    pipelines: [wgpu::RenderPipeline; 2],
+    indices: [(wgpu::Buffer, u32); 2],
+}
+
+struct Pool {
+    capacity: u64,
+    nodes: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+impl<'g> Capture<'g> {
+    /// Sets up capturing `triangles` (ascending indices into `geometry.triangles`; a
+    /// fragment's id is its position in this list, as the peeler's). With `until_opaque`
+    /// (phase 1, whose walk stops at a sample's first opaque fragment), fragments behind the
+    /// nearest always-opaque one are not captured, where the device can force the depth test
+    /// before the fragment shader.
+    pub fn new(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        triangles: &[u32],
+        frames: &[FrameState],
+        view: View,
+        until_opaque: bool,
+    ) -> Result<Self, RecordError> {
+        let device = &gpu.device;
+        let scene = crate::peeler::visibility_scene(gpu, geometry, frames, view);
+        let until_opaque = until_opaque
+            && device
+                .features()
+                .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("capture"),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::capture_shader(until_opaque).into()),
+        });
+        let storage = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("capture"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(16),
+                    },
+                    count: None,
+                },
+                storage(1),
+                storage(2),
+                storage(3),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("capture"),
+            bind_group_layouts: &[Some(&scene.layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        // No colour target. Without the prepass no depth test either: every fragment is kept
+        // (the depth attachment only gives the pass its sample count); with it, `LessEqual`
+        // against the nearest always-opaque fragment, not written.
+        let build = |label, layout: &wgpu::PipelineLayout, cull_mode, depth, fragment: bool| {
+            let (write, compare) = depth;
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_capture"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(vertex_layout())],
+                },
+                primitive: wgpu::PrimitiveState {
+                    front_face: wgpu::FrontFace::Ccw,
+                    cull_mode,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: wgpu::TextureFormat::Depth32Float,
+                    depth_write_enabled: Some(write),
+                    depth_compare: Some(compare),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState {
+                    count: view.samples,
+                    ..Default::default()
+                },
+                fragment: fragment.then(|| wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_capture"),
+                    compilation_options: Default::default(),
+                    targets: &[],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let compare = if until_opaque {
+            wgpu::CompareFunction::LessEqual
+        } else {
+            wgpu::CompareFunction::Always
+        };
+        let pipeline = build("capture", &pipeline_layout, None, (false, compare), true);
+        let prepass = until_opaque.then(|| {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("capture prepass"),
+                bind_group_layouts: &[Some(&scene.layout)],
+                immediate_size: 0,
+            });
+            let depth = (true, wgpu::CompareFunction::Less);
+            let pipelines = [
+                build(
+                    "capture prepass",
+                    &layout,
+                    Some(wgpu::Face::Back),
+                    depth,
+                    false,
+                ),
+                build("capture prepass", &layout, None, depth, false),
+            ];
+            let indices = opaque_indices(geometry, triangles, view.glass_opacity)
+                .map(|list| (index_buffer(device, &list), (list.len() / 3) as u32));
+            Prepass { pipelines, indices }
+        });
+        let depth = trisort_gpu::pipeline::texture_2d(
+            device,
+            "capture depth",
+            (view.width, view.height),
+            view.samples,
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
+
+        let mut index_data: Vec<u32> = Vec::with_capacity(triangles.len() * 3);
+        for &t in triangles {
+            index_data.extend_from_slice(&geometry.triangles[t as usize]);
+        }
+        let index = index_buffer(device, &index_data);
+        let chunks = (triangles.len() as u32).div_ceil(CHUNK_TRIANGLES).max(1) as u64;
+        let params_stride = device.limits().min_uniform_buffer_offset_alignment.max(16) as u64;
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("capture params"),
+            size: chunks * params_stride,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let slots = view.width as u64 * view.height as u64 * view.samples as u64;
+        let largest = binding_limit(device);
+        if slots * 4 > largest {
+            return Err(RecordError::Unsupported(format!(
+                "{}x{} at {}x needs {} bytes of list heads; the device binds at most {largest}",
+                view.width,
+                view.height,
+                view.samples,
+                slots * 4
+            )));
+        }
+        let buffer = |label, size, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let heads = buffer(
+            "capture heads",
+            slots * 4,
+            wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        );
+        let counter = buffer(
+            "capture counter",
+            16,
+            wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        );
+        let counter_staging = buffer(
+            "capture counter readback",
+            16,
+            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        );
+        let mut capture = Capture {
+            gpu,
+            scene,
+            pipeline,
+            layout,
+            index,
+            triangles: triangles.len() as u32,
+            depth,
+            params,
+            params_stride,
+            heads,
+            counter,
+            counter_staging,
+            pool: None,
+            prepass,
+            view,
+        };
+        // A fragment a sample to begin with (a frame's pass that asks for more is drawn again
+        // with room for what it asked plus an eighth, kept for later frames).
+        let first = POOL_LIMITS
+            .with(|c| c.get())
+            .map_or(slots, |(first, _)| first);
+        capture.grow(first.min(pool_limit(device)));
+        Ok(capture)
+    }
+
+    /// [`crate::Peeler::set_frame_subpixel_offset`] for the capture's scene.
+    pub fn set_frame_subpixel_offset(&self, frame: u32, offset: [f64; 2]) {
+        self.scene
+            .set_subpixel_offset_of(&self.gpu.queue, offset, frame..frame + 1);
+    }
+
+    /// Number of triangles drawn (ids are positions in this list, plus 1).
+    pub fn triangles(&self) -> usize {
+        self.triangles as usize
+    }
+
+    /// Replaces the pool with one of `capacity` nodes.
+    fn grow(&mut self, capacity: u64) {
+        let device = &self.gpu.device;
+        let capacity = capacity.max(1);
+        let nodes = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("capture nodes"),
+            size: capacity * NODE_BYTES,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("capture readback"),
+            size: capacity * NODE_BYTES + self.heads.size(),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("capture"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.params,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(16),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: self.heads.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.counter.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: nodes.as_entire_binding(),
+                },
+            ],
+        });
+        let chunks = self.chunks();
+        for (c, r) in chunks.iter().enumerate() {
+            let p = [
+                r.start,
+                self.view.width,
+                self.view.samples,
+                capacity.min(u32::MAX as u64) as u32,
+            ];
+            self.gpu.queue.write_buffer(
+                &self.params,
+                c as u64 * self.params_stride,
+                bytemuck::cast_slice(&p),
+            );
+        }
+        self.pool = Some(Pool {
+            capacity,
+            nodes,
+            staging,
+            bind_group,
+        });
+    }
+
+    fn chunks(&self) -> Vec<Range<u32>> {
+        (0..self.triangles.div_ceil(CHUNK_TRIANGLES).max(1))
+            .map(|c| c * CHUNK_TRIANGLES..((c + 1) * CHUNK_TRIANGLES).min(self.triangles))
+            .collect()
+    }
+
+    /// Captures frame `frame` and calls `on_rows` with each band of rows captured, a [`Band`]
+    /// to read its samples' sorted fragment lists from. Bands cover the image once, top to
+    /// bottom; usually one band is the whole image.
+    pub fn frame(
+        &mut self,
+        frame: u32,
+        mut on_rows: impl FnMut(&Band) -> Result<(), RecordError>,
+    ) -> Result<CaptureStats, RecordError> {
+        let mut stats = CaptureStats::default();
+        // Bands still to capture (a stack: the next is last), starting with the whole image.
+        let mut todo: Vec<Range<u32>> = Vec::new();
+        todo.push(0..self.view.height);
+        while let Some(rows) = todo.pop() {
+            let asked = self.draw(frame, rows.clone())?;
+            stats.passes += 1;
+            COUNTERS[0].fetch_add(1, Relaxed);
+            let limit = pool_limit(&self.gpu.device);
+            let capacity = self.pool.as_ref().map_or(0, |p| p.capacity);
+            if asked > capacity {
+                if asked <= limit.min(u32::MAX as u64 - 1) {
+                    // Room for this many and an eighth more, so a next frame rarely redraws.
+                    self.grow((asked + asked / 8).min(limit));
+                    COUNTERS[1].fetch_add(1, Relaxed);
+                    todo.push(rows);
+                } else if rows.len() > 1 {
+                    // More fragments than one binding holds: halve the band (bottom half
+                    // pushed first, so bands are handed out top to bottom).
+                    let mid = rows.start + rows.len() as u32 / 2;
+                    COUNTERS[2].fetch_add(1, Relaxed);
+                    todo.push(mid..rows.end);
+                    todo.push(rows.start..mid);
+                } else {
+                    return Err(RecordError::Unsupported(format!(
+                        "one row of {} pixels at {}x holds {asked} fragments; the device binds \
+                         at most {limit} ({} bytes)",
+                        self.view.width,
+                        self.view.samples,
+                        limit * NODE_BYTES
+                    )));
+                }
+                continue;
+            }
+            stats.fragments += asked;
+            let band = self.read(rows, asked)?;
+            stats.bytes += band.bytes;
+            COUNTERS[3].fetch_add(band.bytes, Relaxed);
+            on_rows(&band)?;
+        }
+        Ok(stats)
+    }
+
+    /// Benchmarks: wall milliseconds of one capture pass over the whole image (submitted and
+    /// waited for, the counter read back; the lists are not).
+    pub fn time_draw(&self, frame: u32) -> Result<f64, RecordError> {
+        let t = std::time::Instant::now();
+        self.draw(frame, 0..self.view.height)?;
+        Ok(t.elapsed().as_secs_f64() * 1000.0)
+    }
+
+    /// Draws every triangle into the lists of `rows` (a scissor) and returns how many
+    /// fragments asked for a node.
+    fn draw(&self, frame: u32, rows: Range<u32>) -> Result<u64, RecordError> {
+        let gpu = self.gpu;
+        let pool = self.pool.as_ref().expect("a pool exists");
+        let mut enc = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("capture"),
+            });
+        enc.clear_buffer(&self.heads, 0, None);
+        enc.clear_buffer(&self.counter, 0, None);
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("capture"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+            pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+            pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
+            pass.set_scissor_rect(0, rows.start, self.view.width, rows.len() as u32);
+            if let Some(pre) = &self.prepass {
+                for (pipeline, (index, count)) in pre.pipelines.iter().zip(&pre.indices) {
+                    if *count > 0 {
+                        pass.set_pipeline(pipeline);
+                        pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
+                        pass.draw_indexed(0..count * 3, 0, 0..1);
+                    }
+                }
+            }
+            pass.set_pipeline(&self.pipeline);
+            pass.set_index_buffer(self.index.slice(..), wgpu::IndexFormat::Uint32);
+            for (c, r) in self.chunks().iter().enumerate() {
+                if r.is_empty() {
+                    continue;
+                }
+                pass.set_bind_group(
+                    1,
+                    &pool.bind_group,
+                    &[(c as u64 * self.params_stride) as u32],
+                );
+                pass.draw_indexed(r.start * 3..r.end * 3, 0, 0..1);
+            }
+        }
+        enc.copy_buffer_to_buffer(&self.counter, 0, &self.counter_staging, 0, 16);
+        gpu.queue.submit([enc.finish()]);
+        let words = read_mapped(gpu, &self.counter_staging, 16, |w| w[0])?;
+        Ok(words as u64)
+    }
+
+    /// Reads back the heads of `rows` and the first `nodes` nodes of the pool.
+    fn read(&self, rows: Range<u32>, nodes: u64) -> Result<Band, RecordError> {
+        let gpu = self.gpu;
+        let pool = self.pool.as_ref().expect("a pool exists");
+        let row_slots = self.view.width as u64 * self.view.samples as u64;
+        let heads_at = rows.start as u64 * row_slots * 4;
+        let heads_len = rows.len() as u64 * row_slots * 4;
+        let nodes_len = nodes * NODE_BYTES;
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(&self.heads, heads_at, &pool.staging, 0, heads_len);
+        if nodes_len > 0 {
+            enc.copy_buffer_to_buffer(&pool.nodes, 0, &pool.staging, heads_len, nodes_len);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let total = heads_len + nodes_len;
+        let words = read_mapped(gpu, &pool.staging, total, |w| w.to_vec())?;
+        let split = (heads_len / 4) as usize;
+        Ok(Band {
+            words,
+            split,
+            bytes: total,
+        })
+    }
+}
+
+/// An index buffer holding `indices` (one degenerate triangle where there are none: buffers
+/// may not be empty).
+fn index_buffer(device: &wgpu::Device, indices: &[u32]) -> wgpu::Buffer {
+    let empty = [0u32; 3];
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("capture indices"),
+        contents: bytemuck::cast_slice(if indices.is_empty() { &empty } else { indices }),
+        usage: wgpu::BufferUsages::INDEX,
+    })
+}
+
+/// The indices of the triangles among `triangles` whose every fragment has alpha 1 (alpha mode
+/// OPAQUE, and not glass unless glass is recorded at opacity 1): single-sided, then
+/// double-sided. Their order does not matter: they only set the nearest depth.
+fn opaque_indices(geometry: &Geometry, triangles: &[u32], glass_opacity: f32) -> [Vec<u32>; 2] {
+    let mut lists = [Vec::new(), Vec::new()];
+    for &t in triangles {
+        let m = &geometry.materials[geometry.triangle_material(t) as usize];
+        let glass = m.transmission > 0.0;
+        if m.alpha_mode == AlphaMode::Opaque && (!glass || glass_opacity >= 1.0) {
+            lists[m.double_sided as usize].extend_from_slice(&geometry.triangles[t as usize]);
+        }
+    }
+    lists
+}
+
+/// What capturing one frame cost: passes drawn (a redraw after the pool grew, or one per band,
+/// counts), fragments kept, bytes read back.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct CaptureStats {
+    pub passes: u32,
+    pub fragments: u64,
+    pub bytes: u64,
+}
+
+/// One band of rows read back: list heads and the node pool, as words.
+pub(crate) struct Band {
+    words: Vec<u32>,
+    /// Heads are `words[..split]`, nodes (4 words each) `words[split..]`.
+    split: usize,
+    bytes: u64,
+}
+
+impl Band {
+    /// Samples in this band.
+    pub fn slots(&self) -> usize {
+        self.split
+    }
+
+    /// The fragments of the band's sample `slot` (0-based within the band) sorted by
+    /// (depth, id), the order the peel's layers give them, into `out` (cleared first).
+    pub fn sorted(&self, slot: usize, out: &mut Vec<Fragment>) {
+        out.clear();
+        let nodes = &self.words[self.split..];
+        let mut n = self.words[slot];
+        while n != 0 {
+            let node = &nodes[(n as usize - 1) * 4..n as usize * 4];
+            out.push(Fragment {
+                depth: f32::from_bits(node[0]),
+                id: node[1],
+                alpha: f32::from_bits(node[2]),
+            });
+            n = node[3];
+        }
+        // The peel's order: a fragment comes after another when its depth is greater, or equal
+        // (as `==` compares: -0 and +0 are equal) with a greater id. Depths are never NaN.
+        out.sort_unstable_by(|a, b| {
+            a.depth
+                .partial_cmp(&b.depth)
+                .unwrap_or(std::cmp::Ordering::Equal)
+                .then(a.id.cmp(&b.id))
+        });
+    }
+}
+
+/// Capture passes drawn, pools grown, bands split, bytes read back (see [`capture_counters`]).
+static COUNTERS: [AtomicU64; 4] = [const { AtomicU64::new(0) }; 4];
+
+/// What every capture of this process did so far: passes drawn, passes drawn again after the
+/// pool grew, bands split in two, and bytes read back (tests and benchmarks).
+#[doc(hidden)]
+pub fn capture_counters() -> [u64; 4] {
+    std::array::from_fn(|k| COUNTERS[k].load(Relaxed))
+}
+
+thread_local! {
+    /// See [`with_pool_limits`].
+    static POOL_LIMITS: std::cell::Cell<Option<(u64, u64)>> =
+        const { std::cell::Cell::new(None) };
+}
+
+/// Runs `f` with captures set up inside it starting with a pool of `first` nodes (instead of
+/// one a sample) and holding at most `most` fragments a pass (instead of what one storage
+/// binding holds), so that tests can make a frame grow its pool and split into bands on any
+/// device.
+#[doc(hidden)]
+pub fn with_pool_limits<R>(first: u64, most: u64, f: impl FnOnce() -> R) -> R {
+    let before = POOL_LIMITS.with(|c| c.replace(Some((first, most))));
+    let r = f();
+    POOL_LIMITS.with(|c| c.set(before));
+    r
+}
+
+/// Most nodes one pool holds on `device` ([`with_pool_limits`] may lower it).
+fn pool_limit(device: &wgpu::Device) -> u64 {
+    let binding = binding_limit(device) / NODE_BYTES;
+    POOL_LIMITS
+        .with(|c| c.get())
+        .map_or(binding, |(_, most)| most.min(binding))
+}
+
+/// The largest storage buffer one binding holds on `device`.
+fn binding_limit(device: &wgpu::Device) -> u64 {
+    let l = device.limits();
+    l.max_storage_buffer_binding_size.min(l.max_buffer_size)
+}
+
+/// Maps the first `len` bytes of `buffer` (a `MAP_READ` buffer the last submission wrote),
+/// waits, hands them to `f` as words and unmaps.
+fn read_mapped<R>(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    len: u64,
+    f: impl FnOnce(&[u32]) -> R,
+) -> Result<R, RecordError> {
+    let slice = buffer.slice(..len);
+    slice.map_async(wgpu::MapMode::Read, |_| {});
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| RecordError::Device(e.to_string()))?;
+    let r = {
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| RecordError::Device(e.to_string()))?;
+        f(bytemuck::cast_slice(&data))
+    };
+    buffer.unmap();
+    Ok(r)
+}

@@ -1,0 +1,104 @@
+//! Capturing every fragment of a frame in one pass and sorting each sample's list records
+//! exactly what depth peeling, one pass per layer, records: byte-identical `Recording`s, both
+//! made in this process, on the demo car, GlassVaseFlowers (textured MASK and BLEND leaves,
+//! glass) and CarConcept, plain, robust and conservative, at 4× and 1× MSAA; also when the
+//! pool must grow and when a frame's fragments are split into bands of rows.
+
+use trisort_format::RecordSettings;
+use trisort_recorder::{capture_counters, with_peeling, with_pool_limits};
+use trisort_scene::Scene;
+
+use crate::compact_readback::{assert_switch_keeps_recording, variants};
+
+fn capture_matches_peeling(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) {
+    assert_switch_keeps_recording(
+        gpu,
+        scene,
+        settings,
+        |run| with_peeling(run),
+        "capturing instead of peeling",
+    );
+}
+
+#[test]
+fn capture_matches_peeling_on_the_demo_car() {
+    let Some(gpu) = trisort_testkit::gpu() else {
+        return;
+    };
+    let scene = trisort_scene::demo_car(20_000);
+    let before = capture_counters();
+    for s in variants() {
+        capture_matches_peeling(&gpu, &scene, s);
+    }
+    // Not peeling both times: the device captured (other tests may capture at the same time,
+    // so only a lower bound).
+    assert!(capture_counters()[0] > before[0], "nothing was captured");
+}
+
+/// Pools of 256 nodes at first: every phase's first frame asks for more, so it is drawn again
+/// in a grown pool, and the recording is still the one peeling makes.
+#[test]
+fn capture_with_a_growing_pool_matches_peeling() {
+    let Some(gpu) = trisort_testkit::gpu() else {
+        return;
+    };
+    let scene = trisort_scene::demo_car(20_000);
+    let before = capture_counters();
+    with_pool_limits(256, u64::MAX, || {
+        capture_matches_peeling(&gpu, &scene, variants()[0])
+    });
+    let after = capture_counters();
+    // Other tests may capture at the same time, so only a lower bound.
+    assert!(after[1] > before[1], "the pool never grew");
+}
+
+#[test]
+fn capture_matches_peeling_on_a_real_scene() {
+    let Some(gpu) = trisort_testkit::gpu() else {
+        return;
+    };
+    let Some(path) = trisort_testkit::scene_path("GlassVaseFlowers/GlassVaseFlowers.glb") else {
+        return;
+    };
+    let scene = trisort_scene::load(&path).expect("scene loads");
+    for s in variants() {
+        capture_matches_peeling(&gpu, &scene, s);
+    }
+}
+
+#[test]
+fn capture_matches_peeling_on_car_concept() {
+    let Some(gpu) = trisort_testkit::gpu() else {
+        return;
+    };
+    let Some(path) = trisort_testkit::scene_path("CarConcept/CarConcept.glb") else {
+        return;
+    };
+    let scene = trisort_scene::load(&path).expect("scene loads");
+    // Plain at 4×, glass recorded at the demo's 0.35 (so it saturates part-way).
+    let s = RecordSettings {
+        glass_opacity: 0.35,
+        ..variants()[0]
+    };
+    capture_matches_peeling(&gpu, &scene, s);
+}
+
+/// Pools of at most 500 nodes: the car's frames ask for more, so each is split into bands
+/// of rows (each drawing every triangle again), halved until each fits, and the recording is
+/// still the one peeling makes.
+#[test]
+fn capture_in_bands_matches_peeling() {
+    let Some(gpu) = trisort_testkit::gpu() else {
+        return;
+    };
+    let scene = trisort_scene::demo_car(20_000);
+    let s = RecordSettings {
+        width: 32,
+        height: 32,
+        ..variants()[0]
+    };
+    let before = capture_counters();
+    with_pool_limits(256, 500, || capture_matches_peeling(&gpu, &scene, s));
+    let after = capture_counters();
+    assert!(after[2] > before[2], "no frame was split into bands");
+}
