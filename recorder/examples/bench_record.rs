@@ -1,7 +1,7 @@
 //! Recorder benchmark (numbers for BENCHMARKS.md, not a test).
 //!
 //! ```sh
-//! cargo run --release -p trisort-recorder --example bench_record -- SCENE PATH SIZE SAMPLES STRIDE [compare]
+//! cargo run --release -p trisort-recorder --example bench_record -- SCENE PATH SIZE SAMPLES STRIDE [compare|costs]
 //! ```
 //!
 //! Records every STRIDE-th frame of the path (a sample of its frames: G then comes from those
@@ -10,7 +10,7 @@
 //! same triangles, measured in the same run. With `compare`, first the same by depth peeling
 //! (`with_peeling`: one pass per layer, the recorder until 2026-12-02), then as shipped (one
 //! capture pass a frame where the device can), in one process, and checks that both
-//! recordings are identical.
+//! recordings are identical. With `costs`, only the pass costs (no recording).
 
 use std::time::Instant;
 
@@ -58,8 +58,9 @@ fn counters() -> (u64, u64) {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let compare = args.len() == 7 && args[6] == "compare";
-    if args.len() != 6 && !compare {
-        eprintln!("usage: bench_record SCENE PATH SIZE SAMPLES STRIDE [compare]");
+    let only_costs = args.len() == 7 && args[6] == "costs";
+    if args.len() != 6 && !compare && !only_costs {
+        eprintln!("usage: bench_record SCENE PATH SIZE SAMPLES STRIDE [compare|costs]");
         std::process::exit(2);
     }
     let scene = trisort_scene::load(std::path::Path::new(&args[1])).expect("scene");
@@ -119,7 +120,9 @@ fn main() {
         report(&rec, &p1, &p2, total, scene.geometry.triangles.len());
         rec
     };
-    if compare {
+    if only_costs {
+        // Only the pass costs below.
+    } else if compare {
         println!("\nbefore: depth peeling, one pass a layer");
         let before = with_peeling(run);
         println!("\nafter: one capture pass a frame");

@@ -52,9 +52,16 @@ pub(crate) fn supported(gpu: &Gpu) -> bool {
 pub(crate) struct Capture<'g> {
     gpu: &'g Gpu,
     scene: SceneGpu,
-    pipeline: wgpu::RenderPipeline,
+    /// The capture pipeline specialised to triangles whose opacity needs no texture, and the
+    /// general one.
+    pipelines: [wgpu::RenderPipeline; 2],
     layout: wgpu::BindGroupLayout,
+    /// The drawn triangles, those whose opacity needs no texture first ([`draw_order`]).
     index: wgpu::Buffer,
+    /// Per triangle of `index`, its position in the drawn list.
+    draw_ids: wgpu::Buffer,
+    /// The draws: pipeline (0 or 1) and triangles of `index`; draw k reads parameter slot k.
+    draws: Vec<(usize, Range<u32>)>,
     triangles: u32,
     depth: wgpu::TextureView,
     params: wgpu::Buffer,
@@ -134,6 +141,16 @@ impl<'g> Capture<'g> {
                 storage(1),
                 storage(2),
                 storage(3),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -144,7 +161,11 @@ impl<'g> Capture<'g> {
         // No colour target. Without the prepass no depth test either: every fragment is kept
         // (the depth attachment only gives the pass its sample count); with it, `LessEqual`
         // against the nearest always-opaque fragment, not written.
-        let build = |label, layout: &wgpu::PipelineLayout, cull_mode, depth, fragment: bool| {
+        let build = |label,
+                     layout: &wgpu::PipelineLayout,
+                     cull_mode,
+                     depth,
+                     fragment: Option<&[(&str, f64)]>| {
             let (write, compare) = depth;
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
@@ -171,10 +192,13 @@ impl<'g> Capture<'g> {
                     count: view.samples,
                     ..Default::default()
                 },
-                fragment: fragment.then(|| wgpu::FragmentState {
+                fragment: fragment.map(|constants| wgpu::FragmentState {
                     module: &module,
                     entry_point: Some("fs_capture"),
-                    compilation_options: Default::default(),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants,
+                        ..Default::default()
+                    },
                     targets: &[],
                 }),
                 multiview_mask: None,
@@ -186,7 +210,16 @@ impl<'g> Capture<'g> {
         } else {
             wgpu::CompareFunction::Always
         };
-        let pipeline = build("capture", &pipeline_layout, None, (false, compare), true);
+        let pipelines = [0.0, 1.0].map(|reads_alpha| {
+            let constants = [("READS_ALPHA", reads_alpha)];
+            build(
+                "capture",
+                &pipeline_layout,
+                None,
+                (false, compare),
+                Some(&constants),
+            )
+        });
         let prepass = until_opaque.then(|| {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("capture prepass"),
@@ -200,9 +233,9 @@ impl<'g> Capture<'g> {
                     &layout,
                     Some(wgpu::Face::Back),
                     depth,
-                    false,
+                    None,
                 ),
-                build("capture prepass", &layout, None, depth, false),
+                build("capture prepass", &layout, None, depth, None),
             ];
             let indices = opaque_indices(geometry, triangles, view.glass_opacity)
                 .map(|list| (index_buffer(device, &list), (list.len() / 3) as u32));
@@ -218,16 +251,32 @@ impl<'g> Capture<'g> {
         )
         .create_view(&Default::default());
 
+        let (order, without_texture) = draw_order(geometry, triangles);
         let mut index_data: Vec<u32> = Vec::with_capacity(triangles.len() * 3);
-        for &t in triangles {
-            index_data.extend_from_slice(&geometry.triangles[t as usize]);
+        for &position in &order {
+            index_data
+                .extend_from_slice(&geometry.triangles[triangles[position as usize] as usize]);
         }
         let index = index_buffer(device, &index_data);
-        let chunks = (triangles.len() as u32).div_ceil(CHUNK_TRIANGLES).max(1) as u64;
+        let draw_ids = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("capture draw ids"),
+            contents: bytemuck::cast_slice(if order.is_empty() { &[0u32] } else { &order }),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        // Each part by its pipeline, in draws of at most CHUNK_TRIANGLES.
+        let chunked = |r: Range<u32>| {
+            (r.start..r.end)
+                .step_by(CHUNK_TRIANGLES as usize)
+                .map(move |a| a..(a + CHUNK_TRIANGLES).min(r.end))
+        };
+        let draws: Vec<(usize, Range<u32>)> = chunked(0..without_texture)
+            .map(|r| (0, r))
+            .chain(chunked(without_texture..order.len() as u32).map(|r| (1, r)))
+            .collect();
         let params_stride = device.limits().min_uniform_buffer_offset_alignment.max(16) as u64;
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("capture params"),
-            size: chunks * params_stride,
+            size: draws.len().max(1) as u64 * params_stride,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -272,9 +321,11 @@ impl<'g> Capture<'g> {
         let mut capture = Capture {
             gpu,
             scene,
-            pipeline,
+            pipelines,
             layout,
             index,
+            draw_ids,
+            draws,
             triangles: triangles.len() as u32,
             depth,
             params,
@@ -346,10 +397,13 @@ impl<'g> Capture<'g> {
                     binding: 3,
                     resource: nodes.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: self.draw_ids.as_entire_binding(),
+                },
             ],
         });
-        let chunks = self.chunks();
-        for (c, r) in chunks.iter().enumerate() {
+        for (c, (_, r)) in self.draws.iter().enumerate() {
             let p = [
                 r.start,
                 self.view.width,
@@ -368,12 +422,6 @@ impl<'g> Capture<'g> {
             staging,
             bind_group,
         });
-    }
-
-    fn chunks(&self) -> Vec<Range<u32>> {
-        (0..self.triangles.div_ceil(CHUNK_TRIANGLES).max(1))
-            .map(|c| c * CHUNK_TRIANGLES..((c + 1) * CHUNK_TRIANGLES).min(self.triangles))
-            .collect()
     }
 
     /// Captures frame `frame` and calls `on_rows` with each band of rows captured, a [`Band`]
@@ -473,12 +521,9 @@ impl<'g> Capture<'g> {
                     }
                 }
             }
-            pass.set_pipeline(&self.pipeline);
             pass.set_index_buffer(self.index.slice(..), wgpu::IndexFormat::Uint32);
-            for (c, r) in self.chunks().iter().enumerate() {
-                if r.is_empty() {
-                    continue;
-                }
+            for (c, (pipeline, r)) in self.draws.iter().enumerate() {
+                pass.set_pipeline(&self.pipelines[*pipeline]);
                 pass.set_bind_group(
                     1,
                     &pool.bind_group,
@@ -527,6 +572,22 @@ fn index_buffer(device: &wgpu::Device, indices: &[u32]) -> wgpu::Buffer {
         contents: bytemuck::cast_slice(if indices.is_empty() { &empty } else { indices }),
         usage: wgpu::BufferUsages::INDEX,
     })
+}
+
+/// The order the capture draws `triangles` in, as positions in that list: those whose
+/// opacity needs no texture (OPAQUE materials, glass) first, then the rest (MASK, BLEND), each
+/// part ascending; and the length of the first part. The GPU's `surface_base` decides glass by
+/// transmission before the alpha mode, and so does this.
+fn draw_order(geometry: &Geometry, triangles: &[u32]) -> (Vec<u32>, u32) {
+    let without_texture = |t: u32| {
+        let m = &geometry.materials[geometry.triangle_material(t) as usize];
+        m.transmission > 0.0 || m.alpha_mode == AlphaMode::Opaque
+    };
+    let (mut first, rest): (Vec<u32>, Vec<u32>) =
+        (0..triangles.len() as u32).partition(|&p| without_texture(triangles[p as usize]));
+    let n = first.len() as u32;
+    first.extend(rest);
+    (first, n)
 }
 
 /// The indices of the triangles among `triangles` whose every fragment has alpha 1 (alpha mode

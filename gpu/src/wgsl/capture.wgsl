@@ -6,7 +6,8 @@
 //
 // Drawn like a peel pass: the same vertex transform (@invariant position), the same MSAA
 // pattern, shaded once per covered sample (`sample_index`), the same facing, MASK and alpha
-// rules (`surface_base` at the pixel centre), and the same id (`base_id + primitive_index`).
+// rules (`surface_base` at the pixel centre), and the same id (the triangle's position in the
+// drawn list).
 // A peel keeps only fragments that pass its depth test `Less` against the cleared 1.0, so
 // fragments at depth 1 are left out here too. Phase 2 runs no depth test: every fragment is
 // kept. Phase 1 (visibility until saturation) may first draw the triangles that are opaque
@@ -19,8 +20,9 @@
 // the pool's end, so the host knows how large a pool the pass needed and draws again.
 
 struct Capture {
-    // Id of the first triangle of this draw (primitive_index restarts per draw).
-    base_id: u32,
+    // Position in the index buffer of this draw's first triangle (primitive_index restarts
+    // per draw): its id is `draw_ids[first + primitive_index]`.
+    first: u32,
     // Image width and sample count.
     width: u32,
     samples: u32,
@@ -43,6 +45,17 @@ struct Node {
 // Fragments that asked for a node (may exceed the capacity).
 @group(1) @binding(2) var<storage, read_write> counter: array<atomic<u32>, 4>;
 @group(1) @binding(3) var<storage, read_write> nodes: array<Node>;
+// Per triangle of the index buffer, its id (its position in the drawn list): the index buffer
+// holds the triangles whose opacity needs no texture first, then the others, each part in id
+// order, and each part is drawn by its own pipeline (READS_ALPHA). The order fragments are
+// drawn in does not matter here: the host sorts every sample's list.
+@group(1) @binding(4) var<storage, read> draw_ids: array<u32>;
+
+// Whether this pipeline's triangles may take their opacity from a texture (MASK and BLEND
+// materials, `surface_base`). Where not (OPAQUE materials and glass), the opacity is what
+// `surface_base` gives them without sampling: 1, or the glass opacity. A CPU rasterizer runs
+// both sides of a branch on the material, so the texture is left out by specialising.
+override READS_ALPHA: bool = true;
 
 struct CaptureVarying {
     @invariant @builtin(position) position: vec4<f32>,
@@ -74,9 +87,14 @@ fn fs_capture(
     if (culled_of(m, front_facing)) {
         return;
     }
-    let base = surface_base_of(m, in.uv, in.uv1);
+    var alpha = 1.0;
+    if (READS_ALPHA) {
+        alpha = surface_base_of(m, in.uv, in.uv1).a;
+    } else if (m.emissive.a > 0.0) {
+        alpha = frame.params.x;
+    }
     let z = in.position.z;
-    if (base.a < 0.0 || !(z < 1.0)) {
+    if (alpha < 0.0 || !(z < 1.0)) {
         return;
     }
     let n = atomicAdd(&counter[0], 1u);
@@ -88,8 +106,8 @@ fn fs_capture(
     let next = atomicExchange(&heads[slot], n + 1u);
     nodes[n] = Node(
         bitcast<u32>(z),
-        capture.base_id + primitive + 1u,
-        bitcast<u32>(clamp(base.a, 0.0, 1.0)),
+        draw_ids[capture.first + primitive] + 1u,
+        bitcast<u32>(clamp(alpha, 0.0, 1.0)),
         next,
     );
 }
