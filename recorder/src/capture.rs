@@ -628,6 +628,35 @@ impl Band {
         self.split
     }
 
+    /// Walks every sample's sorted fragment list ([`Band::sorted`]) with `walk`, in parallel
+    /// over runs of samples, each run into its own state made by `init`; returns the states
+    /// (in run order) for the caller to merge. What the caller merges must not depend on how
+    /// samples were split into runs (sums, unions, maxima), so recordings stay identical
+    /// whatever the thread count.
+    pub fn walk<S: Send>(
+        &self,
+        init: impl Fn() -> S + Sync,
+        walk: impl Fn(&mut S, &[Fragment]) + Sync,
+    ) -> Vec<S> {
+        use rayon::prelude::*;
+        let runs = (rayon::current_num_threads() * 4).max(1);
+        let per_run = self.slots().div_ceil(runs).max(1);
+        (0..self.slots())
+            .step_by(per_run)
+            .collect::<Vec<usize>>()
+            .into_par_iter()
+            .map(|start| {
+                let mut state = init();
+                let mut list = Vec::new();
+                for slot in start..(start + per_run).min(self.slots()) {
+                    self.sorted(slot, &mut list);
+                    walk(&mut state, &list);
+                }
+                state
+            })
+            .collect()
+    }
+
     /// The fragments of the band's sample `slot` (0-based within the band) sorted by
     /// (depth, id), the order the peel's layers give them, into `out` (cleared first).
     pub fn sorted(&self, slot: usize, out: &mut Vec<Fragment>) {

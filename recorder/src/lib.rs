@@ -210,26 +210,35 @@ fn visibility_frame(
         let (l, t) = match source {
             Layers::Capture(c) => {
                 // Each sample's fragments in peel order, walked as the peel's layers would be:
-                // until the sample saturates or `max_layers` fragments were taken.
+                // until the sample saturates or `max_layers` fragments were taken. Per run of
+                // samples: the ids reached, the most fragments taken, whether any were left.
                 let (mut most, mut left) = (0u32, false);
-                let mut list = Vec::new();
                 c.borrow_mut().frame(frame, |band| {
-                    for slot in 0..band.slots() {
-                        band.sorted(slot, &mut list);
-                        let (mut transmittance, mut taken) = (1.0f32, 0u32);
-                        for f in &list {
-                            if taken == s.max_layers {
-                                left = true;
-                                break;
+                    let runs = band.walk(
+                        || (Vec::new(), 0u32, false),
+                        |(ids, most, left), list| {
+                            let (mut transmittance, mut taken) = (1.0f32, 0u32);
+                            for f in list {
+                                if taken == s.max_layers {
+                                    *left = true;
+                                    break;
+                                }
+                                ids.push(f.id - 1);
+                                taken += 1;
+                                transmittance *= 1.0 - f.alpha;
+                                if transmittance <= residual {
+                                    break;
+                                }
                             }
-                            reached[(f.id - 1) as usize] = true;
-                            taken += 1;
-                            transmittance *= 1.0 - f.alpha;
-                            if transmittance <= residual {
-                                break;
-                            }
+                            *most = (*most).max(taken);
+                        },
+                    );
+                    for (ids, m, l) in runs {
+                        for id in ids {
+                            reached[id as usize] = true;
                         }
-                        most = most.max(taken);
+                        most = most.max(m);
+                        left |= l;
                     }
                     Ok(())
                 })?;
@@ -290,7 +299,30 @@ struct GraphParts<'a> {
     ties: HashMap<(u32, u32), u32>,
 }
 
-impl GraphParts<'_> {
+impl<'a> GraphParts<'a> {
+    /// Nothing covered, no edges, over the drawn list `g`.
+    fn new(g: &'a [u32]) -> Self {
+        GraphParts {
+            g,
+            covered: vec![false; g.len()],
+            edges: HashMap::new(),
+            ties: HashMap::new(),
+        }
+    }
+
+    /// Adds what `other` gathered (over the same drawn list): covered flags, edge and tie
+    /// weights.
+    fn absorb(&mut self, other: GraphParts) {
+        for (c, o) in self.covered.iter_mut().zip(other.covered) {
+            *c |= o;
+        }
+        for (mine, theirs) in [(&mut self.edges, other.edges), (&mut self.ties, other.ties)] {
+            for (key, w) in theirs {
+                *mine.entry(key).or_default() += w;
+            }
+        }
+    }
+
     /// Fragment `id` (+ 1) follows fragment `prev` (+ 1) at a sample, at depths `depth` and
     /// `prev_depth`; `grown` edges go to `grown_edges` and carry no ties.
     fn pair(
@@ -324,12 +356,7 @@ fn graph_frame(
     g: &[u32],
     s: &RecordSettings,
 ) -> Result<Graph, RecordError> {
-    let mut parts = GraphParts {
-        g,
-        covered: vec![false; g.len()],
-        edges: HashMap::new(),
-        ties: HashMap::new(),
-    };
+    let mut parts = GraphParts::new(g);
     let (mut layers, mut truncated) = (0, false);
     // Robust settings: the union over the sample patterns (edge weights add up).
     let offsets = s.robust.offsets();
@@ -342,22 +369,29 @@ fn graph_frame(
         }
         let (l, t) = match source {
             Layers::Capture(c) => {
-                // Every sample's fragments in peel order, the first `max_layers` of them.
+                // Every sample's fragments in peel order, the first `max_layers` of them. Per
+                // run of samples: its own graph parts, the most fragments, whether any were left.
                 let (mut most, mut left) = (0usize, false);
-                let mut list = Vec::new();
                 c.borrow_mut().frame(frame, |band| {
-                    for slot in 0..band.slots() {
-                        band.sorted(slot, &mut list);
-                        left |= list.len() > max;
-                        let taken = &list[..list.len().min(max)];
-                        most = most.max(taken.len());
-                        for (k, f) in taken.iter().enumerate() {
-                            parts.covered[(f.id - 1) as usize] = true;
-                            if k > 0 {
-                                let p = &taken[k - 1];
-                                parts.pair(p.id, f.id, (p.depth, f.depth), None);
+                    let runs = band.walk(
+                        || (GraphParts::new(g), 0usize, false),
+                        |(run, most, left), list| {
+                            *left |= list.len() > max;
+                            let taken = &list[..list.len().min(max)];
+                            *most = (*most).max(taken.len());
+                            for (k, f) in taken.iter().enumerate() {
+                                run.covered[(f.id - 1) as usize] = true;
+                                if k > 0 {
+                                    let p = &taken[k - 1];
+                                    run.pair(p.id, f.id, (p.depth, f.depth), None);
+                                }
                             }
-                        }
+                        },
+                    );
+                    for (run, m, l) in runs {
+                        parts.absorb(run);
+                        most = most.max(m);
+                        left |= l;
                     }
                     Ok(())
                 })?;
