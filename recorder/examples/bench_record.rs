@@ -1,7 +1,7 @@
 //! Recorder benchmark (numbers for BENCHMARKS.md, not a test).
 //!
 //! ```sh
-//! cargo run --release -p trisort-recorder --example bench_record -- SCENE PATH SIZE SAMPLES STRIDE [compare|costs]
+//! cargo run --release -p trisort-recorder --example bench_record -- SCENE PATH SIZE SAMPLES STRIDE [compare|costs|record|peel]
 //! ```
 //!
 //! Records every STRIDE-th frame of the path (a sample of its frames: G then comes from those
@@ -10,7 +10,8 @@
 //! same triangles, measured in the same run. With `compare`, first the same by depth peeling
 //! (`with_peeling`: one pass per layer, the recorder until 2026-12-02), then as shipped (one
 //! capture pass a frame where the device can), in one process, and checks that both
-//! recordings are identical. With `costs`, only the pass costs (no recording).
+//! recordings are identical. With `costs`, only the pass costs (no recording); with `record`
+//! or `peel`, one recording as shipped or by peeling and its peak memory (no pass costs).
 
 use std::time::Instant;
 
@@ -58,9 +59,10 @@ fn counters() -> (u64, u64) {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let compare = args.len() == 7 && args[6] == "compare";
-    let only_costs = args.len() == 7 && args[6] == "costs";
-    if args.len() != 6 && !compare && !only_costs {
-        eprintln!("usage: bench_record SCENE PATH SIZE SAMPLES STRIDE [compare|costs]");
+    let mode = args.get(6).map_or("", |m| m.as_str());
+    let only_costs = mode == "costs";
+    if args.len() > 7 || !["", "compare", "costs", "record", "peel"].contains(&mode) {
+        eprintln!("usage: bench_record SCENE PATH SIZE SAMPLES STRIDE [compare|costs|record|peel]");
         std::process::exit(2);
     }
     let scene = trisort_scene::load(std::path::Path::new(&args[1])).expect("scene");
@@ -122,6 +124,16 @@ fn main() {
     };
     if only_costs {
         // Only the pass costs below.
+    } else if mode == "record" || mode == "peel" {
+        // One recording (as shipped, or by peeling), no pass costs: the peak memory is the
+        // recording's.
+        if mode == "peel" {
+            with_peeling(run);
+        } else {
+            run();
+        }
+        println!("peak RSS {:.0} MiB", peak_rss_mib());
+        return;
     } else if compare {
         println!("\nbefore: depth peeling, one pass a layer");
         let before = with_peeling(run);
