@@ -81,6 +81,24 @@ pub fn capture_shader(early_depth_test: bool) -> String {
     )
 }
 
+/// The grown capture's entry points (`vs_capture_grown`, `fs_capture_grown`); compose with
+/// [`capture_grown_shader`].
+pub const CAPTURE_GROWN: &str = include_str!("wgsl/capture_grown.wgsl");
+
+/// The complete grown-capture shader: [`COMMON`], the capture's bindings and functions
+/// ([`CAPTURE`], group 1), [`GROW`] in group 2 and [`CAPTURE_GROWN`]: the one-pass form of
+/// [`peel_grown_shader`] (needs writable storage in fragment shaders).
+pub fn capture_grown_shader() -> String {
+    compose(
+        &["primitive_index"],
+        &format!(
+            "{}\n{}\n{CAPTURE_GROWN}",
+            CAPTURE.replace("EARLY_DEPTH_TEST", ""),
+            GROW.replace("CONS_GROUP", "2")
+        ),
+    )
+}
+
 /// The compute pass that gathers a peel layer per sample; compose with [`gather_shader`].
 pub const GATHER: &str = include_str!("wgsl/gather.wgsl");
 
@@ -297,6 +315,9 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("conservative 4x", conservative_shader(4)),
         ("peel grown 1x", peel_grown_shader(1)),
         ("peel grown 4x", peel_grown_shader(4)),
+        ("capture", capture_shader(false)),
+        ("capture, early depth test", capture_shader(true)),
+        ("capture grown", capture_grown_shader()),
         ("blit", blit_shader(false, true, BACKGROUND)),
         ("blit saturate linear", blit_shader(true, false, BACKGROUND)),
     ]

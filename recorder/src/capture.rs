@@ -21,6 +21,7 @@ use trisort_gpu::scene_gpu::{vertex_layout, SceneGpu, View};
 use trisort_gpu::Gpu;
 use wgpu::util::DeviceExt;
 
+use crate::conservative::{pulled_pipeline, GrowBuffers};
 use crate::RecordError;
 
 /// One captured fragment: depth, id + 1 (a position in the drawn list, plus 1), opacity.
@@ -53,11 +54,14 @@ pub(crate) struct Capture<'g> {
     gpu: &'g Gpu,
     scene: SceneGpu,
     /// The capture pipeline specialised to triangles whose opacity needs no texture, and the
-    /// general one.
-    pipelines: [wgpu::RenderPipeline; 2],
+    /// general one; or the grown capture's one pipeline.
+    pipelines: Vec<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
-    /// The drawn triangles, those whose opacity needs no texture first ([`draw_order`]).
-    index: wgpu::Buffer,
+    /// The drawn triangles, those whose opacity needs no texture first ([`draw_order`]);
+    /// `None` for the grown capture, which pulls its triangles from storage in drawn order.
+    index: Option<wgpu::Buffer>,
+    /// The grown capture's triangle storage (group 2).
+    grown: Option<wgpu::BindGroup>,
     /// Per triangle of `index`, its position in the drawn list.
     draw_ids: wgpu::Buffer,
     /// The draws: pipeline (0 or 1) and triangles of `index`; draw k reads parameter slot k.
@@ -105,15 +109,54 @@ impl<'g> Capture<'g> {
         view: View,
         until_opaque: bool,
     ) -> Result<Self, RecordError> {
+        Capture::build(gpu, geometry, triangles, frames, view, until_opaque, None)
+    }
+
+    /// [`Capture::new`] over the triangles grown by `tolerance` pixels
+    /// (`capture_grown.wgsl`): the one-pass form of [`crate::Peeler::grown`], whose layers
+    /// phase 2 of `record --conservative` takes the added triangles' edges from. Fragments
+    /// carry alpha 1.
+    pub fn grown(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        triangles: &[u32],
+        frames: &[FrameState],
+        view: View,
+        tolerance: f32,
+    ) -> Result<Self, RecordError> {
+        Capture::build(
+            gpu,
+            geometry,
+            triangles,
+            frames,
+            view,
+            false,
+            Some(tolerance),
+        )
+    }
+
+    fn build(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        triangles: &[u32],
+        frames: &[FrameState],
+        view: View,
+        until_opaque: bool,
+        grow: Option<f32>,
+    ) -> Result<Self, RecordError> {
         let device = &gpu.device;
         let scene = crate::peeler::visibility_scene(gpu, geometry, frames, view);
         let until_opaque = until_opaque
             && device
                 .features()
                 .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
+        let source = match grow {
+            None => trisort_gpu::capture_shader(until_opaque),
+            Some(_) => trisort_gpu::capture_grown_shader(),
+        };
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("capture"),
-            source: wgpu::ShaderSource::Wgsl(trisort_gpu::capture_shader(until_opaque).into()),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         let storage = |binding| wgpu::BindGroupLayoutEntry {
             binding,
@@ -210,16 +253,45 @@ impl<'g> Capture<'g> {
         } else {
             wgpu::CompareFunction::Always
         };
-        let pipelines = [0.0, 1.0].map(|reads_alpha| {
-            let constants = [("READS_ALPHA", reads_alpha)];
-            build(
-                "capture",
-                &pipeline_layout,
-                None,
-                (false, compare),
-                Some(&constants),
-            )
-        });
+        let (pipelines, grown) = match grow {
+            None => {
+                let pipelines = [0.0, 1.0].map(|reads_alpha| {
+                    let constants = [("READS_ALPHA", reads_alpha)];
+                    build(
+                        "capture",
+                        &pipeline_layout,
+                        None,
+                        (false, compare),
+                        Some(&constants),
+                    )
+                });
+                (Vec::from(pipelines), None)
+            }
+            Some(tolerance) => {
+                let buffers = GrowBuffers::new(device, geometry, triangles, view, tolerance);
+                let grow_layout =
+                    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                        label: Some("grown capture"),
+                        entries: &GrowBuffers::layout_entries(),
+                    });
+                let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("grown capture"),
+                    layout: &grow_layout,
+                    entries: &buffers.entries(),
+                });
+                let pipeline = pulled_pipeline(
+                    device,
+                    "grown capture",
+                    &[&scene.layout, &layout, &grow_layout],
+                    &module,
+                    ("vs_capture_grown", "fs_capture_grown"),
+                    None,
+                    Some((wgpu::TextureFormat::Depth32Float, compare)),
+                    view.samples,
+                );
+                (vec![pipeline], Some(group))
+            }
+        };
         let prepass = until_opaque.then(|| {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("capture prepass"),
@@ -251,13 +323,20 @@ impl<'g> Capture<'g> {
         )
         .create_view(&Default::default());
 
-        let (order, without_texture) = draw_order(geometry, triangles);
+        // The grown capture pulls triangle k of the drawn list as draw triangle k: one part.
+        let (order, without_texture) = match grow {
+            None => draw_order(geometry, triangles),
+            Some(_) => (
+                (0..triangles.len() as u32).collect(),
+                triangles.len() as u32,
+            ),
+        };
         let mut index_data: Vec<u32> = Vec::with_capacity(triangles.len() * 3);
         for &position in &order {
             index_data
                 .extend_from_slice(&geometry.triangles[triangles[position as usize] as usize]);
         }
-        let index = index_buffer(device, &index_data);
+        let index = grow.is_none().then(|| index_buffer(device, &index_data));
         let draw_ids = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("capture draw ids"),
             contents: bytemuck::cast_slice(if order.is_empty() { &[0u32] } else { &order }),
@@ -324,6 +403,7 @@ impl<'g> Capture<'g> {
             pipelines,
             layout,
             index,
+            grown,
             draw_ids,
             draws,
             triangles: triangles.len() as u32,
@@ -521,7 +601,12 @@ impl<'g> Capture<'g> {
                     }
                 }
             }
-            pass.set_index_buffer(self.index.slice(..), wgpu::IndexFormat::Uint32);
+            if let Some(index) = &self.index {
+                pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
+            }
+            if let Some(group) = &self.grown {
+                pass.set_bind_group(2, group, &[]);
+            }
             for (c, (pipeline, r)) in self.draws.iter().enumerate() {
                 pass.set_pipeline(&self.pipelines[*pipeline]);
                 pass.set_bind_group(
@@ -529,7 +614,12 @@ impl<'g> Capture<'g> {
                     &pool.bind_group,
                     &[(c as u64 * self.params_stride) as u32],
                 );
-                pass.draw_indexed(r.start * 3..r.end * 3, 0, 0..1);
+                if self.index.is_some() {
+                    pass.draw_indexed(r.start * 3..r.end * 3, 0, 0..1);
+                } else {
+                    // Pulled from storage: the triangle is vertex_index / 3.
+                    pass.draw(r.start * 3..r.end * 3, 0..1);
+                }
             }
         }
         enc.copy_buffer_to_buffer(&self.counter, 0, &self.counter_staging, 0, 16);

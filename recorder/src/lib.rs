@@ -171,6 +171,27 @@ impl<'g> Layers<'g> {
         }
     }
 
+    /// The grown layers of `record --conservative`'s phase 2 ([`Peeler::grown`]), captured
+    /// where the device can, as [`Layers::new`] decides.
+    fn grown(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        triangles: &[u32],
+        frames: &[FrameState],
+        view: View,
+        tolerance: f32,
+    ) -> Result<Self, RecordError> {
+        if capture::supported(gpu) && !PEELING.with(|c| c.get()) && !peeler::interleaved() {
+            let c = capture::Capture::grown(gpu, geometry, triangles, frames, view, tolerance)?;
+            Ok(Layers::Capture(std::cell::RefCell::new(c)))
+        } else {
+            Ok(Layers::Peel(
+                Peeler::grown(gpu, geometry, triangles, frames, view, tolerance)?
+                    .with_readback(false, true),
+            ))
+        }
+    }
+
     fn set_frame_subpixel_offset(&self, frame: u32, offset: [f64; 2]) {
         match self {
             Layers::Capture(c) => c.borrow().set_frame_subpixel_offset(frame, offset),
@@ -351,7 +372,7 @@ impl<'a> GraphParts<'a> {
 /// conservative recording, the grown peel (`grown`, [`Peeler::grown`]): edge weights add up.
 fn graph_frame(
     source: &Layers,
-    grown: Option<&Peeler>,
+    grown: Option<&Layers>,
     frame: u32,
     g: &[u32],
     s: &RecordSettings,
@@ -362,41 +383,12 @@ fn graph_frame(
     let offsets = s.robust.offsets();
     // The grown peel's edges, kept apart: they may only add order, never a cycle.
     let mut grown_edges: HashMap<(u32, u32), u32> = HashMap::new();
-    let max = s.max_layers as usize;
     for &offset in &offsets {
         if offsets.len() > 1 {
             source.set_frame_subpixel_offset(frame, offset);
         }
         let (l, t) = match source {
-            Layers::Capture(c) => {
-                // Every sample's fragments in peel order, the first `max_layers` of them. Per
-                // run of samples: its own graph parts, the most fragments, whether any were left.
-                let (mut most, mut left) = (0usize, false);
-                c.borrow_mut().frame(frame, |band| {
-                    let runs = band.walk(
-                        || (GraphParts::new(g), 0usize, false),
-                        |(run, most, left), list| {
-                            *left |= list.len() > max;
-                            let taken = &list[..list.len().min(max)];
-                            *most = (*most).max(taken.len());
-                            for (k, f) in taken.iter().enumerate() {
-                                run.covered[(f.id - 1) as usize] = true;
-                                if k > 0 {
-                                    let p = &taken[k - 1];
-                                    run.pair(p.id, f.id, (p.depth, f.depth), None);
-                                }
-                            }
-                        },
-                    );
-                    for (run, m, l) in runs {
-                        parts.absorb(run);
-                        most = most.max(m);
-                        left |= l;
-                    }
-                    Ok(())
-                })?;
-                (most as u32, left)
-            }
+            Layers::Capture(c) => capture_graph(c, frame, s, &mut parts, None)?,
             Layers::Peel(peeler) => peel_graph(peeler, frame, s, &mut parts, None)?,
         };
         layers += l;
@@ -405,8 +397,11 @@ fn graph_frame(
     if offsets.len() > 1 {
         source.set_frame_subpixel_offset(frame, [0.0, 0.0]);
     }
-    if let Some(p) = grown {
-        let (l, t) = peel_graph(p, frame, s, &mut parts, Some(&mut grown_edges))?;
+    if let Some(grown) = grown {
+        let (l, t) = match grown {
+            Layers::Capture(c) => capture_graph(c, frame, s, &mut parts, Some(&mut grown_edges))?,
+            Layers::Peel(p) => peel_graph(p, frame, s, &mut parts, Some(&mut grown_edges))?,
+        };
         layers += l;
         truncated |= t;
     }
@@ -432,6 +427,53 @@ fn graph_frame(
         v
     };
     Ok((covered, to_edges(edges), to_edges(ties), layers, truncated))
+}
+
+/// Captures frame `frame` with `capture` into `parts` (into `grown` for the grown capture's
+/// edges): every sample's fragments in peel order, the first `max_layers` of them, walked in
+/// parallel runs of samples, each into its own parts; returns the most fragments a sample
+/// took (the layers a peel would have needed) and whether any sample had more.
+fn capture_graph(
+    capture: &std::cell::RefCell<capture::Capture>,
+    frame: u32,
+    s: &RecordSettings,
+    parts: &mut GraphParts,
+    mut grown: Option<&mut HashMap<(u32, u32), u32>>,
+) -> Result<(u32, bool), RecordError> {
+    let max = s.max_layers as usize;
+    let is_grown = grown.is_some();
+    let g = parts.g;
+    let (mut most, mut left) = (0usize, false);
+    capture.borrow_mut().frame(frame, |band| {
+        let runs = band.walk(
+            || (GraphParts::new(g), HashMap::new(), 0usize, false),
+            |(run, run_grown, most, left), list| {
+                *left |= list.len() > max;
+                let taken = &list[..list.len().min(max)];
+                *most = (*most).max(taken.len());
+                for (k, f) in taken.iter().enumerate() {
+                    run.covered[(f.id - 1) as usize] = true;
+                    if k > 0 {
+                        let p = &taken[k - 1];
+                        let to = is_grown.then_some(&mut *run_grown);
+                        run.pair(p.id, f.id, (p.depth, f.depth), to);
+                    }
+                }
+            },
+        );
+        for (run, run_grown, m, l) in runs {
+            parts.absorb(run);
+            if let Some(grown) = grown.as_deref_mut() {
+                for (key, w) in run_grown {
+                    *grown.entry(key).or_default() += w;
+                }
+            }
+            most = most.max(m);
+            left |= l;
+        }
+        Ok(())
+    })?;
+    Ok((most as u32, left))
 }
 
 /// Peels frame `frame` completely with `peeler` into `parts` (into `grown` for the grown
@@ -618,17 +660,14 @@ pub fn record(
                         )?);
                     }
                     if s.robust.conservative && grown.is_none() {
-                        grown = Some(
-                            Peeler::grown(
-                                gpu,
-                                job.geometry,
-                                &g,
-                                job.frames,
-                                view,
-                                s.robust.tolerance,
-                            )?
-                            .with_readback(false, true),
-                        );
+                        grown = Some(Layers::grown(
+                            gpu,
+                            job.geometry,
+                            &g,
+                            job.frames,
+                            view,
+                            s.robust.tolerance,
+                        )?);
                     }
                     let r = graph_frame(peeler.as_ref().unwrap(), grown.as_ref(), f, &g, &s)?;
                     if let Some(p) = partial {

@@ -97,17 +97,18 @@ fn fs_capture(
     if (alpha < 0.0 || !(z < 1.0)) {
         return;
     }
+    capture_push(in.position.xy, sample, z, draw_ids[capture.first + primitive] + 1u, alpha);
+}
+
+// Pushes a fragment (depth `z`, id + 1 `id1`, opacity `alpha`) on the list of `sample` of the
+// pixel at `xy`, if the pool has room (the counter counts the attempt either way).
+fn capture_push(xy: vec2<f32>, sample: u32, z: f32, id1: u32, alpha: f32) {
     let n = atomicAdd(&counter[0], 1u);
     if (n >= capture.capacity) {
         return;
     }
-    let coord = vec2<u32>(in.position.xy);
+    let coord = vec2<u32>(xy);
     let slot = (coord.y * capture.width + coord.x) * capture.samples + sample;
     let next = atomicExchange(&heads[slot], n + 1u);
-    nodes[n] = Node(
-        bitcast<u32>(z),
-        draw_ids[capture.first + primitive] + 1u,
-        bitcast<u32>(clamp(alpha, 0.0, 1.0)),
-        next,
-    );
+    nodes[n] = Node(bitcast<u32>(z), id1, bitcast<u32>(clamp(alpha, 0.0, 1.0)), next);
 }
