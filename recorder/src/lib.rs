@@ -11,8 +11,8 @@
 //! The layers of a sample are its fragments in (depth, id) order. Where the device has writable
 //! storage in fragment shaders (every Vulkan device), one render pass captures every fragment
 //! of the frame on per-sample lists and the host sorts each list (`capture.rs`,
-//! `gpu/src/wgsl/capture.wgsl`). Elsewhere, and for the grown peel of conservative recording,
-//! each layer is one depth-peeling render pass: triangles in ascending id order, depth test
+//! `gpu/src/wgsl/capture.wgsl`; conservative recording's grown peel likewise,
+//! `capture_grown.wgsl`). Elsewhere each layer is one depth-peeling render pass: triangles in ascending id order, depth test
 //! `Less`, the depth written explicitly, and fragments whose (depth, id) key is not greater
 //! than the previous layer's at that sample discarded (see `gpu/src/wgsl/peel.wgsl`); samples
 //! that are finished are masked so later layers do no work there. Both give the same layers,
