@@ -162,8 +162,9 @@ fn bakes_are_byte_identical_across_runs_and_thread_counts() {
     }
 }
 
-/// A recording the device cannot hold (16384² at 4× needs a 16 GiB gather buffer, beyond
-/// any binding limit) ends with exit 1 and a message naming the limit, no panic, no output.
+/// A recording the device cannot hold (16384² at 4× needs 4 GiB of per-sample list heads to
+/// capture, or a 12 GiB gather buffer to peel, beyond any binding limit) ends with exit 1 and
+/// a message naming the limit, no panic, no output, before anything that size is allocated.
 #[test]
 fn a_recording_too_large_for_the_device_fails_cleanly() {
     let Some(dir) = gpu_tempdir() else {

@@ -155,10 +155,14 @@ fn main() {
             "frame {f}: peel layer {:.1} ms (render {:.1} ms + gather/readback), plain pass {:.1} ms: render ratio {:.2}x, with readback {:.2}x",
             c.peel_ms, c.peel_render_ms, c.plain_ms, c.peel_render_ms / c.plain_ms, c.peel_ms / c.plain_ms
         );
-        println!(
-            "frame {f}: capture pass {:.1} ms ({:.2}x plain), with readback and sorting {:.1} ms ({:.2}x plain)",
-            c.capture_render_ms, c.capture_render_ms / c.plain_ms, c.capture_ms, c.capture_ms / c.plain_ms
-        );
+        match (c.capture_render_ms, c.capture_ms) {
+            (Some(render), Some(all)) => println!(
+                "frame {f}: capture pass {render:.1} ms ({:.2}x plain), with readback and sorting {all:.1} ms ({:.2}x plain)",
+                render / c.plain_ms,
+                all / c.plain_ms
+            ),
+            _ => println!("frame {f}: this device cannot capture"),
+        }
     }
     println!("peak RSS {:.0} MiB", peak_rss_mib());
 }

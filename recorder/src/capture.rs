@@ -22,10 +22,11 @@ use trisort_gpu::Gpu;
 use wgpu::util::DeviceExt;
 
 use crate::conservative::{pulled_pipeline, GrowBuffers};
+use crate::peeler::{read_mapped, CHUNK_TRIANGLES};
 use crate::RecordError;
 
 /// One captured fragment: depth, id + 1 (a position in the drawn list, plus 1), opacity.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct Fragment {
     pub depth: f32,
     pub id: u32,
@@ -34,8 +35,6 @@ pub(crate) struct Fragment {
 
 /// Bytes of one pool node (depth, id, alpha, next).
 const NODE_BYTES: u64 = 16;
-/// Most triangles drawn by one draw call (as the peeler: ids restart per draw).
-const CHUNK_TRIANGLES: u32 = 1 << 22;
 
 /// Whether the device can capture: writable storage in fragment shaders and primitive ids.
 pub(crate) fn supported(gpu: &Gpu) -> bool {
@@ -145,6 +144,18 @@ impl<'g> Capture<'g> {
         grow: Option<f32>,
     ) -> Result<Self, RecordError> {
         let device = &gpu.device;
+        // Before anything is allocated: the list heads must fit one binding.
+        let slots = view.width as u64 * view.height as u64 * view.samples as u64;
+        let largest = binding_limit(device);
+        if slots * 4 > largest {
+            return Err(RecordError::Unsupported(format!(
+                "{}x{} at {}x needs {} bytes of list heads; the device binds at most {largest}",
+                view.width,
+                view.height,
+                view.samples,
+                slots * 4
+            )));
+        }
         let scene = crate::peeler::visibility_scene(gpu, geometry, frames, view);
         let until_opaque = until_opaque
             && device
@@ -202,14 +213,15 @@ impl<'g> Capture<'g> {
             immediate_size: 0,
         });
         // No colour target. Without the prepass no depth test either: every fragment is kept
-        // (the depth attachment only gives the pass its sample count); with it, `LessEqual`
-        // against the nearest always-opaque fragment, not written.
+        // (the depth attachment only gives the pass its sample count; the grown capture's
+        // pulled pipeline writes it, with `Always`, which keeps every fragment too); with it,
+        // `LessEqual` against the nearest always-opaque fragment, not written.
         let build = |label,
                      layout: &wgpu::PipelineLayout,
                      cull_mode,
                      depth,
                      fragment: Option<&[(&str, f64)]>| {
-            let (write, compare) = depth;
+            let (write, compare, bias) = depth;
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: Some(layout),
@@ -229,7 +241,7 @@ impl<'g> Capture<'g> {
                     depth_write_enabled: Some(write),
                     depth_compare: Some(compare),
                     stencil: Default::default(),
-                    bias: Default::default(),
+                    bias,
                 }),
                 multisample: wgpu::MultisampleState {
                     count: view.samples,
@@ -261,7 +273,7 @@ impl<'g> Capture<'g> {
                         "capture",
                         &pipeline_layout,
                         None,
-                        (false, compare),
+                        (false, compare, wgpu::DepthBiasState::default()),
                         Some(&constants),
                     )
                 });
@@ -298,7 +310,17 @@ impl<'g> Capture<'g> {
                 bind_group_layouts: &[Some(&scene.layout)],
                 immediate_size: 0,
             });
-            let depth = (true, wgpu::CompareFunction::Less);
+            // Pushed back a few units of the depth format: the capture's `LessEqual` test then
+            // keeps every fragment before a sample's first opaque one even where a device's
+            // depth-test value and the shader's `position.z` differ in the last bits (the peel
+            // compared only the latter). What else it keeps lies behind that fragment, where
+            // the walk never goes.
+            let bias = wgpu::DepthBiasState {
+                constant: 8,
+                slope_scale: 0.0,
+                clamp: 0.0,
+            };
+            let depth = (true, wgpu::CompareFunction::Less, bias);
             let pipelines = [
                 build(
                     "capture prepass",
@@ -337,9 +359,15 @@ impl<'g> Capture<'g> {
                 .extend_from_slice(&geometry.triangles[triangles[position as usize] as usize]);
         }
         let index = grow.is_none().then(|| index_buffer(device, &index_data));
+        // The grown capture reads no table (its ids are its draw's triangles): one word.
+        let ids: &[u32] = if order.is_empty() || grow.is_some() {
+            &[0]
+        } else {
+            &order
+        };
         let draw_ids = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("capture draw ids"),
-            contents: bytemuck::cast_slice(if order.is_empty() { &[0u32] } else { &order }),
+            contents: bytemuck::cast_slice(ids),
             usage: wgpu::BufferUsages::STORAGE,
         });
         // Each part by its pipeline, in draws of at most CHUNK_TRIANGLES.
@@ -359,17 +387,6 @@ impl<'g> Capture<'g> {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let slots = view.width as u64 * view.height as u64 * view.samples as u64;
-        let largest = binding_limit(device);
-        if slots * 4 > largest {
-            return Err(RecordError::Unsupported(format!(
-                "{}x{} at {}x needs {} bytes of list heads; the device binds at most {largest}",
-                view.width,
-                view.height,
-                view.samples,
-                slots * 4
-            )));
-        }
         let buffer = |label, size, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -417,12 +434,13 @@ impl<'g> Capture<'g> {
             prepass,
             view,
         };
-        // A fragment a sample to begin with (a frame's pass that asks for more is drawn again
-        // with room for what it asked plus an eighth, kept for later frames).
+        // A fragment a sample to begin with, at most 4 Mi (64 MiB): a frame's pass that asks
+        // for more is drawn again with room for what it asked plus an eighth, kept for later
+        // frames.
         let first = POOL_LIMITS
             .with(|c| c.get())
-            .map_or(slots, |(first, _)| first);
-        capture.grow(first.min(pool_limit(device)));
+            .map_or(slots.min(1 << 22), |(first, _)| first);
+        capture.grow(first.min(capture.pool_limit()));
         Ok(capture)
     }
 
@@ -511,19 +529,19 @@ impl<'g> Capture<'g> {
         &mut self,
         frame: u32,
         mut on_rows: impl FnMut(&Band) -> Result<(), RecordError>,
-    ) -> Result<CaptureStats, RecordError> {
-        let mut stats = CaptureStats::default();
+    ) -> Result<(), RecordError> {
         // Bands still to capture (a stack: the next is last), starting with the whole image.
         let mut todo: Vec<Range<u32>> = Vec::new();
         todo.push(0..self.view.height);
         while let Some(rows) = todo.pop() {
-            let asked = self.draw(frame, rows.clone())?;
-            stats.passes += 1;
+            let (asked, full) = self.draw(frame, rows.clone())?;
             COUNTERS[0].fetch_add(1, Relaxed);
-            let limit = pool_limit(&self.gpu.device);
+            let limit = self.pool_limit();
             let capacity = self.pool.as_ref().map_or(0, |p| p.capacity);
-            if asked > capacity {
-                if asked <= limit.min(u32::MAX as u64 - 1) {
+            if full {
+                // `asked` may have wrapped low on an enormous pass: it is at least one more.
+                let asked = asked.max(capacity + 1);
+                if asked <= limit {
                     // Room for this many and an eighth more, so a next frame rarely redraws.
                     self.grow((asked + asked / 8).min(limit));
                     COUNTERS[1].fetch_add(1, Relaxed);
@@ -546,13 +564,9 @@ impl<'g> Capture<'g> {
                 }
                 continue;
             }
-            stats.fragments += asked;
-            let band = self.read(rows, asked)?;
-            stats.bytes += band.bytes;
-            COUNTERS[3].fetch_add(band.bytes, Relaxed);
-            on_rows(&band)?;
+            self.read(rows, asked, &mut on_rows)?;
         }
-        Ok(stats)
+        Ok(())
     }
 
     /// Benchmarks: wall milliseconds of one capture pass over the whole image (submitted and
@@ -564,8 +578,8 @@ impl<'g> Capture<'g> {
     }
 
     /// Draws every triangle into the lists of `rows` (a scissor) and returns how many
-    /// fragments asked for a node.
-    fn draw(&self, frame: u32, rows: Range<u32>) -> Result<u64, RecordError> {
+    /// fragments asked for a node and whether any found the pool full.
+    fn draw(&self, frame: u32, rows: Range<u32>) -> Result<(u64, bool), RecordError> {
         let gpu = self.gpu;
         let pool = self.pool.as_ref().expect("a pool exists");
         let mut enc = gpu
@@ -624,12 +638,19 @@ impl<'g> Capture<'g> {
         }
         enc.copy_buffer_to_buffer(&self.counter, 0, &self.counter_staging, 0, 16);
         gpu.queue.submit([enc.finish()]);
-        let words = read_mapped(gpu, &self.counter_staging, 16, |w| w[0])?;
-        Ok(words as u64)
+        read_mapped(gpu, &self.counter_staging, 16, |w| {
+            (w[0] as u64 + w[1] as u64, w[2] != 0)
+        })
     }
 
-    /// Reads back the heads of `rows` and the first `nodes` nodes of the pool.
-    fn read(&self, rows: Range<u32>, nodes: u64) -> Result<Band, RecordError> {
+    /// Reads back the heads of `rows` and the first `nodes` nodes of the pool and hands them
+    /// to `on_rows` while mapped (no copy).
+    fn read(
+        &self,
+        rows: Range<u32>,
+        nodes: u64,
+        on_rows: &mut impl FnMut(&Band) -> Result<(), RecordError>,
+    ) -> Result<(), RecordError> {
         let gpu = self.gpu;
         let pool = self.pool.as_ref().expect("a pool exists");
         let row_slots = self.view.width as u64 * self.view.samples as u64;
@@ -643,13 +664,11 @@ impl<'g> Capture<'g> {
         }
         gpu.queue.submit([enc.finish()]);
         let total = heads_len + nodes_len;
-        let words = read_mapped(gpu, &pool.staging, total, |w| w.to_vec())?;
+        COUNTERS[3].fetch_add(total, Relaxed);
         let split = (heads_len / 4) as usize;
-        Ok(Band {
-            words,
-            split,
-            bytes: total,
-        })
+        read_mapped(gpu, &pool.staging, total, |words| {
+            on_rows(&Band { words, split })
+        })?
     }
 }
 
@@ -695,24 +714,14 @@ fn opaque_indices(geometry: &Geometry, triangles: &[u32], glass_opacity: f32) ->
     lists
 }
 
-/// What capturing one frame cost: passes drawn (a redraw after the pool grew, or one per band,
-/// counts), fragments kept, bytes read back.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct CaptureStats {
-    pub passes: u32,
-    pub fragments: u64,
-    pub bytes: u64,
-}
-
-/// One band of rows read back: list heads and the node pool, as words.
-pub(crate) struct Band {
-    words: Vec<u32>,
+/// One band of rows read back: list heads and the node pool, as words of the mapped readback.
+pub(crate) struct Band<'a> {
+    words: &'a [u32],
     /// Heads are `words[..split]`, nodes (4 words each) `words[split..]`.
     split: usize,
-    bytes: u64,
 }
 
-impl Band {
+impl Band<'_> {
     /// Samples in this band.
     pub fn slots(&self) -> usize {
         self.split
@@ -795,45 +804,26 @@ thread_local! {
 /// device.
 #[doc(hidden)]
 pub fn with_pool_limits<R>(first: u64, most: u64, f: impl FnOnce() -> R) -> R {
-    let before = POOL_LIMITS.with(|c| c.replace(Some((first, most))));
-    let r = f();
-    POOL_LIMITS.with(|c| c.set(before));
-    r
+    crate::peeler::with_switch(&POOL_LIMITS, Some((first, most)), f)
 }
 
-/// Most nodes one pool holds on `device` ([`with_pool_limits`] may lower it).
-fn pool_limit(device: &wgpu::Device) -> u64 {
-    let binding = binding_limit(device) / NODE_BYTES;
-    POOL_LIMITS
-        .with(|c| c.get())
-        .map_or(binding, |(_, most)| most.min(binding))
+impl Capture<'_> {
+    /// Most nodes one pool holds: one storage binding, a readback buffer of the pool and the
+    /// heads within the device's largest buffer, node indices + 1 in a u32 ([`with_pool_limits`]
+    /// may lower it).
+    fn pool_limit(&self) -> u64 {
+        let limits = self.gpu.device.limits();
+        let nodes = (binding_limit(&self.gpu.device) / NODE_BYTES)
+            .min(limits.max_buffer_size.saturating_sub(self.heads.size()) / NODE_BYTES)
+            .min(u32::MAX as u64 - 1);
+        POOL_LIMITS
+            .with(|c| c.get())
+            .map_or(nodes, |(_, most)| most.min(nodes))
+    }
 }
 
 /// The largest storage buffer one binding holds on `device`.
 fn binding_limit(device: &wgpu::Device) -> u64 {
     let l = device.limits();
     l.max_storage_buffer_binding_size.min(l.max_buffer_size)
-}
-
-/// Maps the first `len` bytes of `buffer` (a `MAP_READ` buffer the last submission wrote),
-/// waits, hands them to `f` as words and unmaps.
-fn read_mapped<R>(
-    gpu: &Gpu,
-    buffer: &wgpu::Buffer,
-    len: u64,
-    f: impl FnOnce(&[u32]) -> R,
-) -> Result<R, RecordError> {
-    let slice = buffer.slice(..len);
-    slice.map_async(wgpu::MapMode::Read, |_| {});
-    gpu.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| RecordError::Device(e.to_string()))?;
-    let r = {
-        let data = slice
-            .get_mapped_range()
-            .map_err(|e| RecordError::Device(e.to_string()))?;
-        f(bytemuck::cast_slice(&data))
-    };
-    buffer.unmap();
-    Ok(r)
 }

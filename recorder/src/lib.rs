@@ -8,15 +8,16 @@
 //! give an edge front → back weighted by the samples showing it (E_f); equal-depth neighbours
 //! are also listed as ties.
 //!
-//! The layers of a sample are its fragments in (depth, id) order. Where the device has writable
-//! storage in fragment shaders (every Vulkan device), one render pass captures every fragment
-//! of the frame on per-sample lists and the host sorts each list (`capture.rs`,
-//! `gpu/src/wgsl/capture.wgsl`; conservative recording's grown peel likewise,
-//! `capture_grown.wgsl`). Elsewhere each layer is one depth-peeling render pass: triangles in ascending id order, depth test
-//! `Less`, the depth written explicitly, and fragments whose (depth, id) key is not greater
-//! than the previous layer's at that sample discarded (see `gpu/src/wgsl/peel.wgsl`); samples
-//! that are finished are masked so later layers do no work there. Both give the same layers,
-//! so the same recordings (test `capture_matches_peeling`).
+//! The layers of a sample are its fragments in (depth, id) order. Where the device has
+//! primitive ids and writable storage in fragment shaders (`capture::supported`; lavapipe and
+//! most desktop Vulkan drivers have both, neither is required by Vulkan), one render pass
+//! captures every fragment of the frame on per-sample lists and the host sorts each list
+//! (`capture.rs`, `gpu/src/wgsl/capture.wgsl`; conservative recording's grown peel likewise,
+//! `capture_grown.wgsl`). Elsewhere each layer is one depth-peeling render pass: triangles in
+//! ascending id order, depth test `Less`, the depth written explicitly, and fragments whose
+//! (depth, id) key is not greater than the previous layer's at that sample discarded (see
+//! `gpu/src/wgsl/peel.wgsl`); samples that are finished are masked so later layers do no work
+//! there. Both give the same layers, so the same recordings (test `capture_matches_peeling`).
 #![deny(missing_docs)]
 
 pub mod bench;
@@ -29,6 +30,7 @@ mod peeler;
 
 use std::collections::HashMap;
 use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
 #[cfg(doc)]
 use trisort_format::Robust;
@@ -137,10 +139,14 @@ thread_local! {
 /// that both give the same recordings, and what capturing saves.
 #[doc(hidden)]
 pub fn with_peeling<R>(f: impl FnOnce() -> R) -> R {
-    let before = PEELING.with(|c| c.replace(true));
-    let r = f();
-    PEELING.with(|c| c.set(before));
-    r
+    peeler::with_switch(&PEELING, true, f)
+}
+
+/// Whether recordings on `gpu` capture (one pass a frame) rather than peel: the device can
+/// ([`capture::supported`]: primitive ids and writable storage in fragment shaders), and
+/// neither [`with_peeling`] nor [`with_interleaved_readback`] asks for peeling.
+fn captures(gpu: &Gpu) -> bool {
+    capture::supported(gpu) && !PEELING.with(|c| c.get()) && !peeler::interleaved()
 }
 
 /// Where a phase's layers come from: one capture pass a frame, or one peel pass a layer.
@@ -161,7 +167,7 @@ impl<'g> Layers<'g> {
         view: View,
         (alpha, depth): (bool, bool),
     ) -> Result<Self, RecordError> {
-        if capture::supported(gpu) && !PEELING.with(|c| c.get()) && !peeler::interleaved() {
+        if captures(gpu) {
             let c = capture::Capture::new(gpu, geometry, triangles, frames, view, alpha)?;
             Ok(Layers::Capture(std::cell::RefCell::new(c)))
         } else {
@@ -181,7 +187,7 @@ impl<'g> Layers<'g> {
         view: View,
         tolerance: f32,
     ) -> Result<Self, RecordError> {
-        if capture::supported(gpu) && !PEELING.with(|c| c.get()) && !peeler::interleaved() {
+        if captures(gpu) {
             let c = capture::Capture::grown(gpu, geometry, triangles, frames, view, tolerance)?;
             Ok(Layers::Capture(std::cell::RefCell::new(c)))
         } else {
@@ -220,7 +226,9 @@ fn visibility_frame(
     // Per drawn triangle (phase 1 draws every scene triangle, in id order): reached before
     // saturation. One flag a triangle instead of one entry a sample and layer to sort.
     let interleaved = peeler::interleaved();
-    let mut reached = vec![false; if interleaved { 0 } else { source.triangles() }];
+    let reached: Vec<AtomicBool> = (0..if interleaved { 0 } else { source.triangles() })
+        .map(|_| AtomicBool::new(false))
+        .collect();
     let residual = 1.0 - s.saturation;
     let (mut layers, mut truncated) = (0, false);
     let offsets = s.robust.offsets();
@@ -231,20 +239,21 @@ fn visibility_frame(
         let (l, t) = match source {
             Layers::Capture(c) => {
                 // Each sample's fragments in peel order, walked as the peel's layers would be:
-                // until the sample saturates or `max_layers` fragments were taken. Per run of
-                // samples: the ids reached, the most fragments taken, whether any were left.
+                // until the sample saturates or `max_layers` fragments were taken. Runs of
+                // samples in parallel, each with the most fragments it took and whether any
+                // were left; the reached flags are shared (a union).
                 let (mut most, mut left) = (0u32, false);
                 c.borrow_mut().frame(frame, |band| {
                     let runs = band.walk(
-                        || (Vec::new(), 0u32, false),
-                        |(ids, most, left), list| {
+                        || (0u32, false),
+                        |(most, left), list| {
                             let (mut transmittance, mut taken) = (1.0f32, 0u32);
                             for f in list {
                                 if taken == s.max_layers {
                                     *left = true;
                                     break;
                                 }
-                                ids.push(f.id - 1);
+                                reached[(f.id - 1) as usize].store(true, Relaxed);
                                 taken += 1;
                                 transmittance *= 1.0 - f.alpha;
                                 if transmittance <= residual {
@@ -254,10 +263,7 @@ fn visibility_frame(
                             *most = (*most).max(taken);
                         },
                     );
-                    for (ids, m, l) in runs {
-                        for id in ids {
-                            reached[id as usize] = true;
-                        }
+                    for (m, l) in runs {
                         most = most.max(m);
                         left |= l;
                     }
@@ -278,7 +284,7 @@ fn visibility_frame(
                         if interleaved {
                             visible.push(id - 1);
                         } else {
-                            reached[(id - 1) as usize] = true;
+                            reached[(id - 1) as usize].store(true, Relaxed);
                         }
                         transmittance[i] *= 1.0 - layer.alpha[i];
                         if transmittance[i] <= residual {
@@ -299,7 +305,7 @@ fn visibility_frame(
         reached
             .iter()
             .enumerate()
-            .filter(|(_, &r)| r)
+            .filter(|(_, r)| r.load(Relaxed))
             .map(|(t, _)| t as u32),
     );
     if let Some(c) = conservative {
@@ -310,33 +316,26 @@ fn visibility_frame(
     Ok((visible, layers, truncated))
 }
 
-/// A frame's graph as it is gathered: per drawn triangle whether it was covered, and the
-/// edges and ties by scene ids with their weights.
-struct GraphParts<'a> {
+/// Edges and ties between consecutive fragments, by scene ids, with their weights (samples).
+struct Pairs<'a> {
     /// Scene ids of the drawn list.
     g: &'a [u32],
-    covered: Vec<bool>,
     edges: HashMap<(u32, u32), u32>,
     ties: HashMap<(u32, u32), u32>,
 }
 
-impl<'a> GraphParts<'a> {
-    /// Nothing covered, no edges, over the drawn list `g`.
+impl<'a> Pairs<'a> {
+    /// No edges, over the drawn list `g`.
     fn new(g: &'a [u32]) -> Self {
-        GraphParts {
+        Pairs {
             g,
-            covered: vec![false; g.len()],
             edges: HashMap::new(),
             ties: HashMap::new(),
         }
     }
 
-    /// Adds what `other` gathered (over the same drawn list): covered flags, edge and tie
-    /// weights.
-    fn absorb(&mut self, other: GraphParts) {
-        for (c, o) in self.covered.iter_mut().zip(other.covered) {
-            *c |= o;
-        }
+    /// Adds what `other` gathered over the same drawn list: edge and tie weights.
+    fn absorb(&mut self, other: Pairs) {
         for (mine, theirs) in [(&mut self.edges, other.edges), (&mut self.ties, other.ties)] {
             for (key, w) in theirs {
                 *mine.entry(key).or_default() += w;
@@ -344,8 +343,8 @@ impl<'a> GraphParts<'a> {
         }
     }
 
-    /// Fragment `id` (+ 1) follows fragment `prev` (+ 1) at a sample, at depths `depth` and
-    /// `prev_depth`; `grown` edges go to `grown_edges` and carry no ties.
+    /// Fragment `id` (+ 1) follows fragment `prev` (+ 1) at a sample, at depths `depths`
+    /// (previous, this); `grown` edges go to `grown` and carry no ties.
     fn pair(
         &mut self,
         prev: u32,
@@ -363,6 +362,23 @@ impl<'a> GraphParts<'a> {
                     *self.ties.entry(key).or_default() += 1;
                 }
             }
+        }
+    }
+}
+
+/// A frame's graph as it is gathered: per drawn triangle whether it was covered (shared by
+/// parallel walks: a union), and the pairs.
+struct GraphParts<'a> {
+    covered: Vec<AtomicBool>,
+    pairs: Pairs<'a>,
+}
+
+impl<'a> GraphParts<'a> {
+    /// Nothing covered, no edges, over the drawn list `g`.
+    fn new(g: &'a [u32]) -> Self {
+        GraphParts {
+            covered: g.iter().map(|_| AtomicBool::new(false)).collect(),
+            pairs: Pairs::new(g),
         }
     }
 }
@@ -407,15 +423,15 @@ fn graph_frame(
     }
     let GraphParts {
         covered,
-        mut edges,
-        ties,
-        ..
+        pairs: Pairs {
+            mut edges, ties, ..
+        },
     } = parts;
     merge_grown_edges(&mut edges, grown_edges);
     let covered: Vec<u32> = covered
         .iter()
         .enumerate()
-        .filter(|(_, c)| **c)
+        .filter(|(_, c)| c.load(Relaxed))
         .map(|(k, _)| g[k])
         .collect();
     let to_edges = |m: HashMap<(u32, u32), u32>| {
@@ -431,8 +447,9 @@ fn graph_frame(
 
 /// Captures frame `frame` with `capture` into `parts` (into `grown` for the grown capture's
 /// edges): every sample's fragments in peel order, the first `max_layers` of them, walked in
-/// parallel runs of samples, each into its own parts; returns the most fragments a sample
-/// took (the layers a peel would have needed) and whether any sample had more.
+/// parallel runs of samples, each into its own pairs (covered flags are shared); returns the
+/// most fragments a sample took (the layers a peel would have needed) and whether any sample
+/// had more.
 fn capture_graph(
     capture: &std::cell::RefCell<capture::Capture>,
     frame: u32,
@@ -442,17 +459,18 @@ fn capture_graph(
 ) -> Result<(u32, bool), RecordError> {
     let max = s.max_layers as usize;
     let is_grown = grown.is_some();
-    let g = parts.g;
+    let g = parts.pairs.g;
+    let covered = &parts.covered;
     let (mut most, mut left) = (0usize, false);
     capture.borrow_mut().frame(frame, |band| {
         let runs = band.walk(
-            || (GraphParts::new(g), HashMap::new(), 0usize, false),
+            || (Pairs::new(g), HashMap::new(), 0usize, false),
             |(run, run_grown, most, left), list| {
                 *left |= list.len() > max;
                 let taken = &list[..list.len().min(max)];
                 *most = (*most).max(taken.len());
                 for (k, f) in taken.iter().enumerate() {
-                    run.covered[(f.id - 1) as usize] = true;
+                    covered[(f.id - 1) as usize].store(true, Relaxed);
                     if k > 0 {
                         let p = &taken[k - 1];
                         let to = is_grown.then_some(&mut *run_grown);
@@ -462,7 +480,7 @@ fn capture_graph(
             },
         );
         for (run, run_grown, m, l) in runs {
-            parts.absorb(run);
+            parts.pairs.absorb(run);
             if let Some(grown) = grown.as_deref_mut() {
                 for (key, w) in run_grown {
                     *grown.entry(key).or_default() += w;
@@ -494,10 +512,10 @@ fn peel_graph(
             if id == 0 {
                 continue;
             }
-            parts.covered[(id - 1) as usize] = true;
+            parts.covered[(id - 1) as usize].store(true, Relaxed);
             let prev = last_id[i];
             if prev != 0 {
-                parts.pair(
+                parts.pairs.pair(
                     prev,
                     id,
                     (last_depth[i], layer.depth[i]),

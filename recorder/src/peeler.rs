@@ -39,10 +39,7 @@ thread_local! {
 /// can show both upload the same recordings.
 #[doc(hidden)]
 pub fn with_full_texture_upload<R>(f: impl FnOnce() -> R) -> R {
-    let before = FULL_UPLOAD.with(|c| c.replace(true));
-    let r = f();
-    FULL_UPLOAD.with(|c| c.set(before));
-    r
+    with_switch(&FULL_UPLOAD, true, f)
 }
 
 /// The scene as the recorder's shaders read it, which is only what decides visibility:
@@ -68,10 +65,7 @@ pub(crate) fn visibility_scene(
 /// same recordings.
 #[doc(hidden)]
 pub fn with_interleaved_readback<R>(f: impl FnOnce() -> R) -> R {
-    let before = INTERLEAVED.with(|c| c.replace(true));
-    let r = f();
-    INTERLEAVED.with(|c| c.set(before));
-    r
+    with_switch(&INTERLEAVED, true, f)
 }
 
 /// Layers peeled and bytes read back by every peeler of the process (benchmarks).
@@ -111,7 +105,54 @@ pub(crate) fn view_texture(
 }
 
 /// Most triangles drawn by one draw call (keeps single draws and primitive ids modest).
-const CHUNK_TRIANGLES: u32 = 1 << 22;
+pub(crate) const CHUNK_TRIANGLES: u32 = 1 << 22;
+
+/// Maps the first `len` bytes of `buffer` (a `MAP_READ` buffer the last submission wrote),
+/// waits, hands them to `f` as words and unmaps.
+pub(crate) fn read_mapped<R>(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    len: u64,
+    f: impl FnOnce(&[u32]) -> R,
+) -> Result<R, RecordError> {
+    let slice = buffer.slice(..len);
+    slice.map_async(wgpu::MapMode::Read, |_| {});
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| RecordError::Device(e.to_string()))?;
+    let r = {
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| RecordError::Device(e.to_string()))?;
+        f(bytemuck::cast_slice(&data))
+    };
+    buffer.unmap();
+    Ok(r)
+}
+
+/// Runs `f` with the thread-local switch `key` set to `value`, and restores its former value
+/// afterwards, also when `f` panics (a test that fails inside must not leave the switch on for
+/// the next test on its thread).
+pub(crate) fn with_switch<T: Copy + 'static, R>(
+    key: &'static std::thread::LocalKey<std::cell::Cell<T>>,
+    value: T,
+    f: impl FnOnce() -> R,
+) -> R {
+    struct Restore<T: Copy + 'static> {
+        key: &'static std::thread::LocalKey<std::cell::Cell<T>>,
+        before: T,
+    }
+    impl<T: Copy + 'static> Drop for Restore<T> {
+        fn drop(&mut self) {
+            self.key.with(|c| c.set(self.before));
+        }
+    }
+    let _restore = Restore {
+        key,
+        before: key.with(|c| c.replace(value)),
+    };
+    f()
+}
 
 /// The peeling pipeline for one scene at one view.
 pub struct Peeler<'g> {
@@ -765,33 +806,22 @@ impl<'g> Peeler<'g> {
         self.gpu.queue.submit([enc.finish()]);
         COUNTERS[0].fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         COUNTERS[1].fetch_add(self.readback_bytes(), std::sync::atomic::Ordering::Relaxed);
-        let slice = self.staging.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        self.gpu
-            .device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RecordError::Device(e.to_string()))?;
         let mut layer = Layer {
             ids: Vec::new(),
             alpha: Vec::new(),
             depth: Vec::new(),
         };
-        {
-            let data = slice
-                .get_mapped_range()
-                .map_err(|e| RecordError::Device(e.to_string()))?;
+        read_mapped(self.gpu, &self.staging, self.staging.size(), |words| {
             if self.interleaved {
                 layer.ids.reserve(slots);
                 layer.alpha.reserve(slots);
                 layer.depth.reserve(slots);
-                let words: &[u32] = bytemuck::cast_slice(&data);
                 for s in words.chunks_exact(4) {
                     layer.ids.push(s[0]);
                     layer.alpha.push(f32::from_bits(s[1]));
                     layer.depth.push(f32::from_bits(s[2]));
                 }
             } else {
-                let words: &[u32] = bytemuck::cast_slice(&data);
                 let array = |k: usize| &words[k * slots..(k + 1) * slots];
                 layer.ids = array(0).to_vec();
                 if self.read_alpha {
@@ -801,8 +831,7 @@ impl<'g> Peeler<'g> {
                     layer.depth = bytemuck::cast_slice(array(2)).to_vec();
                 }
             }
-        }
-        self.staging.unmap();
+        })?;
         Ok(layer)
     }
 }

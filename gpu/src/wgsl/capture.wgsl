@@ -16,8 +16,9 @@
 // opaque fragment, and every fragment before it in (depth, id) order passes.
 //
 // Each kept fragment takes a node from the pool with an atomic counter and pushes it on its
-// sample's list (`atomicExchange` on the head). The counter counts every attempt, also past
-// the pool's end, so the host knows how large a pool the pass needed and draws again.
+// sample's list (`atomicExchange` on the head). Fragments that find the pool full are counted
+// apart, so the host knows how large a pool the pass needed and draws again, and the node
+// counter never passes the capacity by more than the fragments in flight (it cannot wrap).
 
 struct Capture {
     // Position in the index buffer of this draw's first triangle (primitive_index restarts
@@ -42,7 +43,9 @@ struct Node {
 @group(1) @binding(0) var<uniform> capture: Capture;
 // Per sample (pixel (x, y) sample s is (y * width + x) * samples + s): first node index + 1.
 @group(1) @binding(1) var<storage, read_write> heads: array<atomic<u32>>;
-// Fragments that asked for a node (may exceed the capacity).
+// 0: nodes taken (at most the capacity plus the fragments in flight); 1: fragments that found
+// the pool full before taking one (may wrap past 2^32 on an enormous pass); 2: non-zero once
+// any fragment found the pool full.
 @group(1) @binding(2) var<storage, read_write> counter: array<atomic<u32>, 4>;
 @group(1) @binding(3) var<storage, read_write> nodes: array<Node>;
 // Per triangle of the index buffer, its id (its position in the drawn list): the index buffer
@@ -101,10 +104,17 @@ fn fs_capture(
 }
 
 // Pushes a fragment (depth `z`, id + 1 `id1`, opacity `alpha`) on the list of `sample` of the
-// pixel at `xy`, if the pool has room (the counter counts the attempt either way).
+// pixel at `xy`, if the pool has room (the counters count the attempt either way).
 fn capture_push(xy: vec2<f32>, sample: u32, z: f32, id1: u32, alpha: f32) {
+    if (atomicLoad(&counter[0]) >= capture.capacity) {
+        atomicAdd(&counter[1], 1u);
+        atomicStore(&counter[2], 1u);
+        return;
+    }
     let n = atomicAdd(&counter[0], 1u);
     if (n >= capture.capacity) {
+        // Counted in counter[0] already.
+        atomicStore(&counter[2], 1u);
         return;
     }
     let coord = vec2<u32>(xy);
