@@ -9,9 +9,10 @@
 //! `capture_matches_peeling`), and a frame costs one pass over its triangles instead of one per
 //! layer plus the last, empty, one.
 //!
-//! The node pool starts at a fragment a sample and grows to what a pass asked for (the
-//! counter counts every attempt); a frame whose fragments exceed one storage-buffer binding is
-//! captured in bands of rows (a scissor per band), each band drawing every triangle again.
+//! The node pool starts at a fragment a sample (at most 4 Mi) and grows to what a pass asked
+//! for (fragments that find it full are counted, and the pass is drawn again); a frame whose
+//! fragments exceed one storage-buffer binding is captured in bands of rows (a scissor per
+//! band), each band drawing every triangle again.
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
