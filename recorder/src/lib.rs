@@ -155,47 +155,48 @@ enum Layers<'g> {
     Peel(Peeler<'g>),
 }
 
+/// What a phase's layers are for, which decides what is drawn and read back.
+#[derive(Clone, Copy)]
+enum Purpose {
+    /// Phase 1: ids and opacity until saturation (a capture may stop at the first opaque
+    /// fragment; a peeler reads back alpha, not depth).
+    Visibility,
+    /// Phase 2: ids and depth of every layer (a peeler reads back depth, not alpha).
+    Graphs,
+    /// Phase 2 of `record --conservative`: the triangles grown by this tolerance in pixels
+    /// ([`Peeler::grown`]).
+    Grown(f32),
+}
+
 impl<'g> Layers<'g> {
-    /// Capture where the device can (and [`with_peeling`] does not say otherwise), else a
-    /// peeler reading back `alpha` and `depth` as asked. Reading alpha means phase 1: its
-    /// capture leaves out what lies behind the nearest opaque fragment.
+    /// Capture where the device can (and [`with_peeling`] does not say otherwise), else peel,
+    /// as `purpose` needs.
     fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
         triangles: &[u32],
         frames: &[FrameState],
         view: View,
-        (alpha, depth): (bool, bool),
+        purpose: Purpose,
     ) -> Result<Self, RecordError> {
+        let (g, t, f) = (geometry, triangles, frames);
         if captures(gpu) {
-            let c = capture::Capture::new(gpu, geometry, triangles, frames, view, alpha)?;
-            Ok(Layers::Capture(std::cell::RefCell::new(c)))
-        } else {
-            Ok(Layers::Peel(
-                Peeler::new(gpu, geometry, triangles, frames, view)?.with_readback(alpha, depth),
-            ))
+            let c = match purpose {
+                Purpose::Visibility => capture::Capture::new(gpu, g, t, f, view, true)?,
+                Purpose::Graphs => capture::Capture::new(gpu, g, t, f, view, false)?,
+                Purpose::Grown(tolerance) => {
+                    capture::Capture::grown(gpu, g, t, f, view, tolerance)?
+                }
+            };
+            return Ok(Layers::Capture(std::cell::RefCell::new(c)));
         }
-    }
-
-    /// The grown layers of `record --conservative`'s phase 2 ([`Peeler::grown`]), captured
-    /// where the device can, as [`Layers::new`] decides.
-    fn grown(
-        gpu: &'g Gpu,
-        geometry: &Geometry,
-        triangles: &[u32],
-        frames: &[FrameState],
-        view: View,
-        tolerance: f32,
-    ) -> Result<Self, RecordError> {
-        if captures(gpu) {
-            let c = capture::Capture::grown(gpu, geometry, triangles, frames, view, tolerance)?;
-            Ok(Layers::Capture(std::cell::RefCell::new(c)))
-        } else {
-            Ok(Layers::Peel(
-                Peeler::grown(gpu, geometry, triangles, frames, view, tolerance)?
-                    .with_readback(false, true),
-            ))
-        }
+        Ok(Layers::Peel(match purpose {
+            Purpose::Visibility => Peeler::new(gpu, g, t, f, view)?.with_readback(true, false),
+            Purpose::Graphs => Peeler::new(gpu, g, t, f, view)?.with_readback(false, true),
+            Purpose::Grown(tolerance) => {
+                Peeler::grown(gpu, g, t, f, view, tolerance)?.with_readback(false, true)
+            }
+        }))
     }
 
     fn set_frame_subpixel_offset(&self, frame: u32, offset: [f64; 2]) {
@@ -595,8 +596,14 @@ pub fn record(
         let total = phase1_range.len() as u32;
         let mut done = total - todo.len() as u32;
         if !todo.is_empty() {
-            // Phase 1 needs ids and alpha, not depth.
-            let source = Layers::new(gpu, job.geometry, &all_ids, job.frames, view, (true, false))?;
+            let source = Layers::new(
+                gpu,
+                job.geometry,
+                &all_ids,
+                job.frames,
+                view,
+                Purpose::Visibility,
+            )?;
             let conservative = if s.robust.conservative {
                 Some(Conservative::new(
                     gpu,
@@ -666,26 +673,13 @@ pub fn record(
             let result = match partial.and_then(|p| p.load_graph(f)) {
                 Some(r) => r,
                 None => {
+                    let layers =
+                        |purpose| Layers::new(gpu, job.geometry, &g, job.frames, view, purpose);
                     if peeler.is_none() {
-                        // Phase 2 needs ids and depth (ties), not alpha.
-                        peeler = Some(Layers::new(
-                            gpu,
-                            job.geometry,
-                            &g,
-                            job.frames,
-                            view,
-                            (false, true),
-                        )?);
+                        peeler = Some(layers(Purpose::Graphs)?);
                     }
                     if s.robust.conservative && grown.is_none() {
-                        grown = Some(Layers::grown(
-                            gpu,
-                            job.geometry,
-                            &g,
-                            job.frames,
-                            view,
-                            s.robust.tolerance,
-                        )?);
+                        grown = Some(layers(Purpose::Grown(s.robust.tolerance))?);
                     }
                     let r = graph_frame(peeler.as_ref().unwrap(), grown.as_ref(), f, &g, &s)?;
                     if let Some(p) = partial {
