@@ -57,10 +57,15 @@ pub fn reference_shader() -> String {
     compose(&["primitive_index"], &format!("{PLAYER}\n{REFERENCE}"))
 }
 
-/// Depth peeling entry points (`vs_peel`, `fs_peel`); compose with [`peel_shader`].
+/// The recorder's vertex stage (`vs_record`, `RecordVarying`), shared by [`PEEL`] and
+/// [`CAPTURE`] so both rasterize the same positions.
+pub const RECORD_VERTEX: &str = include_str!("wgsl/record_vertex.wgsl");
+
+/// Depth peeling's fragment stage (`fs_peel`, after [`RECORD_VERTEX`]); compose with
+/// [`peel_shader`].
 pub const PEEL: &str = include_str!("wgsl/peel.wgsl");
 
-/// The recorder's fragment capture (`vs_capture`, `fs_capture`): every fragment of every
+/// The recorder's fragment capture (`fs_capture`, after [`RECORD_VERTEX`]): every fragment of every
 /// sample in one pass, pushed on per-sample lists; compose with [`capture_shader`].
 pub const CAPTURE: &str = include_str!("wgsl/capture.wgsl");
 
@@ -70,7 +75,7 @@ pub const CAPTURE: &str = include_str!("wgsl/capture.wgsl");
 pub fn capture_shader(early_depth_test: bool) -> String {
     compose(
         &["primitive_index"],
-        &CAPTURE.replace(
+        &format!("{RECORD_VERTEX}\n{CAPTURE}").replace(
             "EARLY_DEPTH_TEST",
             if early_depth_test {
                 "@early_depth_test(force)"
@@ -81,7 +86,7 @@ pub fn capture_shader(early_depth_test: bool) -> String {
     )
 }
 
-/// The grown capture's entry points (`vs_capture_grown`, `fs_capture_grown`); compose with
+/// The grown capture's fragment stage (`fs_capture_grown`, after [`GROW`]'s `vs_grown`); compose with
 /// [`capture_grown_shader`].
 pub const CAPTURE_GROWN: &str = include_str!("wgsl/capture_grown.wgsl");
 
@@ -93,7 +98,7 @@ pub fn capture_grown_shader() -> String {
         &["primitive_index"],
         &format!(
             "{}\n{}\n{CAPTURE_GROWN}",
-            CAPTURE.replace("EARLY_DEPTH_TEST", ""),
+            format!("{RECORD_VERTEX}\n{CAPTURE}").replace("EARLY_DEPTH_TEST", ""),
             GROW.replace("CONS_GROUP", "2")
         ),
     )
@@ -149,7 +154,10 @@ fn peel_types(body: &str, samples: u32) -> String {
 
 /// The complete peel shader for a sample count (needs `Features::PRIMITIVE_INDEX`).
 pub fn peel_shader(samples: u32) -> String {
-    compose(&["primitive_index"], &peel_types(PEEL, samples))
+    compose(
+        &["primitive_index"],
+        &peel_types(&format!("{RECORD_VERTEX}\n{PEEL}"), samples),
+    )
 }
 
 /// The complete gather shader for a sample count (stand-alone: no shared bindings).
@@ -247,7 +255,7 @@ pub fn conservative_shader(samples: u32) -> String {
     )
 }
 
-/// The grown peel's entry points (`vs_peel_grown`, `fs_peel_grown`); compose with
+/// The grown peel's fragment stage (`fs_peel_grown`, after [`GROW`]'s `vs_grown`); compose with
 /// [`peel_grown_shader`].
 pub const PEEL_GROWN: &str = include_str!("wgsl/peel_grown.wgsl");
 
@@ -258,7 +266,10 @@ pub fn peel_grown_shader(samples: u32) -> String {
     compose(
         &["primitive_index"],
         &peel_types(
-            &format!("{PEEL}\n{}\n{PEEL_GROWN}", GROW.replace("CONS_GROUP", "2")),
+            &format!(
+                "{RECORD_VERTEX}\n{PEEL}\n{}\n{PEEL_GROWN}",
+                GROW.replace("CONS_GROUP", "2")
+            ),
             samples,
         ),
     )

@@ -228,7 +228,7 @@ impl<'g> Capture<'g> {
                 layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module: &module,
-                    entry_point: Some("vs_capture"),
+                    entry_point: Some("vs_record"),
                     compilation_options: Default::default(),
                     buffers: &[Some(vertex_layout())],
                 },
@@ -297,7 +297,7 @@ impl<'g> Capture<'g> {
                     "grown capture",
                     &[&scene.layout, &layout, &grow_layout],
                     &module,
-                    ("vs_capture_grown", "fs_capture_grown"),
+                    ("vs_grown", "fs_capture_grown"),
                     None,
                     Some((wgpu::TextureFormat::Depth32Float, compare)),
                     view.samples,

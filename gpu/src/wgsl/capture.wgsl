@@ -60,28 +60,10 @@ struct Node {
 // both sides of a branch on the material, so the texture is left out by specialising.
 override READS_ALPHA: bool = true;
 
-struct CaptureVarying {
-    @invariant @builtin(position) position: vec4<f32>,
-    @location(0) @interpolate(flat) material: u32,
-    // Alpha from textures is evaluated at the pixel centre, as the peel and the player do.
-    @location(1) @interpolate(perspective, center) uv: vec2<f32>,
-    @location(2) @interpolate(perspective, center) uv1: vec2<f32>,
-}
-
-@vertex
-fn vs_capture(v: VertexIn) -> CaptureVarying {
-    var out: CaptureVarying;
-    out.position = transform_position(v.position, v.node);
-    out.material = v.material;
-    out.uv = v.uv;
-    out.uv1 = v.uv1;
-    return out;
-}
-
 EARLY_DEPTH_TEST
 @fragment
 fn fs_capture(
-    in: CaptureVarying,
+    in: RecordVarying,
     @builtin(front_facing) front_facing: bool,
     @builtin(sample_index) sample: u32,
     @builtin(primitive_index) primitive: u32,

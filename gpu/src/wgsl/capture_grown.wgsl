@@ -6,29 +6,16 @@
 // (depth, id) as the grown peel's layers would come. Ids are positions in the drawn list (the
 // non-indexed draw's triangle); opacity is 1 (phase 2 reads none).
 
-@vertex
-fn vs_capture_grown(@builtin(vertex_index) vi: u32) -> ConsVarying {
-    return cons_corner(vi / 3u, vi % 3u, 1.0);
-}
-
 @fragment
 fn fs_capture_grown(
     in: ConsVarying,
     @builtin(front_facing) front_facing: bool,
     @builtin(sample_index) sample: u32,
 ) {
-    if (culled(in.material, front_facing)) {
-        return;
-    }
-    var z = in.position.z;
-    if (in.plane.w > 0.5) {
-        if (!cons_inside(in, 1.0)) {
-            return;
-        }
-        z = clamp(cons_plane_depth(in), 0.0, 1.0);
-    }
+    let grown = cons_grown_depth(in, front_facing);
+    let z = grown.x;
     // The grown peel writes z as its depth and tests `Less` against the cleared 1.0.
-    if (!(z < 1.0)) {
+    if (grown.y < 0.5 || !(z < 1.0)) {
         return;
     }
     capture_push(in.position.xy, sample, z, in.tri + 1u, 1.0);

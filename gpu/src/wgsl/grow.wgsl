@@ -175,3 +175,26 @@ fn cons_occludes(material: u32) -> bool {
     return u32(m.params.x) == 0u && m.emissive.a <= 0.0;
 }
 
+// The grown peel's and grown capture's vertex stage: triangle `vi / 3` of the drawn list, grown
+// by the box.
+@vertex
+fn vs_grown(@builtin(vertex_index) vi: u32) -> ConsVarying {
+    return cons_corner(vi / 3u, vi % 3u, 1.0);
+}
+
+// A grown fragment: x, the depth it is recorded at (its triangle's plane at the sample,
+// clamped to [0, 1]; the interpolated depth where the plane is not valid); y, 1 where it is
+// kept and 0 where it is dropped (a culled back face, or a sample the grown triangle does not
+// reach).
+fn cons_grown_depth(in: ConsVarying, front_facing: bool) -> vec2<f32> {
+    if (culled(in.material, front_facing)) {
+        return vec2<f32>(0.0, 0.0);
+    }
+    if (in.plane.w > 0.5) {
+        if (!cons_inside(in, 1.0)) {
+            return vec2<f32>(0.0, 0.0);
+        }
+        return vec2<f32>(clamp(cons_plane_depth(in), 0.0, 1.0), 1.0);
+    }
+    return vec2<f32>(in.position.z, 1.0);
+}

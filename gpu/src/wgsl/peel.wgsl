@@ -19,24 +19,6 @@ struct Peel {
 // Per sample: non-zero once the sample is saturated or has no fragment left.
 @group(1) @binding(3) var<storage, read> done: array<u32>;
 
-struct PeelVarying {
-    @invariant @builtin(position) position: vec4<f32>,
-    @location(0) @interpolate(flat) material: u32,
-    // Alpha from textures is evaluated at the pixel centre, as the player evaluates it.
-    @location(1) @interpolate(perspective, center) uv: vec2<f32>,
-    @location(2) @interpolate(perspective, center) uv1: vec2<f32>,
-}
-
-@vertex
-fn vs_peel(v: VertexIn) -> PeelVarying {
-    var out: PeelVarying;
-    out.position = transform_position(v.position, v.node);
-    out.material = v.material;
-    out.uv = v.uv;
-    out.uv1 = v.uv1;
-    return out;
-}
-
 struct PeelOut {
     // x: id + 1 (0 = no fragment), y: alpha bits.
     @location(0) ids: vec2<u32>,
@@ -62,7 +44,7 @@ fn peeled_before(coord: vec2<i32>, sample: u32, z: f32, id: u32) -> bool {
 
 @fragment
 fn fs_peel(
-    in: PeelVarying,
+    in: RecordVarying,
     @builtin(front_facing) front_facing: bool,
     @builtin(sample_index) sample: u32,
     @builtin(primitive_index) primitive: u32,

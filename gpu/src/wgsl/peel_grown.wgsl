@@ -6,11 +6,6 @@
 // triangle's edges); its id is its position in the drawn list (the non-indexed draw's
 // triangle, no primitive index needed). Alpha is not evaluated (phase 2 needs none): 1.
 
-@vertex
-fn vs_peel_grown(@builtin(vertex_index) vi: u32) -> ConsVarying {
-    return cons_corner(vi / 3u, vi % 3u, 1.0);
-}
-
 @fragment
 fn fs_peel_grown(
     in: ConsVarying,
@@ -21,16 +16,11 @@ fn fs_peel_grown(
     if (peel_done(coord, sample)) {
         discard;
     }
-    if (culled(in.material, front_facing)) {
+    let grown = cons_grown_depth(in, front_facing);
+    if (grown.y < 0.5) {
         discard;
     }
-    var z = in.position.z;
-    if (in.plane.w > 0.5) {
-        if (!cons_inside(in, 1.0)) {
-            discard;
-        }
-        z = clamp(cons_plane_depth(in), 0.0, 1.0);
-    }
+    let z = grown.x;
     let id = in.tri;
     if (peeled_before(coord, sample, z, id)) {
         discard;
