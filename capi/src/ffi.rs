@@ -432,6 +432,21 @@ unsafe fn c_path(s: *const c_char, what: &str) -> Result<PathBuf, Failure> {
     Ok(PathBuf::from(s))
 }
 
+/// The length half of the copy conventions of the module documentation: writes `n` to `*len`
+/// when `len` is given, and says whether to copy (`out` is given). Both null is a failure.
+///
+/// # Safety
+/// `len` is null or valid for one write.
+unsafe fn report_len<T>(n: usize, out: *mut T, len: *mut usize) -> Result<bool, Failure> {
+    if !len.is_null() {
+        *len = n;
+    }
+    if out.is_null() && len.is_null() {
+        return Err(null("both out and len are"));
+    }
+    Ok(!out.is_null())
+}
+
 /// Copies `src` to the host's buffer under the conventions of the module documentation.
 ///
 /// # Safety
@@ -442,13 +457,7 @@ unsafe fn copy_out<T: Copy>(
     cap: usize,
     len: *mut usize,
 ) -> Result<(), Failure> {
-    if !len.is_null() {
-        *len = src.len();
-    }
-    if out.is_null() {
-        if len.is_null() {
-            return Err(null("both out and len are"));
-        }
+    if !report_len(src.len(), out, len)? {
         return Ok(());
     }
     if cap < src.len() {
@@ -484,13 +493,7 @@ unsafe fn copy_string(
     cap: usize,
     len: *mut usize,
 ) -> Result<(), Failure> {
-    if !len.is_null() {
-        *len = s.len();
-    }
-    if out.is_null() {
-        if len.is_null() {
-            return Err(null("both out and len are"));
-        }
+    if !report_len(s.len(), out, len)? {
         return Ok(());
     }
     if cap <= s.len() {
