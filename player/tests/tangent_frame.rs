@@ -59,14 +59,7 @@ fn a_mirrored_node_draws_its_normal_map_mirrored() {
         for v in g.vertices.iter_mut().filter(|v| v.material == 2) {
             v.node = 1;
         }
-        let vertices = &g.vertices;
-        for t in g
-            .triangles
-            .iter_mut()
-            .filter(|t| vertices[t[0] as usize].material == 2)
-        {
-            t.swap(1, 2);
-        }
+        reverse_winding(g, 2);
     });
     let image = pbr(&gpu, &plain);
     let d = max_diff(&pbr(&gpu, &twin), &mirrored_image(&image));
@@ -155,14 +148,7 @@ fn a_double_sided_back_face_reverses_the_mapped_normal() {
             v.normal = [0.0, 0.0, -1.0];
             v.tangent = [1.0, 0.0, 0.0, 1.0];
         }
-        let vertices = &g.vertices;
-        for t in g
-            .triangles
-            .iter_mut()
-            .filter(|t| vertices[t[0] as usize].material == 2)
-        {
-            t.swap(1, 2);
-        }
+        reverse_winding(g, 2);
     });
     // −(t·x + b·y + n·z) with t = +X, b = cross(−Z, +X) = −Y, n = −Z is (−x, y, z): a
     // front face with normal +Z, tangent −X and handedness −1 (b = +Y) maps to the same.
@@ -176,4 +162,17 @@ fn a_double_sided_back_face_reverses_the_mapped_normal() {
     // The check can fail: the sun (from +X) tells the map's x from its mirror.
     let d = max_diff(&pbr(&gpu, &front), &pbr(&gpu, &mapped(TILT)));
     assert!(d >= 8, "the map's x changes the image by only {d}/255");
+}
+
+/// Reverses the winding of material `material`'s triangles in `g` (as the importer does for a
+/// mirrored instance, or to turn a face around).
+fn reverse_winding(g: &mut trisort_format::Geometry, material: u32) {
+    let vertices = &g.vertices;
+    for t in g
+        .triangles
+        .iter_mut()
+        .filter(|t| vertices[t[0] as usize].material == material)
+    {
+        t.swap(1, 2);
+    }
 }

@@ -8,7 +8,7 @@ use trisort_format::RecordSettings;
 use trisort_recorder::{capture_counters, with_peeling, with_pool_limits};
 use trisort_scene::Scene;
 
-use crate::compact_readback::{assert_switch_keeps_recording, variants};
+use crate::compact_readback::{assert_switch_keeps_recording, shared_scene, variants};
 
 fn capture_matches_peeling(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) {
     assert_switch_keeps_recording(
@@ -58,10 +58,9 @@ fn capture_matches_peeling_on_a_real_scene() {
     let Some(gpu) = trisort_testkit::gpu() else {
         return;
     };
-    let Some(path) = trisort_testkit::scene_path("GlassVaseFlowers/GlassVaseFlowers.glb") else {
+    let Some(scene) = shared_scene("GlassVaseFlowers/GlassVaseFlowers.glb") else {
         return;
     };
-    let scene = trisort_scene::load(&path).expect("scene loads");
     for s in variants() {
         capture_matches_peeling(&gpu, &scene, s);
     }
@@ -72,10 +71,9 @@ fn capture_matches_peeling_on_car_concept() {
     let Some(gpu) = trisort_testkit::gpu() else {
         return;
     };
-    let Some(path) = trisort_testkit::scene_path("CarConcept/CarConcept.glb") else {
+    let Some(scene) = shared_scene("CarConcept/CarConcept.glb") else {
         return;
     };
-    let scene = trisort_scene::load(&path).expect("scene loads");
     // Plain at 4×, glass recorded at the demo's 0.35 (so it saturates part-way).
     let s = RecordSettings {
         glass_opacity: 0.35,

@@ -64,6 +64,13 @@ fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) 
     });
 }
 
+/// The shared scene at `rel` under `TRISORT_SCENES`, loaded; `None` (the test skips) where
+/// the scenes are absent and not required.
+pub(crate) fn shared_scene(rel: &str) -> Option<Scene> {
+    let path = trisort_testkit::scene_path(rel)?;
+    Some(trisort_scene::load(&path).expect("scene loads"))
+}
+
 /// Plain, robust and conservative at 4×, and plain at 1×, at 64×64.
 pub(crate) fn variants() -> Vec<RecordSettings> {
     let base = RecordSettings {
@@ -108,10 +115,9 @@ fn compact_readback_records_a_real_scene_as_before() {
     let Some(gpu) = trisort_testkit::gpu() else {
         return;
     };
-    let Some(path) = trisort_testkit::scene_path("GlassVaseFlowers/GlassVaseFlowers.glb") else {
+    let Some(scene) = shared_scene("GlassVaseFlowers/GlassVaseFlowers.glb") else {
         return;
     };
-    let scene = trisort_scene::load(&path).expect("scene loads");
     for s in variants() {
         record_both(&gpu, &scene, s);
     }

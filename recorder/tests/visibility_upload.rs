@@ -8,7 +8,7 @@ use trisort_gpu::scene_gpu::{SceneGpu, View};
 use trisort_recorder::with_full_texture_upload;
 use trisort_scene::Scene;
 
-use crate::compact_readback::{assert_switch_keeps_recording, variants};
+use crate::compact_readback::{assert_switch_keeps_recording, shared_scene, variants};
 
 /// Records three frames of `scene`'s orbit with the visibility-only and the full upload, for
 /// every settings of [`variants`], and asserts the bytes agree.
@@ -51,6 +51,21 @@ fn first_frame(scene: &Scene) -> Vec<FrameState> {
     timeline.frames[..1].to_vec()
 }
 
+/// Texture bytes on the GPU of `scene` uploaded as a player does and for visibility (first
+/// frame).
+fn texture_bytes(gpu: &trisort_gpu::Gpu, scene: &Scene) -> (u64, u64) {
+    let (device, queue, g, f) = (
+        &gpu.device,
+        &gpu.queue,
+        &scene.geometry,
+        &first_frame(scene),
+    );
+    (
+        SceneGpu::new(device, queue, g, f, view()).texture_bytes(),
+        SceneGpu::for_visibility(device, queue, g, f, view()).texture_bytes(),
+    )
+}
+
 fn view() -> View {
     View {
         width: 64,
@@ -67,14 +82,8 @@ fn the_visibility_upload_records_the_demo_car_with_linear_maps_as_the_full_one()
     };
     let scene = demo_car_with_linear_maps();
     // Not vacuous: the linear map is left out.
-    let (device, queue, g, f) = (
-        &gpu.device,
-        &gpu.queue,
-        &scene.geometry,
-        &first_frame(&scene),
-    );
-    let full = SceneGpu::new(device, queue, g, f, view()).texture_bytes();
-    let visibility = SceneGpu::for_visibility(device, queue, g, f, view()).texture_bytes();
+    let g = &scene.geometry;
+    let (full, visibility) = texture_bytes(&gpu, &scene);
     let maps = g.textures.last().unwrap().byte_len();
     // Less the white texel left in its place (two layers of it on GL).
     assert!(
@@ -99,16 +108,8 @@ fn a_linear_base_colour_texture_is_uploaded_for_visibility() {
         .find_map(|m| m.base_color_texture)
         .expect("the demo car's plate is textured") as usize;
     scene.geometry.textures[plate].srgb = false;
-    let (device, queue, g, f) = (
-        &gpu.device,
-        &gpu.queue,
-        &scene.geometry,
-        &first_frame(&scene),
-    );
-    assert_eq!(
-        SceneGpu::for_visibility(device, queue, g, f, view()).texture_bytes(),
-        SceneGpu::new(device, queue, g, f, view()).texture_bytes()
-    );
+    let (full, visibility) = texture_bytes(&gpu, &scene);
+    assert_eq!(visibility, full);
 }
 
 #[test]
@@ -116,10 +117,10 @@ fn the_visibility_upload_records_a_real_scene_as_the_full_one() {
     let Some(gpu) = trisort_testkit::gpu() else {
         return;
     };
-    let Some(path) = trisort_testkit::scene_path("GlassVaseFlowers/GlassVaseFlowers.glb") else {
+    let Some(scene) = shared_scene("GlassVaseFlowers/GlassVaseFlowers.glb") else {
         return;
     };
-    record_both(&gpu, &trisort_scene::load(&path).expect("scene loads"));
+    record_both(&gpu, &scene);
 }
 
 /// CarConcept's linear maps are most of its texture memory; the recorder leaves them out.
@@ -129,18 +130,11 @@ fn the_visibility_upload_of_car_concept_leaves_out_its_linear_maps() {
     let Some(gpu) = trisort_testkit::gpu() else {
         return;
     };
-    let Some(path) = trisort_testkit::scene_path("CarConcept/CarConcept.glb") else {
+    let Some(scene) = shared_scene("CarConcept/CarConcept.glb") else {
         return;
     };
-    let scene = trisort_scene::load(&path).expect("scene loads");
-    let (device, queue, g, f) = (
-        &gpu.device,
-        &gpu.queue,
-        &scene.geometry,
-        &first_frame(&scene),
-    );
-    let full = SceneGpu::new(device, queue, g, f, view()).texture_bytes();
-    let visibility = SceneGpu::for_visibility(device, queue, g, f, view()).texture_bytes();
+    let g = &scene.geometry;
+    let (full, visibility) = texture_bytes(&gpu, &scene);
     let linear: u64 = g
         .textures
         .iter()
