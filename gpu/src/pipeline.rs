@@ -1,4 +1,5 @@
-//! Descriptor helpers: full-screen pipelines beyond
+//! Descriptor helpers: buffer entries of bind group layouts, bind groups by position,
+//! full-screen pipelines beyond
 //! [`ScenePipeline`](crate::scene_gpu::ScenePipeline) (passes that read a frame or per-sample
 //! lists and write one target) and the 2D textures every target is made of.
 
@@ -70,5 +71,65 @@ pub fn fullscreen(
         }),
         multiview_mask: None,
         cache: None,
+    })
+}
+
+/// A storage-buffer entry of a bind group layout at `binding`, seen by `visibility`.
+pub fn storage_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A uniform-buffer entry of a bind group layout at `binding`, seen by `visibility`, with
+/// dynamic offsets where `dynamic` and a minimum size of `min_size` bytes where given.
+pub fn uniform_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    dynamic: bool,
+    min_size: Option<u64>,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: dynamic,
+            min_binding_size: min_size.and_then(wgpu::BufferSize::new),
+        },
+        count: None,
+    }
+}
+
+/// A bind group of `layout` whose bindings 0, 1, 2, … are `resources` in order.
+pub fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[wgpu::BindingResource],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = resources
+        .iter()
+        .enumerate()
+        .map(|(binding, resource)| wgpu::BindGroupEntry {
+            binding: binding as u32,
+            resource: resource.clone(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
     })
 }

@@ -419,16 +419,7 @@ pub fn previous_key_entries(samples: u32) -> [wgpu::BindGroupLayoutEntry; 3] {
         count: None,
     };
     [
-        wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: true,
-                min_binding_size: wgpu::BufferSize::new(16),
-            },
-            count: None,
-        },
+        crate::pipeline::uniform_entry(0, wgpu::ShaderStages::FRAGMENT, true, Some(16)),
         texture(1, wgpu::TextureSampleType::Depth),
         texture(2, wgpu::TextureSampleType::Uint),
     ]

@@ -6,6 +6,7 @@
 use std::ops::Range;
 
 use trisort_format::{FrameState, Geometry};
+use trisort_gpu::pipeline::{bind_group, storage_entry, uniform_entry};
 use trisort_gpu::scene_gpu::{
     begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
 };
@@ -240,26 +241,8 @@ fn gather_pipeline(
         entries: &[
             tex(0, wgpu::TextureSampleType::Uint),
             tex(1, wgpu::TextureSampleType::Depth),
-            wgpu::BindGroupLayoutEntry {
-                binding: 2,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: false },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
+            storage_entry(2, wgpu::ShaderStages::COMPUTE, false),
+            uniform_entry(3, wgpu::ShaderStages::COMPUTE, false, None),
         ],
     });
     let gather_pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -375,16 +358,7 @@ impl<'g> Peeler<'g> {
                 previous[0],
                 previous[1],
                 previous[2],
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                storage_entry(3, wgpu::ShaderStages::FRAGMENT, true),
             ],
         });
         let depth_less = Some((DEPTH_FORMAT, wgpu::CompareFunction::Less, true));
@@ -676,34 +650,21 @@ impl<'g> Peeler<'g> {
         prev_depth: &wgpu::TextureView,
         prev_ids: &wgpu::TextureView,
     ) -> wgpu::BindGroup {
-        self.gpu
-            .device
-            .create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("peel"),
-                layout: &self.peel_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &self.params,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(16),
-                        }),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(prev_depth),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(prev_ids),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: self.done.as_entire_binding(),
-                    },
-                ],
-            })
+        bind_group(
+            &self.gpu.device,
+            "peel",
+            &self.peel_layout,
+            &[
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &self.params,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(16),
+                }),
+                wgpu::BindingResource::TextureView(prev_depth),
+                wgpu::BindingResource::TextureView(prev_ids),
+                self.done.as_entire_binding(),
+            ],
+        )
     }
 
     fn layer(
@@ -719,28 +680,17 @@ impl<'g> Peeler<'g> {
         let depth_views = [dv(&self.depth[0]), dv(&self.depth[1])];
         let id_views = [dv(&self.ids[0]), dv(&self.ids[1])];
         let peel_bg = self.peel_bind_group(&depth_views[prev], &id_views[prev]);
-        let gather_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gather"),
-            layout: &self.gather_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&id_views[cur]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&depth_views[cur]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: self.out.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: self.dims.as_entire_binding(),
-                },
+        let gather_bg = bind_group(
+            device,
+            "gather",
+            &self.gather_layout,
+            &[
+                wgpu::BindingResource::TextureView(&id_views[cur]),
+                wgpu::BindingResource::TextureView(&depth_views[cur]),
+                self.out.as_entire_binding(),
+                self.dims.as_entire_binding(),
             ],
-        });
+        );
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("peel layer"),
         });

@@ -29,6 +29,7 @@ use trisort_format::{
     Baked, DrawIndexedIndirectArgs, Environment, FrameState, FrameWindow, Geometry, RecordSettings,
     Recording,
 };
+use trisort_gpu::pipeline::{storage_entry, uniform_entry};
 use trisort_gpu::scene_gpu::{Lighting, SceneGpu, ScenePipeline, View};
 use trisort_gpu::Gpu;
 use trisort_gpu::{clear_colour, halves, quantize_rgba16f, BACKGROUND, COLOR_FORMAT};
@@ -286,31 +287,13 @@ impl<'g> ExactReference<'g> {
         let device = &gpu.device;
         let shading = lighting.shading;
         let scene = lit_scene(gpu, geometry, frames, view, lighting);
-        let storage = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
+        let fragment = wgpu::ShaderStages::FRAGMENT;
         let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("reference composite"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: wgpu::BufferSize::new(16),
-                    },
-                    count: None,
-                },
-                storage(1),
-                storage(2),
+                uniform_entry(0, fragment, false, Some(16)),
+                storage_entry(1, fragment, true),
+                storage_entry(2, fragment, true),
             ],
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
