@@ -144,9 +144,9 @@ pub fn with_peeling<R>(f: impl FnOnce() -> R) -> R {
 
 /// Whether recordings on `gpu` capture (one pass a frame) rather than peel: the device can
 /// ([`capture::supported`]: primitive ids and writable storage in fragment shaders), and
-/// neither [`with_peeling`] nor [`with_interleaved_readback`] asks for peeling.
+/// [`with_peeling`] does not ask for peeling.
 fn captures(gpu: &Gpu) -> bool {
-    capture::supported(gpu) && !PEELING.with(|c| c.get()) && !peeler::interleaved()
+    capture::supported(gpu) && !PEELING.with(|c| c.get())
 }
 
 /// Where a phase's layers come from: one capture pass a frame, or one peel pass a layer.
@@ -227,7 +227,7 @@ fn visibility_frame(
     // Per drawn triangle (phase 1 draws every scene triangle, in id order): reached before
     // saturation. One flag a triangle instead of one entry a sample and layer to sort.
     let interleaved = peeler::interleaved();
-    let reached: Vec<AtomicBool> = (0..if interleaved { 0 } else { source.triangles() })
+    let reached: Vec<AtomicBool> = (0..source.triangles())
         .map(|_| AtomicBool::new(false))
         .collect();
     let residual = 1.0 - s.saturation;

@@ -61,9 +61,10 @@ pub(crate) fn visibility_scene(
 
 /// Runs `f` with the recorder's former readback on this thread: peelers built inside gather
 /// every layer interleaved (16 bytes a sample, all fields read back and unpacked sample by
-/// sample), and phase 1 lists visible triangles sample by sample. Kept only so that tests and
-/// the benchmark can compare the compact readback against it in one process: both give the
-/// same recordings.
+/// sample), and phase 1 lists visible triangles sample by sample when it peels. Kept only so
+/// that tests can compare the compact readback against it in one process (inside
+/// [`crate::with_peeling`]: a recording that captures reads back no layers): both give the same
+/// recordings.
 #[doc(hidden)]
 pub fn with_interleaved_readback<R>(f: impl FnOnce() -> R) -> R {
     with_switch(&INTERLEAVED, true, f)
