@@ -89,6 +89,22 @@ struct Prepass {
     indices: [(wgpu::Buffer, u32); 2],
 }
 
+/// How a capture grows its triangles: as the grown peel's (phase 2 of `--conservative`), or
+/// with the envelope's depths and flags (its phase 1), with the opposite-vertex table.
+#[derive(Clone, Copy)]
+enum Grow<'a> {
+    Peel(f32),
+    Envelope(f32, &'a [[u32; 4]]),
+}
+
+impl Grow<'_> {
+    fn tolerance(&self) -> f32 {
+        match self {
+            Grow::Peel(t) | Grow::Envelope(t, _) => *t,
+        }
+    }
+}
+
 struct Pool {
     capacity: u64,
     nodes: wgpu::Buffer,
@@ -132,7 +148,33 @@ impl<'g> Capture<'g> {
             frames,
             view,
             false,
-            Some(tolerance),
+            Some(Grow::Peel(tolerance)),
+        )
+    }
+
+    /// The envelope capture of `record --conservative`'s phase 1 (`capture_grown.wgsl`,
+    /// [`crate::envelope`]): [`Capture::grown`]'s fragments, each with its plane's nearest depth
+    /// over the tolerance box as its depth, its farthest as its opacity, and flags above the id
+    /// (whether it occludes, which of its edges cross the box and which are closable).
+    /// `opposite` holds per drawn triangle the vertex across each edge
+    /// ([`crate::envelope::Adjacency`]).
+    pub fn envelope(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        triangles: &[u32],
+        frames: &[FrameState],
+        view: View,
+        tolerance: f32,
+        opposite: &[[u32; 4]],
+    ) -> Result<Self, RecordError> {
+        Capture::build(
+            gpu,
+            geometry,
+            triangles,
+            frames,
+            view,
+            false,
+            Some(Grow::Envelope(tolerance, opposite)),
         )
     }
 
@@ -143,7 +185,7 @@ impl<'g> Capture<'g> {
         frames: &[FrameState],
         view: View,
         until_opaque: bool,
-        grow: Option<f32>,
+        grow: Option<Grow>,
     ) -> Result<Self, RecordError> {
         let device = &gpu.device;
         // Before anything is allocated: the list heads must fit one binding.
@@ -254,24 +296,56 @@ impl<'g> Capture<'g> {
                 });
                 (Vec::from(pipelines), None)
             }
-            Some(tolerance) => {
+            Some(grow) => {
+                let tolerance = grow.tolerance();
                 let buffers = GrowBuffers::new(device, geometry, triangles, view, tolerance);
+                let mut layout_entries = GrowBuffers::layout_entries().to_vec();
+                let mut entries = buffers.entries().to_vec();
+                let opposite = match grow {
+                    Grow::Peel(_) => None,
+                    Grow::Envelope(_, opposite) => {
+                        let empty = [[u32::MAX; 4]];
+                        let data = if opposite.is_empty() {
+                            &empty[..]
+                        } else {
+                            opposite
+                        };
+                        Some(
+                            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                                label: Some("envelope opposite vertices"),
+                                contents: bytemuck::cast_slice(data),
+                                usage: wgpu::BufferUsages::STORAGE,
+                            }),
+                        )
+                    }
+                };
+                if let Some(opposite) = &opposite {
+                    layout_entries.push(storage_entry(3, wgpu::ShaderStages::VERTEX, true));
+                    entries.push(wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: opposite.as_entire_binding(),
+                    });
+                }
                 let grow_layout =
                     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                         label: Some("grown capture"),
-                        entries: &GrowBuffers::layout_entries(),
+                        entries: &layout_entries,
                     });
                 let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("grown capture"),
                     layout: &grow_layout,
-                    entries: &buffers.entries(),
+                    entries: &entries,
                 });
+                let stages = match grow {
+                    Grow::Peel(_) => ("vs_grown", "fs_capture_grown"),
+                    Grow::Envelope(..) => ("vs_envelope", "fs_capture_envelope"),
+                };
                 let pipeline = pulled_pipeline(
                     device,
                     "grown capture",
                     &[&scene.layout, &layout, &grow_layout],
                     &module,
-                    ("vs_grown", "fs_capture_grown"),
+                    stages,
                     None,
                     Some((wgpu::TextureFormat::Depth32Float, compare)),
                     view.samples,

@@ -25,6 +25,7 @@ mod capture;
 mod conservative;
 #[cfg(test)]
 mod coverage_test;
+mod envelope;
 pub mod partial;
 mod peeler;
 
@@ -132,6 +133,17 @@ fn view_of(s: &RecordSettings) -> View {
 thread_local! {
     /// See [`with_peeling`].
     static PEELING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    static CONSERVATIVE_PASSES: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f` with `--conservative` recordings made inside it taking phase 1's extra triangles
+/// from the three conservative passes ([`Conservative`]: the nearest opaque surface as samples
+/// see it, spread over their neighbours) even where the device can capture the envelope bound
+/// (`envelope.rs`). The passes are what devices without capture use; kept callable so tests
+/// can record with them on any device.
+#[doc(hidden)]
+pub fn with_conservative_passes<R>(f: impl FnOnce() -> R) -> R {
+    peeler::with_switch(&CONSERVATIVE_PASSES, true, f)
 }
 
 /// Runs `f` with recordings made inside it by depth peeling, one pass per layer, even where the
@@ -214,12 +226,28 @@ impl<'g> Layers<'g> {
     }
 }
 
+/// Phase 1's conservative set: the envelope bound where the device can capture
+/// ([`envelope`]), else the three conservative passes ([`Conservative`]).
+enum PhaseOneConservative<'g> {
+    Envelope(envelope::Envelope<'g>),
+    Passes(Conservative<'g>),
+}
+
+impl PhaseOneConservative<'_> {
+    fn visible(&self, frame: u32) -> Result<Vec<u32>, RecordError> {
+        match self {
+            PhaseOneConservative::Envelope(e) => e.visible(frame),
+            PhaseOneConservative::Passes(c) => c.visible(frame),
+        }
+    }
+}
+
 /// Phase 1 of one frame: the visible set, layers used, and whether `max_layers` truncated it.
 /// With robust settings, the union over the sample patterns of [`Robust::offsets`] (layers
 /// add up) and the conservative pass's triangles.
 fn visibility_frame(
     source: &Layers,
-    conservative: Option<&Conservative>,
+    conservative: Option<&PhaseOneConservative>,
     frame: u32,
     s: &RecordSettings,
 ) -> Result<Visibility, RecordError> {
@@ -605,13 +633,15 @@ pub fn record(
                 Purpose::Visibility,
             )?;
             let conservative = if s.robust.conservative {
-                Some(Conservative::new(
-                    gpu,
-                    job.geometry,
-                    job.frames,
-                    view,
-                    s.robust.tolerance,
-                )?)
+                let (g, f, t) = (job.geometry, job.frames, s.robust.tolerance);
+                // The envelope needs a capture, but not the layers' switch: recordings peeled
+                // by `with_peeling` take the same conservative set as captured ones.
+                let passes = CONSERVATIVE_PASSES.with(|c| c.get());
+                Some(if capture::supported(gpu) && !passes {
+                    PhaseOneConservative::Envelope(envelope::Envelope::new(gpu, g, f, view, t)?)
+                } else {
+                    PhaseOneConservative::Passes(Conservative::new(gpu, g, f, view, t)?)
+                })
             } else {
                 None
             };

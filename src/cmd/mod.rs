@@ -86,10 +86,12 @@ pub struct RecordOpts {
     /// or a modest resize opens fewer holes (costs N times the peel).
     #[arg(long, value_name = "N", default_value_t = RecordSettings::default().robust.patterns)]
     pub robust: u32,
-    /// Robust recording: also keep every triangle whose footprint grown by --robust-tolerance
-    /// pixels reaches a sample not behind the nearest opaque surface's farthest depth over
-    /// the sample's tolerance box, with the edges of a peel of the grown triangles (three
-    /// passes per frame in phase 1, a grown peel in phase 2).
+    /// Robust recording: also keep every triangle that may be the nearest surface somewhere in
+    /// a sample's box of ±--robust-tolerance pixels: its footprint grown by the box reaches the
+    /// sample and it is not behind a bound on the nearest opaque surface over the whole box
+    /// (one capture of the grown triangles per frame in phase 1, whose opaque triangles bound
+    /// the box where they close over it; three passes on devices that cannot capture), with
+    /// the edges of the grown triangles' layers (phase 2).
     #[arg(long)]
     pub conservative: bool,
     /// Tolerance in pixels of --robust's jittered patterns and of --conservative.

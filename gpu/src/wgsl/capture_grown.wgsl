@@ -20,3 +20,116 @@ fn fs_capture_grown(
     }
     capture_push(in.position.xy, sample, z, in.tri + 1u, 1.0);
 }
+
+// The envelope capture (record --conservative, phase 1): the grown capture's fragments with
+// what the host needs to bound, per sample, how far the nearest opaque surface can lie
+// anywhere in the sample's tolerance box (recorder/src/envelope.rs). A node holds the plane's
+// nearest depth over the box (as its depth), its farthest (as its opacity) and, above the id's
+// ENVELOPE_ID_BITS, the flags below.
+
+// Per triangle of the drawn list: for edge k (corner k to corner k + 1), the vertex of the
+// triangle across it opposite the edge, or 0xffffffff where the edge has no single neighbour.
+@group(2) @binding(3) var<storage, read> cons_opposite: array<vec4<u32>>;
+
+// Flag bits above the id: the triangle occludes (opaque, its plane valid); edge k crosses the
+// box (bits 1–3); edge k is closable (bits 4–6).
+const ENVELOPE_ID_BITS: u32 = 24u;
+const ENVELOPE_OCCLUDES: u32 = 1u;
+
+// Corner `corner` of grown triangle `vi / 3`, with its closable edges: those whose neighbour's
+// opposite vertex lies strictly on the other side of the edge than the triangle's own third
+// corner (the two cover both sides of it; a fold, a border or a neighbour reaching behind the
+// camera is not closable).
+@vertex
+fn vs_envelope(@builtin(vertex_index) vi: u32) -> ConsVarying {
+    let tri = vi / 3u;
+    var out = cons_corner(tri, vi % 3u, 1.0);
+    if (out.plane.w < 0.5) {
+        return out;
+    }
+    let opposite = cons_opposite[tri];
+    let p = array<vec2<f32>, 3>(out.p01.xy, out.p01.zw, out.p2.xy);
+    var closable = 0u;
+    for (var k = 0u; k < 3u; k++) {
+        let o = opposite[k];
+        if (o == 0xffffffffu) {
+            continue;
+        }
+        let v = cons_vertices[o];
+        let clip = transform_position(v.xyz, bitcast<u32>(v.w));
+        if (clip.w <= 1e-6) {
+            continue;
+        }
+        let q = clip.xy / clip.w * cons.px_per_ndc;
+        let a = p[k];
+        let d = p[(k + 1u) % 3u] - a;
+        let own = cross2(d, p[(k + 2u) % 3u] - a);
+        let theirs = cross2(d, q - a);
+        if (own * theirs < 0.0) {
+            closable |= 1u << k;
+        }
+    }
+    out.closable = closable;
+    return out;
+}
+
+// Whether segment a–b meets the box of half-size `h` around `c` (separating axes: x, y and the
+// segment's normal). The ends are put in one order first, so the two triangles sharing an edge
+// decide alike.
+fn envelope_crosses(a0: vec2<f32>, b0: vec2<f32>, c: vec2<f32>, h: vec2<f32>) -> bool {
+    var a = a0;
+    var b = b0;
+    if (b.x < a.x || (b.x == a.x && b.y < a.y)) {
+        a = b0;
+        b = a0;
+    }
+    if (any(max(a, b) < c - h) || any(min(a, b) > c + h)) {
+        return false;
+    }
+    let n = vec2<f32>(b.y - a.y, a.x - b.x);
+    return abs(dot(n, c - a)) <= abs(n.x) * h.x + abs(n.y) * h.y;
+}
+
+@fragment
+fn fs_capture_envelope(
+    in: ConsVarying,
+    @builtin(front_facing) front_facing: bool,
+    @builtin(sample_index) sample: u32,
+) {
+    if (culled(in.material, front_facing)) {
+        return;
+    }
+    var near = in.position.z;
+    var far = in.position.z;
+    var flags = 0u;
+    if (in.plane.w > 0.5) {
+        if (!cons_inside(in, 1.0)) {
+            return;
+        }
+        // The plane over the box, within the corners' depth range (a sample the triangle
+        // covers, however its corners moved, takes a mix of their depths).
+        let z = cons_plane_depth(in);
+        let slack = cons_slack(in.plane);
+        near = max(z - slack, in.p2.z);
+        far = min(z + slack, in.p2.w);
+        if (cons_occludes(in.material)) {
+            flags = ENVELOPE_OCCLUDES | (in.closable << 4u);
+            // The box a little larger than the tolerance: an edge that may graze it counts as
+            // crossing (which only ever makes the bound farther).
+            let h = cons.tol_px * (1.0 + 1.0 / 64.0) + vec2<f32>(1.0 / 1024.0);
+            let c = cons_point(in.position);
+            let p = array<vec2<f32>, 3>(in.p01.xy, in.p01.zw, in.p2.xy);
+            for (var k = 0u; k < 3u; k++) {
+                if (envelope_crosses(p[k], p[(k + 1u) % 3u], c, h)) {
+                    flags |= 2u << k;
+                }
+            }
+        }
+    }
+    near = clamp(near, 0.0, 1.0);
+    if (!(near < 1.0)) {
+        return;
+    }
+    let id = (in.tri + 1u) | (flags << ENVELOPE_ID_BITS);
+    capture_push(in.position.xy, sample, near, id, clamp(far, 0.0, 1.0));
+}
