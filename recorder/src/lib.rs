@@ -479,6 +479,11 @@ fn graph_frame(
 /// parallel runs of samples, each into its own pairs (covered flags are shared); returns the
 /// most fragments a sample took (the layers a peel would have needed) and whether any sample
 /// had more.
+///
+/// The grown capture's lists are walked whole: a grown triangle covers every sample within
+/// the tolerance of it, so a small image of a dense scene stacks hundreds of them a sample
+/// (CarConcept at 128²), and the one pass has captured them all already; `max_layers` bounds
+/// the passes of a peel, which the grown peel (devices that cannot capture) still obeys.
 fn capture_graph(
     capture: &std::cell::RefCell<capture::Capture>,
     frame: u32,
@@ -486,8 +491,12 @@ fn capture_graph(
     parts: &mut GraphParts,
     mut grown: Option<&mut HashMap<(u32, u32), u32>>,
 ) -> Result<(u32, bool), RecordError> {
-    let max = s.max_layers as usize;
     let is_grown = grown.is_some();
+    let max = if is_grown {
+        usize::MAX
+    } else {
+        s.max_layers as usize
+    };
     let g = parts.pairs.g;
     let covered = &parts.covered;
     let (mut most, mut left) = (0usize, false);
