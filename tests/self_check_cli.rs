@@ -183,12 +183,23 @@ fn self_check_holes(dir: &std::path::Path, baked: &str, offset: &str) -> (u64, b
     (holes, out.status.success())
 }
 
+/// The default bake is conservative too: no hole anywhere in its ±1/8 px box.
 #[test]
 fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
     let Some(dir) = gpu_tempdir() else { return };
     let d = dir.path();
     let bake = format!("bake {SCENE} --path orbit:frames=2,degrees=40 --size 64x64 --samples 4");
-    let plain = run_json(d, &[args(&bake), vec!["-o", "plain.baked"]].concat());
+    let plain = run_json(
+        d,
+        &[args(&bake), args("-o plain.baked --conservative=false")].concat(),
+    );
+    // The default records conservatively within ±1/8 px.
+    let default = run_json(d, &[args(&bake), vec!["-o", "default.baked"]].concat());
+    assert_eq!(
+        default["robust"],
+        serde_json::json!({"patterns": 1, "tolerance": 0.125, "conservative": true}),
+        "{default}"
+    );
     let robust = run_json(
         d,
         &[
@@ -202,9 +213,14 @@ fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
         serde_json::json!({"patterns": 2, "tolerance": 0.125, "conservative": true}),
         "{robust}"
     );
-    assert_eq!(plain["robust"]["patterns"], 1);
+    assert_eq!(
+        plain["robust"],
+        serde_json::json!({"patterns": 1, "tolerance": 0.125, "conservative": false}),
+        "{plain}"
+    );
     let tris = |v: &serde_json::Value| v["source_triangles"].as_u64().unwrap();
     assert!(tris(&robust) > tris(&plain), "{robust}\n{plain}");
+    assert!(tris(&default) > tris(&plain), "{default}\n{plain}");
     // Still a valid bake, exact at its recorded pattern.
     run(
         d,
@@ -221,4 +237,16 @@ fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
     assert!(plain_holes > 0 && !plain_ok, "{plain_holes}");
     let (robust_holes, robust_ok) = self_check_holes(d, "robust.baked", "1/8,0");
     assert_eq!((robust_holes, robust_ok), (0, true));
+    for offset in ["1/16,0", "1/8,0", "0,-1/8", "-0.1,0.1"] {
+        assert_eq!(
+            self_check_holes(d, "default.baked", offset),
+            (0, true),
+            "the default bake moved by {offset} px"
+        );
+    }
+    run(
+        d,
+        &args("verify default.baked --recording default.baked.rec"),
+        true,
+    );
 }

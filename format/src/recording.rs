@@ -49,9 +49,10 @@ pub struct RecordSettings {
 ///   (covered sets, edges, ties; edge weights add up over the patterns);
 /// - `conservative`: phase 1 also keeps every triangle whose footprint, grown by
 ///   `tolerance` in x and y, reaches a sample at a depth (its nearest over the box) not
-///   behind the nearest opaque surface's farthest depth over the sample's ±`tolerance` box
-///   (as the samples nearby see it), and phase 2 adds the edges of a peel of the grown
-///   triangles that close no new cycle (`recorder`'s conservative pass).
+///   behind a bound on the nearest opaque surface over the sample's whole ±`tolerance` box
+///   (the recorder's envelope bound; devices that cannot capture estimate it from the samples
+///   nearby), and phase 2 adds the edges of the grown triangles' layers that close no new
+///   cycle.
 ///
 /// The recorded pattern stays one of the patterns, so a robust bake is still exact at it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -68,14 +69,20 @@ pub struct Robust {
 impl Robust {
     /// The most patterns [`RecordSettings::validate`] accepts.
     pub const MAX_PATTERNS: u32 = 64;
-    /// Recorded pattern only.
+    /// Recorded pattern only: a bake exact where it is played as recorded, and only there.
     pub const OFF: Robust = Robust {
         patterns: 1,
         tolerance: 0.125,
         conservative: false,
     };
-    /// The default of `record`.
-    pub const DEFAULT: Robust = Robust::OFF;
+    /// The default of `record`: conservative within ±1/8 px, so that a bake opens no hole on
+    /// a rasterizer whose samples land up to 1/8 px from the recorded ones (another GPU's
+    /// snapping), at the cost of the extra triangles this keeps (BENCHMARKS § Exactness across
+    /// rasterizers). `record --conservative=false` records the pattern only ([`Robust::OFF`]).
+    pub const DEFAULT: Robust = Robust {
+        conservative: true,
+        ..Robust::OFF
+    };
 
     /// Whether anything beyond the recorded pattern is gathered.
     pub fn is_on(&self) -> bool {

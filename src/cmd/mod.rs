@@ -92,7 +92,17 @@ pub struct RecordOpts {
     /// (one capture of the grown triangles per frame in phase 1, whose opaque triangles bound
     /// the box where they close over it; three passes on devices that cannot capture), with
     /// the edges of the grown triangles' layers (phase 2).
-    #[arg(long)]
+    /// The default; `--conservative=false` records the recorded pattern only (fewer
+    /// triangles a frame, exact only where played as recorded).
+    #[arg(
+        long,
+        value_name = "BOOL",
+        num_args = 0..=1,
+        require_equals = true,
+        default_value_t = RecordSettings::default().robust.conservative,
+        default_missing_value = "true",
+        action = clap::ArgAction::Set
+    )]
     pub conservative: bool,
     /// Tolerance in pixels of --robust's jittered patterns and of --conservative.
     #[arg(long, value_name = "PX", default_value_t = RecordSettings::default().robust.tolerance)]

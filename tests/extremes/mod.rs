@@ -123,8 +123,9 @@ struct Baking {
     baked: Baked,
 }
 
-/// Writes the scene and path, bakes at `size`² with `samples`, checks the graph rules with
-/// `verify --recording` and returns both files. `None` when no GPU (the test skips).
+/// Writes the scene and path, bakes at `size`² with `samples` at the recorded pattern only
+/// (`--conservative=false`), checks the graph rules with `verify --recording` and returns both
+/// files. `None` when no GPU (the test skips).
 fn bake(
     dir: &Path,
     name: &str,
@@ -158,6 +159,12 @@ fn bake_with(
     let size = format!("{size}x{size}");
     let samples = samples.to_string();
     let mut args = bake_args(&glb, &toml, &size, &samples, &out);
+    // The known answers below are the recorded pattern's (which triangle wins which sample,
+    // ties, depth precision): recorded at that pattern only, not conservatively (the
+    // default), unless a test asks otherwise.
+    if !extra.iter().any(|a| a.starts_with("--conservative")) {
+        args.push("--conservative=false");
+    }
     args.extend_from_slice(extra);
     run(dir, &args, true);
     let rec: Recording =
