@@ -24,8 +24,17 @@ fn fs_capture_grown(
 // The envelope capture (record --conservative, phase 1): the grown capture's fragments with
 // what the host needs to bound, per sample, how far the nearest opaque surface can lie
 // anywhere in the sample's tolerance box (recorder/src/envelope.rs). A node holds the plane's
-// nearest depth over the box (as its depth), its farthest (as its opacity) and, above the id's
-// ENVELOPE_ID_BITS, the flags below.
+// nearest depth over the depth box (as its depth), its farthest (as its opacity) and, above
+// the id's ENVELOPE_ID_BITS, the flags below.
+//
+// Two allowances for rasterizers other than the recording one, both measured on SwiftShader
+// (the browser's WebGL2; BENCHMARKS § Exactness across rasterizers):
+// - depth is compared over the sample's box grown by ENVELOPE_DEPTH_REACH more: a rasterizer
+//   may take a triangle's depth at another point of the pixel than the sample (a triangle
+//   0.0035 behind a closed fan that covers it won a sample there, and no longer did when moved
+//   2 % farther along the view rays);
+// - a triangle whose facing snapping may turn (bit 3 of `closable`) is kept either facing and
+//   never occludes.
 
 // Per triangle of the drawn list: for edge k (corner k to corner k + 1), the vertex of the
 // triangle across it opposite the edge, or 0xffffffff where the edge has no single neighbour.
@@ -35,6 +44,9 @@ fn fs_capture_grown(
 // box (bits 1–3); edge k is closable (bits 4–6).
 const ENVELOPE_ID_BITS: u32 = 24u;
 const ENVELOPE_OCCLUDES: u32 = 1u;
+// Pixels beyond the tolerance over which depths are compared: from a sample to its pixel's
+// centre is at most 0.375 px at 4× (0 at 1×); half a pixel covers that with some margin.
+const ENVELOPE_DEPTH_REACH: f32 = 0.5;
 
 // Corner `corner` of grown triangle `vi / 3`, with its closable edges: those whose neighbour's
 // opposite vertex lies strictly on the other side of the edge than the triangle's own third
@@ -48,8 +60,17 @@ fn vs_envelope(@builtin(vertex_index) vi: u32) -> ConsVarying {
         return out;
     }
     let opposite = cons_opposite[tri];
-    let p = array<vec2<f32>, 3>(out.p01.xy, out.p01.zw, out.p2.xy);
+    let p = array<vec2<f32>, 3>(out.p01.xy, out.p01.zw, out.p2);
     var closable = 0u;
+    // Bit 3: its facing may turn on a rasterizer that snaps each corner to its own grid of
+    // 1/16 px (Vulkan's and GLES's least sub-pixel precision): twice its area is within what
+    // moving the corners by up to 1/32 px can change it by.
+    let e1 = p[1] - p[0];
+    let e2 = p[2] - p[0];
+    let moved = 2.0 * sqrt(2.0) / 32.0;
+    if (abs(cross2(e1, e2)) <= moved * (length(e1) + length(e2)) + moved * moved) {
+        closable |= 8u;
+    }
     for (var k = 0u; k < 3u; k++) {
         let o = opposite[k];
         if (o == 0xffffffffu) {
@@ -96,7 +117,9 @@ fn fs_capture_envelope(
     @builtin(front_facing) front_facing: bool,
     @builtin(sample_index) sample: u32,
 ) {
-    if (culled(in.material, front_facing)) {
+    // Either facing where snapping may turn it (bit 3 of closable); then it never occludes.
+    let turns = (in.closable & 8u) != 0u;
+    if (!turns && culled(in.material, front_facing)) {
         return;
     }
     var near = in.position.z;
@@ -106,19 +129,20 @@ fn fs_capture_envelope(
         if (!cons_inside(in, 1.0)) {
             return;
         }
-        // The plane over the box, within the corners' depth range (a sample the triangle
-        // covers, however its corners moved, takes a mix of their depths).
+        // The plane over the depth box: ±(tolerance + ENVELOPE_DEPTH_REACH) px (not clamped
+        // to the corners' depth range, as a depth taken elsewhere in the pixel extrapolates).
         let z = cons_plane_depth(in);
-        let slack = cons_slack(in.plane);
-        near = max(z - slack, in.p2.z);
-        far = min(z + slack, in.p2.w);
-        if (cons_occludes(in.material)) {
-            flags = ENVELOPE_OCCLUDES | (in.closable << 4u);
+        let reach = (cons.tol_px + vec2<f32>(ENVELOPE_DEPTH_REACH)) / cons.px_per_ndc;
+        let slack = abs(in.plane.x) * reach.x + abs(in.plane.y) * reach.y;
+        near = z - slack;
+        far = z + slack;
+        if (!turns && cons_occludes(in.material)) {
+            flags = ENVELOPE_OCCLUDES | ((in.closable & 7u) << 4u);
             // The box a little larger than the tolerance: an edge that may graze it counts as
             // crossing (which only ever makes the bound farther).
             let h = cons.tol_px * (1.0 + 1.0 / 64.0) + vec2<f32>(1.0 / 1024.0);
             let c = cons_point(in.position);
-            let p = array<vec2<f32>, 3>(in.p01.xy, in.p01.zw, in.p2.xy);
+            let p = array<vec2<f32>, 3>(in.p01.xy, in.p01.zw, in.p2);
             for (var k = 0u; k < 3u; k++) {
                 if (envelope_crosses(p[k], p[(k + 1u) % 3u], c, h)) {
                     flags |= 2u << k;

@@ -32,10 +32,9 @@ struct ConsVarying {
     // Grown bounding box in pixel units (min x, min y, max x, max y).
     @location(5) @interpolate(flat) bounds: vec4<f32>,
     @location(6) @interpolate(flat) material: u32,
-    // The corners in pixel units (p0.xy, p1.xy; p2.xy) and the corners' depth range (p2.zw),
-    // for the envelope capture.
+    // The corners in pixel units (p0.xy, p1.xy; p2), for the envelope capture.
     @location(7) @interpolate(flat) p01: vec4<f32>,
-    @location(8) @interpolate(flat) p2: vec4<f32>,
+    @location(8) @interpolate(flat) p2: vec2<f32>,
     // The envelope capture's bit k: across edge k (corner k to corner k + 1) lies a neighbour
     // on the other side of it (see capture_grown.wgsl); 0 elsewhere.
     @location(9) @interpolate(flat) closable: u32,
@@ -53,7 +52,7 @@ fn cons_dropped() -> ConsVarying {
     out.bounds = vec4<f32>(0.0);
     out.material = 0u;
     out.p01 = vec4<f32>(0.0);
-    out.p2 = vec4<f32>(0.0);
+    out.p2 = vec2<f32>(0.0);
     out.closable = 0u;
     return out;
 }
@@ -111,11 +110,7 @@ fn cons_corner(tri: u32, corner: u32, grow: f32) -> ConsVarying {
     out.e1 = e[1];
     out.e2 = e[2];
     out.p01 = vec4<f32>(p[0], p[1]);
-    out.p2 = vec4<f32>(
-        p[2],
-        min(min(ndc[0].z, ndc[1].z), ndc[2].z),
-        max(max(ndc[0].z, ndc[1].z), ndc[2].z),
-    );
+    out.p2 = p[2];
     // The plane through the three NDC points.
     let d1 = ndc[1] - ndc[0];
     let d2 = ndc[2] - ndc[0];
