@@ -208,7 +208,7 @@ impl<'g> Envelope<'g> {
         view: View,
         tolerance: f32,
     ) -> Result<Envelope<'g>, RecordError> {
-        if geometry.triangles.len() as u64 >= ID_MASK as u64 {
+        if !Envelope::fits(geometry) {
             return Err(RecordError::Unsupported(format!(
                 "--conservative records at most {} triangles; the scene has {}",
                 ID_MASK - 1,
@@ -230,6 +230,12 @@ impl<'g> Envelope<'g> {
             capture: RefCell::new(capture),
             neighbour: adjacency.neighbour,
         })
+    }
+
+    /// Whether `geometry` has few enough triangles for the envelope capture (below 2^24 − 1:
+    /// the flags share the captured id's word).
+    pub fn fits(geometry: &Geometry) -> bool {
+        (geometry.triangles.len() as u64) < ID_MASK as u64
     }
 
     /// The triangles (indices into the geometry) that may be nearest at some point of a

@@ -154,6 +154,13 @@ pub fn with_peeling<R>(f: impl FnOnce() -> R) -> R {
     peeler::with_switch(&PEELING, true, f)
 }
 
+/// Whether `gpu` can capture fragments (and so bound `--conservative`'s envelope) rather than
+/// only peel: for tests that check what capturing alone does.
+#[doc(hidden)]
+pub fn can_capture(gpu: &Gpu) -> bool {
+    capture::supported(gpu)
+}
+
 /// Whether recordings on `gpu` capture (one pass a frame) rather than peel: the device can
 /// ([`capture::supported`]: primitive ids and writable storage in fragment shaders), and
 /// [`with_peeling`] does not ask for peeling.
@@ -646,7 +653,9 @@ pub fn record(
                 // The envelope needs a capture, but not the layers' switch: recordings peeled
                 // by `with_peeling` take the same conservative set as captured ones.
                 let passes = CONSERVATIVE_PASSES.with(|c| c.get());
-                Some(if capture::supported(gpu) && !passes {
+                // Scenes of 2^24 triangles or more take the passes too.
+                let envelope = capture::supported(gpu) && !passes && envelope::Envelope::fits(g);
+                Some(if envelope {
                     PhaseOneConservative::Envelope(envelope::Envelope::new(gpu, g, f, view, t)?)
                 } else {
                     PhaseOneConservative::Passes(Conservative::new(gpu, g, f, view, t)?)

@@ -136,13 +136,20 @@ fn fs_capture_envelope(
         let slack = abs(in.plane.x) * reach.x + abs(in.plane.y) * reach.y;
         near = z - slack;
         far = z + slack;
-        if (!turns && cons_occludes(in.material)) {
+        // Only a plane inside the depth range over the whole box occludes there: where the
+        // near or far plane clips it, it covers nothing.
+        let inside = near >= 0.0 && far <= 1.0;
+        if (!turns && inside && cons_occludes(in.material)) {
             flags = ENVELOPE_OCCLUDES | ((in.closable & 7u) << 4u);
-            // The box a little larger than the tolerance: an edge that may graze it counts as
-            // crossing (which only ever makes the bound farther).
-            let h = cons.tol_px * (1.0 + 1.0 / 64.0) + vec2<f32>(1.0 / 1024.0);
-            let c = cons_point(in.position);
             let p = array<vec2<f32>, 3>(in.p01.xy, in.p01.zw, in.p2);
+            // The box a little larger than the tolerance: an edge that may graze it counts as
+            // crossing (which only ever makes the bound farther). The margin grows with the
+            // corners' distance from the centre, which f32 resolves ever more coarsely (a
+            // corner just in front of the eye plane projects millions of pixels away).
+            let far_corner = max(max(abs(p[0]), abs(p[1])), abs(p[2]));
+            let margin = max(far_corner.x, far_corner.y) / 262144.0;
+            let h = cons.tol_px * (1.0 + 1.0 / 64.0) + vec2<f32>(1.0 / 1024.0 + margin);
+            let c = cons_point(in.position);
             for (var k = 0u; k < 3u; k++) {
                 if (envelope_crosses(p[k], p[(k + 1u) % 3u], c, h)) {
                     flags |= 2u << k;
