@@ -89,10 +89,12 @@ struct Prepass {
     indices: [(wgpu::Buffer, u32); 2],
 }
 
-/// How a capture grows its triangles: as the grown peel's (phase 2 of `--conservative`), or
-/// with the envelope's depths and flags (its phase 1), with the opposite-vertex table.
+/// How a capture grows its triangles, by a tolerance in pixels: as the grown peel's (phase 2
+/// of `--conservative`), or with the envelope's depths and flags (its phase 1), with the
+/// opposite vertex across each edge of each drawn triangle
+/// ([`crate::envelope::Adjacency::opposite`]).
 #[derive(Clone, Copy)]
-enum Grow<'a> {
+pub(crate) enum Grow<'a> {
     Peel(f32),
     Envelope(f32, &'a [[u32; 4]]),
 }
@@ -129,53 +131,22 @@ impl<'g> Capture<'g> {
         Capture::build(gpu, geometry, triangles, frames, view, until_opaque, None)
     }
 
-    /// [`Capture::new`] over the triangles grown by `tolerance` pixels
-    /// (`capture_grown.wgsl`): the one-pass form of [`crate::Peeler::grown`], whose layers
-    /// phase 2 of `record --conservative` takes the added triangles' edges from. Fragments
-    /// carry alpha 1.
+    /// [`Capture::new`] over the triangles grown by a tolerance box (`capture_grown.wgsl`):
+    /// with [`Grow::Peel`], the one-pass form of [`crate::Peeler::grown`], whose layers phase 2
+    /// of `record --conservative` takes the added triangles' edges from (fragments carry alpha
+    /// 1); with [`Grow::Envelope`], phase 1's envelope capture ([`crate::envelope`]): each
+    /// fragment has its plane's nearest depth over the depth box as its depth, its farthest as
+    /// its opacity, and flags above the id (whether it occludes, which of its edges cross the
+    /// box and which are closable).
     pub fn grown(
         gpu: &'g Gpu,
         geometry: &Geometry,
         triangles: &[u32],
         frames: &[FrameState],
         view: View,
-        tolerance: f32,
+        grow: Grow,
     ) -> Result<Self, RecordError> {
-        Capture::build(
-            gpu,
-            geometry,
-            triangles,
-            frames,
-            view,
-            false,
-            Some(Grow::Peel(tolerance)),
-        )
-    }
-
-    /// The envelope capture of `record --conservative`'s phase 1 (`capture_grown.wgsl`,
-    /// [`crate::envelope`]): [`Capture::grown`]'s fragments, each with its plane's nearest depth
-    /// over the tolerance box as its depth, its farthest as its opacity, and flags above the id
-    /// (whether it occludes, which of its edges cross the box and which are closable).
-    /// `opposite` holds per drawn triangle the vertex across each edge
-    /// ([`crate::envelope::Adjacency`]).
-    pub fn envelope(
-        gpu: &'g Gpu,
-        geometry: &Geometry,
-        triangles: &[u32],
-        frames: &[FrameState],
-        view: View,
-        tolerance: f32,
-        opposite: &[[u32; 4]],
-    ) -> Result<Self, RecordError> {
-        Capture::build(
-            gpu,
-            geometry,
-            triangles,
-            frames,
-            view,
-            false,
-            Some(Grow::Envelope(tolerance, opposite)),
-        )
+        Capture::build(gpu, geometry, triangles, frames, view, false, Some(grow))
     }
 
     fn build(

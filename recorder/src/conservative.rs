@@ -26,6 +26,7 @@
 //! changes no pixel.
 
 use trisort_format::{FrameState, Geometry};
+use trisort_gpu::pipeline::{storage_entry, uniform_entry};
 use trisort_gpu::scene_gpu::{SceneGpu, View};
 use trisort_gpu::Gpu;
 use wgpu::util::DeviceExt;
@@ -137,17 +138,12 @@ impl GrowBuffers {
 
     /// The layout entries of bindings 0–2.
     pub(crate) fn layout_entries() -> [wgpu::BindGroupLayoutEntry; 3] {
-        let uniform = wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        [uniform, storage_entry(1, true), storage_entry(2, true)]
+        let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        [
+            uniform_entry(0, both, false, None),
+            storage_entry(1, both, true),
+            storage_entry(2, both, true),
+        ]
     }
 
     /// The bind group entries of bindings 0–2.
@@ -242,19 +238,6 @@ pub(crate) fn pulled_pipeline(
     })
 }
 
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl<'g> Conservative<'g> {
     /// Sets up the passes over every triangle of `geometry` for the path's `frames` at `view`
     /// with a tolerance of `tolerance` pixels.
@@ -313,9 +296,7 @@ impl<'g> Conservative<'g> {
             3,
             wgpu::TextureSampleType::Float { filterable: false },
         ));
-        let mut flags_entry = storage_entry(4, false);
-        flags_entry.visibility = wgpu::ShaderStages::FRAGMENT;
-        mark_layout_entries.push(flags_entry);
+        mark_layout_entries.push(storage_entry(4, wgpu::ShaderStages::FRAGMENT, false));
         let mark_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("conservative mark"),
             entries: &mark_layout_entries,

@@ -42,11 +42,11 @@ use trisort_format::{FrameState, Geometry};
 use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
 
-use crate::capture::{Capture, Fragment};
+use crate::capture::{Capture, Fragment, Grow};
 use crate::RecordError;
 
-/// Bits of a captured id that hold the id; the flags sit above (`ENVELOPE_ID_BITS`).
-const ID_BITS: u32 = 24;
+/// Bits of a captured id that hold the id; the flags sit above (the shader's own constant).
+const ID_BITS: u32 = trisort_gpu::ENVELOPE_ID_BITS;
 const ID_MASK: u32 = (1 << ID_BITS) - 1;
 /// Flag: the triangle occludes (opaque material, plane valid).
 const OCCLUDES: u32 = 1;
@@ -217,15 +217,8 @@ impl<'g> Envelope<'g> {
         }
         let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
         let adjacency = Adjacency::new(geometry, &all);
-        let capture = Capture::envelope(
-            gpu,
-            geometry,
-            &all,
-            frames,
-            view,
-            tolerance,
-            &adjacency.opposite,
-        )?;
+        let grow = Grow::Envelope(tolerance, &adjacency.opposite);
+        let capture = Capture::grown(gpu, geometry, &all, frames, view, grow)?;
         Ok(Envelope {
             capture: RefCell::new(capture),
             neighbour: adjacency.neighbour,

@@ -204,7 +204,7 @@ impl<'g> Layers<'g> {
                 Purpose::Visibility => capture::Capture::new(gpu, g, t, f, view, true)?,
                 Purpose::Graphs => capture::Capture::new(gpu, g, t, f, view, false)?,
                 Purpose::Grown(tolerance) => {
-                    capture::Capture::grown(gpu, g, t, f, view, tolerance)?
+                    capture::Capture::grown(gpu, g, t, f, view, capture::Grow::Peel(tolerance))?
                 }
             };
             return Ok(Layers::Capture(std::cell::RefCell::new(c)));
