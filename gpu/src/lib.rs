@@ -97,12 +97,17 @@ pub fn capture_grown_shader() -> String {
     compose(
         &["primitive_index"],
         &format!(
-            "{}\n{}\n{CAPTURE_GROWN}",
+            "{}\n{}\n{}",
             format!("{RECORD_VERTEX}\n{CAPTURE}").replace("EARLY_DEPTH_TEST", ""),
-            GROW.replace("CONS_GROUP", "2")
+            GROW.replace("CONS_GROUP", "2"),
+            CAPTURE_GROWN.replace("ENVELOPE_ID_BITS_VALUE", &ENVELOPE_ID_BITS.to_string())
         ),
     )
 }
+
+/// Bits of an envelope capture node's id word that hold the triangle's id + 1; its flags sit
+/// above them (`capture_grown.wgsl`, read back by the recorder's envelope bound).
+pub const ENVELOPE_ID_BITS: u32 = 24;
 
 /// The compute pass that gathers a peel layer per sample; compose with [`gather_shader`].
 pub const GATHER: &str = include_str!("wgsl/gather.wgsl");

@@ -42,7 +42,8 @@ fn fs_capture_grown(
 
 // Flag bits above the id: the triangle occludes (opaque, its plane valid); edge k crosses the
 // box (bits 1–3); edge k is closable (bits 4–6).
-const ENVELOPE_ID_BITS: u32 = 24u;
+// Bits of a node's id word that hold the id (trisort_gpu::ENVELOPE_ID_BITS, substituted).
+const ENVELOPE_ID_BITS: u32 = ENVELOPE_ID_BITS_VALUEu;
 const ENVELOPE_OCCLUDES: u32 = 1u;
 // Pixels beyond the tolerance over which depths are compared: from a sample to its pixel's
 // centre is at most 0.375 px at 4× (0 at 1×); half a pixel covers that with some margin.
