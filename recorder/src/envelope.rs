@@ -20,11 +20,14 @@
 //! nearest depth over the box is not behind the bound may be nearest somewhere in the box, and
 //! joins V_f.
 //!
-//! Depths are compared over a larger box than coverage, ±(tolerance + 1/2) px, and a triangle
-//! whose facing a 1/32 px snap of its corners could turn is kept either facing and never
-//! occludes: what another rasterizer may do besides moving the samples (both measured on
-//! SwiftShader, whose holes they cut from 26.5 to 0.5 a frame on CarConcept; see
-//! `capture_grown.wgsl`).
+//! Depths are compared over a larger box than coverage: the sample's pixel grown by the
+//! tolerance (a rasterizer may take a sample's depth anywhere in its pixel), for the plane
+//! through the corners snapped to 4 to 8 sub-pixel bits (bounded through the snapped
+//! triangle's barycentric weights: a sliver's may lie anywhere). A triangle whose facing a
+//! 1/32 px snap of its corners could turn is kept either facing and never occludes; one with no
+//! area in f32 is kept wherever its grown bounds reach. That is what another rasterizer may do
+//! besides moving the samples; all of it was found on SwiftShader, whose holes it cut from 26.5
+//! a frame to 0 on CarConcept (see `capture_grown.wgsl`).
 //!
 //! Rigorous up to rounding for sample patterns moved within the tolerance (depths compare with
 //! 1e-6 to spare, the box is tested 1/64 larger for edges): a triangle nearest at some point of

@@ -159,6 +159,61 @@ fn the_envelope_keeps_what_a_gap_narrower_than_the_samples_shows() {
     assert_eq!(wall(&tight), [false, false]);
 }
 
+/// The same view (16×16, one sample per pixel, 90°): behind an opaque quad at z = −0.3 over the
+/// left part (NDC x < −0.1; 0, 1), three triangles reaching from z = −0.6 to z = −1 over
+/// 3 px, all facing the camera:
+///
+/// - 2: a sliver 0.02 px high;
+/// - 3: the same triangle 1.5 px high (2 px lower);
+/// - 4: three collinear corners along y = 0 (no area in f32).
+///
+/// (A point at NDC (u, v) and distance d is (u d, v d, −d): depth 1/d varies linearly on screen,
+/// so each third corner lies on the plane of the other two's depths.)
+fn scene_with_a_sliver_behind_a_wall() -> Geometry {
+    let mut g = scene(vec![material([1.0, 1.0, 1.0], 1.0)]);
+    flat_quad(&mut g, -10.0, -0.03, -10.0, 10.0, -0.3, 0);
+    let at = |u: f32, v: f32, d: f32| [u * d, v * d, -d];
+    let px = 0.125f32;
+    let spanning = |v: f32, high: f32| {
+        [
+            at(-0.7, v, 0.6),
+            at(-0.7 + 3.0 * px, v, 1.0),
+            at(-0.7 + 1.5 * px, v + high * px, 0.75),
+        ]
+    };
+    tri(&mut g, spanning(0.0, 0.02), 0);
+    tri(&mut g, spanning(-2.0 * px, 1.5), 0);
+    tri(&mut g, spanning(0.0, 0.0), 0);
+    g
+}
+
+/// A rasterizer snapping corners to 1/16 px and interpolating depth over the snapped triangle
+/// (SwiftShader) may put a sliver anywhere in depth a fraction of a pixel off it; a triangle
+/// with no area in f32 may gain some. The default keeps both though an opaque surface 0.3 in
+/// front covers them; an ordinary triangle just as far behind it stays hidden.
+#[test]
+fn slivers_behind_a_surface_are_kept_and_an_ordinary_triangle_is_not() {
+    let Some(plain) = run_on(scene_with_a_sliver_behind_a_wall(), Robust::OFF) else {
+        return;
+    };
+    if !trisort_testkit::gpu().is_some_and(|g| trisort_recorder::can_capture(&g)) {
+        return;
+    }
+    let behind = |r: &Recording| {
+        let v = &r.frames[0].visible;
+        [v.contains(&2), v.contains(&3), v.contains(&4)]
+    };
+    assert_eq!(behind(&plain), [false, false, false]);
+    // y = 0 is a pixel boundary, half a pixel from the samples (pixel centres): a tolerance of
+    // 5/8 px reaches it.
+    let cons = Robust {
+        tolerance: 0.625,
+        ..Robust::DEFAULT
+    };
+    let cons = run_on(scene_with_a_sliver_behind_a_wall(), cons).unwrap();
+    assert_eq!(behind(&cons), [true, false, true]);
+}
+
 /// The known answers above hold with the conservative passes too (what devices without
 /// capture record with).
 #[test]

@@ -56,14 +56,16 @@ node web/test/browser.mjs --dist web/dist --native "$out/native-basic" --frames 
 #   the rasterization above plus specular highlights and environment lookups rounded
 #   differently) and at most 6 % differing at all from the reference (measured 4.6 %, mostly
 #   by 1/255);
-# - at most 0.03 % holes (19 pixels at 256²) in the page's own self-check: the default bake is
-#   conservative within ±1/8 px (measured: 2 pixels at worst, 5 of 48 frames with any; the bake
-#   recorded at its pattern only, `--conservative=false`, had 87 at worst and fails this gate).
+# - no hole in the page's own self-check (depth mode against the file's z-buffer twin, both
+#   drawn by SwiftShader): the default bake is conservative within ±1/8 px and allows for a
+#   depth taken anywhere in the pixel by the plane through snapped corners (measured: 0 in all
+#   48 frames; the bake recorded at its pattern only, `--conservative=false`, had 87 at worst).
+#   TRISORT_WEB_MAX_HOLES is a fraction of a frame's pixels.
 MAX_OVER1_NATIVE="${TRISORT_WEB_MAX_OVER1_NATIVE:-0.0125}"
 MAX_DIFFERING_REF="${TRISORT_WEB_MAX_DIFFERING_REF:-0.06}"
 MAX_OVER1_NATIVE_BASIC="${TRISORT_WEB_MAX_OVER1_NATIVE_BASIC:-0.005}"
 MAX_DIFFERING_REF_BASIC="${TRISORT_WEB_MAX_DIFFERING_REF_BASIC:-0.025}"
-MAX_HOLES="${TRISORT_WEB_MAX_HOLES:-0.0003}"
+MAX_HOLES="${TRISORT_WEB_MAX_HOLES:-0}"
 node - "$out/browser.json" "$out/verify.json" "$MAX_OVER1_NATIVE" "$MAX_DIFFERING_REF" "$MAX_HOLES" \
   "$out/browser-basic.json" "$out/verify-basic.json" "$MAX_OVER1_NATIVE_BASIC" "$MAX_DIFFERING_REF_BASIC" <<'JS'
 const fs = require("fs");

@@ -27,14 +27,20 @@ fn fs_capture_grown(
 // nearest depth over the depth box (as its depth), its farthest (as its opacity) and, above
 // the id's ENVELOPE_ID_BITS, the flags below.
 //
-// Two allowances for rasterizers other than the recording one, both measured on SwiftShader
-// (the browser's WebGL2; BENCHMARKS § Exactness across rasterizers):
-// - depth is compared over the sample's box grown by ENVELOPE_DEPTH_REACH more: a rasterizer
-//   may take a triangle's depth at another point of the pixel than the sample (a triangle
-//   0.0035 behind a closed fan that covers it won a sample there, and no longer did when moved
-//   2 % farther along the view rays);
+// Three allowances for rasterizers other than the recording one (BENCHMARKS § Exactness
+// across rasterizers; found on SwiftShader, the browser's WebGL2):
+// - depth is compared over the sample's whole pixel grown by the tolerance, not at the
+//   sample: a rasterizer may take a sample's depth elsewhere in its pixel. SwiftShader does:
+//   it evaluates the depth plane with the sample's offset from the pixel centre negated in x
+//   (in older versions in x and y), so sample 1 of the 4× pattern, at (0.875, 0.375), takes
+//   its depth at (0.125, 0.375);
+// - depth is that of the plane through the corners snapped to the rasterizer's sub-pixel grid
+//   (4 to 8 bits), bounded by envelope_snapped_depth: on a sliver it extrapolates far (on
+//   CarConcept, a sliver 0.04 behind the surface at its sample took a depth 0.03 in front of
+//   it at the mirrored point);
 // - a triangle whose facing snapping may turn (bit 3 of `closable`) is kept either facing and
-//   never occludes.
+//   never occludes; one degenerate in f32 (CONS_DEGENERATE), which snapping may give area,
+//   has no depth to go by at all and is listed at depth 0.
 
 // Per triangle of the drawn list: for edge k (corner k to corner k + 1), the vertex of the
 // triangle across it opposite the edge, or 0xffffffff where the edge has no single neighbour.
@@ -45,9 +51,6 @@ fn fs_capture_grown(
 // Bits of a node's id word that hold the id (trisort_gpu::ENVELOPE_ID_BITS, substituted).
 const ENVELOPE_ID_BITS: u32 = ENVELOPE_ID_BITS_VALUEu;
 const ENVELOPE_OCCLUDES: u32 = 1u;
-// Pixels beyond the tolerance over which depths are compared: from a sample to its pixel's
-// centre is at most 0.375 px at 4× (0 at 1×); half a pixel covers that with some margin.
-const ENVELOPE_DEPTH_REACH: f32 = 0.5;
 
 // Corner `corner` of grown triangle `vi / 3`, with its closable edges: those whose neighbour's
 // opposite vertex lies strictly on the other side of the edge than the triangle's own third
@@ -62,7 +65,8 @@ fn vs_envelope(@builtin(vertex_index) vi: u32) -> ConsVarying {
     }
     let opposite = cons_opposite[tri];
     let p = array<vec2<f32>, 3>(out.p01.xy, out.p01.zw, out.p2);
-    var closable = 0u;
+    // CONS_DEGENERATE from cons_corner, where set.
+    var closable = out.closable;
     // Bit 3: its facing may turn on a rasterizer that snaps each corner to its own grid of
     // 1/16 px (Vulkan's and GLES's least sub-pixel precision): twice its area is within what
     // moving the corners by up to 1/32 px can change it by.
@@ -93,6 +97,44 @@ fn vs_envelope(@builtin(vertex_index) vi: u32) -> ConsVarying {
     }
     out.closable = closable;
     return out;
+}
+
+// How far the depth a rasterizer takes over the box of half-size `r` (pixels) around `c` may
+// lie from the exact plane when it snaps the corners to a grid of `grid` px (rounding: each
+// corner moves by at most e = grid·√2/2) and interpolates the corners' own depths over the
+// snapped triangle. x: the most the snapped triangle's plane departs from the exact plane
+// over the box; y, z: the least and most depth it can take there. Both follow from the
+// barycentric weights λ' of a point of the box in the snapped triangle: with Λ = Σ|λ'|, the
+// snapped plane is the exact plane moved by Σ λ'_k ∇z·δ_k (at most |∇z| e Λ), and a sum of
+// the corner depths weighted to 1 (within (Λ − 1) / 2 of their range). Λ is unbounded for a
+// sliver, whose snapped area may be as small as the grid allows.
+fn envelope_snapped_depth(in: ConsVarying, c: vec2<f32>, r: vec2<f32>, grid: f32) -> vec3<f32> {
+    let e = grid * 0.70710678;
+    let p = array<vec2<f32>, 3>(in.p01.xy, in.p01.zw, in.p2);
+    let z = array<f32, 3>(cons_plane_at(in, p[0]), cons_plane_at(in, p[1]), cons_plane_at(in, p[2]));
+    let zmin = min(min(z[0], z[1]), z[2]);
+    let zmax = max(max(z[0], z[1]), z[2]);
+    // The least twice-area the snapped triangle can have and still be drawn: moving each corner
+    // by e changes twice the area by at most 2e (|e1| + |e2|) + 4e², and a drawn triangle on
+    // the grid has twice its area at least grid².
+    let e1 = p[1] - p[0];
+    let e2 = p[2] - p[0];
+    let least = max(abs(cross2(e1, e2)) - 2.0 * e * (length(e1) + length(e2)) - 4.0 * e * e,
+        grid * grid);
+    // Σ over corners k of |cross(p'_j − p'_i, q − p'_i)| (i, j the other two), bounded over
+    // the box and the corners' moves.
+    var sum = 0.0;
+    for (var k = 0u; k < 3u; k++) {
+        let a = p[(k + 1u) % 3u];
+        let d = p[(k + 2u) % 3u] - a;
+        let v = c - a;
+        sum += abs(cross2(d, v)) + abs(d.x) * r.y + abs(d.y) * r.x + 2.0 * e * length(d)
+            + 2.0 * e * (length(v) + length(r)) + 4.0 * e * e;
+    }
+    let weights = sum / least;
+    let gradient = length(in.plane.xy / cons.px_per_ndc);
+    let extra = 0.5 * (weights - 1.0) * (zmax - zmin);
+    return vec3<f32>(gradient * e * weights, zmin - extra, zmax + extra);
 }
 
 // Whether segment a–b meets the box of half-size `h` around `c` (separating axes: x, y and the
@@ -130,13 +172,26 @@ fn fs_capture_envelope(
         if (!cons_inside(in, 1.0)) {
             return;
         }
-        // The plane over the depth box: ±(tolerance + ENVELOPE_DEPTH_REACH) px (not clamped
-        // to the corners' depth range, as a depth taken elsewhere in the pixel extrapolates).
-        let z = cons_plane_depth(in);
-        let reach = (cons.tol_px + vec2<f32>(ENVELOPE_DEPTH_REACH)) / cons.px_per_ndc;
-        let slack = abs(in.plane.x) * reach.x + abs(in.plane.y) * reach.y;
-        near = z - slack;
-        far = z + slack;
+        // The depth box: the sample's pixel grown by the tolerance (half-size `reach` px
+        // around the pixel's centre `c`). The exact plane over it (not clamped to the
+        // corners' depth range: a depth taken elsewhere in the pixel extrapolates) ...
+        let c = cons_point(vec4<f32>(floor(in.position.xy) + vec2<f32>(0.5), 0.0, 1.0));
+        let reach = vec2<f32>(0.5) + cons.tol_px;
+        let z = cons_plane_at(in, c);
+        let slack = abs(in.plane.x) * reach.x / cons.px_per_ndc.x
+            + abs(in.plane.y) * reach.y / cons.px_per_ndc.y;
+        if ((in.closable & CONS_DEGENERATE) != 0u) {
+            near = 0.0;
+            far = z;
+        } else {
+            // ... and the plane through its corners snapped to 4 sub-pixel bits (Vulkan's and
+            // GLES's least; SwiftShader's) or to 8 (common on desktop GPUs), whichever reaches
+            // farther.
+            let b4 = envelope_snapped_depth(in, c, reach, 1.0 / 16.0);
+            let b8 = envelope_snapped_depth(in, c, reach, 1.0 / 256.0);
+            near = min(max(z - slack - b4.x, b4.y), max(z - slack - b8.x, b8.y));
+            far = max(min(z + slack + b4.x, b4.z), min(z + slack + b8.x, b8.z));
+        }
         // Only a plane inside the depth range over the whole box occludes there: where the
         // near or far plane clips it, it covers nothing.
         let inside = near >= 0.0 && far <= 1.0;

@@ -6,7 +6,8 @@
 // transformed by the one vertex transform, and grown or shrunk in pixel units after the
 // perspective divide; depth is the triangle's plane z = a·x + b·y + c in NDC, evaluated at the
 // sample. A triangle reaching behind the camera (w ≤ ε at a corner) is drawn ungrown with its
-// interpolated depth (plane.w = 0), and is never shrunk.
+// interpolated depth (plane.w = 0), and is never shrunk. One degenerate in f32 is grown as its
+// bounding box at its nearest corner's depth, and never shrunk.
 
 struct Cons {
     // Tolerance in pixels (x, y), pixels per NDC unit (width / 2, height / 2).
@@ -36,9 +37,13 @@ struct ConsVarying {
     @location(7) @interpolate(flat) p01: vec4<f32>,
     @location(8) @interpolate(flat) p2: vec2<f32>,
     // The envelope capture's bit k: across edge k (corner k to corner k + 1) lies a neighbour
-    // on the other side of it (see capture_grown.wgsl); 0 elsewhere.
+    // on the other side of it (see capture_grown.wgsl); CONS_DEGENERATE wherever the triangle
+    // is degenerate in f32 (grown only); 0 elsewhere.
     @location(9) @interpolate(flat) closable: u32,
 }
+
+// `closable`'s flag for a grown triangle of no area in f32 (see cons_corner).
+const CONS_DEGENERATE: u32 = 16u;
 
 fn cons_dropped() -> ConsVarying {
     var out: ConsVarying;
@@ -95,7 +100,12 @@ fn cons_corner(tri: u32, corner: u32, grow: f32) -> ConsVarying {
         p[k] = ndc[k].xy * cons.px_per_ndc;
     }
     let area = cross2(p[1] - p[0], p[2] - p[0]);
-    if (abs(area) < 1e-12) {
+    // Degenerate here (a segment or a point in f32), but a rasterizer snapping its corners to
+    // another grid may give it area: grown, it is kept as its bounding box grown by the box, at
+    // its nearest corner's depth, and marked (CONS_DEGENERATE) so that it never occludes and
+    // its depth is taken as unknown. Ungrown or shrunk, it covers nothing.
+    let degenerate = abs(area) < 1e-12;
+    if (degenerate && grow <= 0.0) {
         return cons_dropped();
     }
     let s = sign(area);
@@ -106,19 +116,26 @@ fn cons_corner(tri: u32, corner: u32, grow: f32) -> ConsVarying {
         let support = abs(n.x) * cons.tol_px.x + abs(n.y) * cons.tol_px.y;
         e[k] = vec3<f32>(n, dot(n, p[k]) + grow * support);
     }
+    out.p01 = vec4<f32>(p[0], p[1]);
+    out.p2 = p[2];
+    if (degenerate) {
+        // Every edge test passes (0 ≤ 0): the grown bounds alone decide.
+        e = array<vec3<f32>, 3>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+        out.plane = vec4<f32>(0.0, 0.0, min(min(ndc[0].z, ndc[1].z), ndc[2].z), 1.0);
+        out.closable = CONS_DEGENERATE;
+    } else {
+        // The plane through the three NDC points.
+        let d1 = ndc[1] - ndc[0];
+        let d2 = ndc[2] - ndc[0];
+        let det3 = d1.x * d2.y - d2.x * d1.y;
+        let pa = (d1.z * d2.y - d2.z * d1.y) / det3;
+        let pb = (d1.x * d2.z - d2.x * d1.z) / det3;
+        let pc = ndc[0].z - pa * ndc[0].x - pb * ndc[0].y;
+        out.plane = vec4<f32>(pa, pb, pc, 1.0);
+    }
     out.e0 = e[0];
     out.e1 = e[1];
     out.e2 = e[2];
-    out.p01 = vec4<f32>(p[0], p[1]);
-    out.p2 = p[2];
-    // The plane through the three NDC points.
-    let d1 = ndc[1] - ndc[0];
-    let d2 = ndc[2] - ndc[0];
-    let det3 = d1.x * d2.y - d2.x * d1.y;
-    let pa = (d1.z * d2.y - d2.z * d1.y) / det3;
-    let pb = (d1.x * d2.z - d2.x * d1.z) / det3;
-    let pc = ndc[0].z - pa * ndc[0].x - pb * ndc[0].y;
-    out.plane = vec4<f32>(pa, pb, pc, 1.0);
     let lo = min(min(p[0], p[1]), p[2]) - cons.tol_px;
     let hi = max(max(p[0], p[1]), p[2]) + cons.tol_px;
     out.bounds = vec4<f32>(lo, hi);
@@ -175,9 +192,14 @@ fn cons_slack(plane: vec4<f32>) -> f32 {
     return abs(plane.x) * tol_ndc.x + abs(plane.y) * tol_ndc.y;
 }
 
+// The triangle's plane at `p` (pixel units of the NDC frame, as cons_point).
+fn cons_plane_at(in: ConsVarying, p: vec2<f32>) -> f32 {
+    let q = p / cons.px_per_ndc;
+    return in.plane.x * q.x + in.plane.y * q.y + in.plane.z;
+}
+
 fn cons_plane_depth(in: ConsVarying) -> f32 {
-    let p = cons_point(in.position) / cons.px_per_ndc;
-    return in.plane.x * p.x + in.plane.y * p.y + in.plane.z;
+    return cons_plane_at(in, cons_point(in.position));
 }
 
 fn cons_occludes(material: u32) -> bool {
