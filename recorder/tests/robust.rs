@@ -167,7 +167,7 @@ fn the_envelope_keeps_what_a_gap_narrower_than_the_samples_shows() {
 /// - 3: the same triangle 1.5 px high (2 px lower);
 /// - 4: three collinear corners along y = 0 (no area in f32).
 ///
-/// (A point at NDC (u, v) and distance d is (u d, v d, −d): depth 1/d varies linearly on screen,
+/// (A point at NDC (u, v) and view depth d is (u d, v d, −d): 1/d varies linearly on screen,
 /// so each third corner lies on the plane of the other two's depths.)
 fn scene_with_a_sliver_behind_a_wall() -> Geometry {
     let mut g = scene(vec![material([1.0, 1.0, 1.0], 1.0)]);
@@ -189,8 +189,9 @@ fn scene_with_a_sliver_behind_a_wall() -> Geometry {
 
 /// A rasterizer snapping corners to 1/16 px and interpolating depth over the snapped triangle
 /// (SwiftShader) may put a sliver anywhere in depth a fraction of a pixel off it; a triangle
-/// with no area in f32 may gain some. The default keeps both though an opaque surface 0.3 in
-/// front covers them; an ordinary triangle just as far behind it stays hidden.
+/// with no area in f32 may gain some. Conservative recording (the default's, at a tolerance
+/// that reaches them) keeps both though an opaque surface 0.3 in front covers them; an
+/// ordinary triangle just as far behind it stays hidden.
 #[test]
 fn slivers_behind_a_surface_are_kept_and_an_ordinary_triangle_is_not() {
     let Some(plain) = run_on(scene_with_a_sliver_behind_a_wall(), Robust::OFF) else {

@@ -173,7 +173,8 @@ fn fs_capture_envelope(
             return;
         }
         // The depth box: the sample's pixel grown by the tolerance (half-size `reach` px
-        // around the pixel's centre `c`). The exact plane over it (not clamped to the
+        // around the pixel's centre `c`; a sample moved within the tolerance is taken to
+        // keep its pixel, as it does at ±1/8 px with the standard patterns). The exact plane over it (not clamped to the
         // corners' depth range: a depth taken elsewhere in the pixel extrapolates) ...
         let c = cons_point(vec4<f32>(floor(in.position.xy) + vec2<f32>(0.5), 0.0, 1.0));
         let reach = vec2<f32>(0.5) + cons.tol_px;
@@ -185,12 +186,16 @@ fn fs_capture_envelope(
             far = z;
         } else {
             // ... and the plane through its corners snapped to 4 sub-pixel bits (Vulkan's and
-            // GLES's least; SwiftShader's) or to 8 (common on desktop GPUs), whichever reaches
-            // farther.
-            let b4 = envelope_snapped_depth(in, c, reach, 1.0 / 16.0);
-            let b8 = envelope_snapped_depth(in, c, reach, 1.0 / 256.0);
-            near = min(max(z - slack - b4.x, b4.y), max(z - slack - b8.x, b8.y));
-            far = max(min(z + slack + b4.x, b4.z), min(z + slack + b8.x, b8.z));
+            // GLES's least; SwiftShader's) to 8 (common on desktop GPUs), whichever reaches
+            // farther (the bound is not monotone in the grid: a sliver's least snapped area
+            // bottoms out in between), or not snapped at all.
+            near = z - slack;
+            far = z + slack;
+            for (var bits = 4u; bits <= 8u; bits++) {
+                let b = envelope_snapped_depth(in, c, reach, 1.0 / f32(1u << bits));
+                near = min(near, max(z - slack - b.x, b.y));
+                far = max(far, min(z + slack + b.x, b.z));
+            }
         }
         // Only a plane inside the depth range over the whole box occludes there: where the
         // near or far plane clips it, it covers nothing.

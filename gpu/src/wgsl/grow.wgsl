@@ -100,11 +100,18 @@ fn cons_corner(tri: u32, corner: u32, grow: f32) -> ConsVarying {
         p[k] = ndc[k].xy * cons.px_per_ndc;
     }
     let area = cross2(p[1] - p[0], p[2] - p[0]);
-    // Degenerate here (a segment or a point in f32), but a rasterizer snapping its corners to
-    // another grid may give it area: grown, it is kept as its bounding box grown by the box, at
-    // its nearest corner's depth, and marked (CONS_DEGENERATE) so that it never occludes and
-    // its depth is taken as unknown. Ungrown or shrunk, it covers nothing.
-    let degenerate = abs(area) < 1e-12;
+    // The plane through the three NDC points.
+    let d1 = ndc[1] - ndc[0];
+    let d2 = ndc[2] - ndc[0];
+    let det3 = d1.x * d2.y - d2.x * d1.y;
+    let pa = (d1.z * d2.y - d2.z * d1.y) / det3;
+    let pb = (d1.x * d2.z - d2.x * d1.z) / det3;
+    let pc = ndc[0].z - pa * ndc[0].x - pb * ndc[0].y;
+    // Degenerate here (a segment or a point in f32, or no finite plane), but a rasterizer
+    // snapping its corners to another grid may give it area: grown, it is kept as its bounding
+    // box grown by the box, at its nearest corner's depth, and marked (CONS_DEGENERATE) so that
+    // it never occludes and its depth is taken as unknown. Ungrown or shrunk, it covers nothing.
+    let degenerate = !(abs(area) >= 1e-12) || !all(abs(vec3<f32>(pa, pb, pc)) < vec3<f32>(1e30));
     if (degenerate && grow <= 0.0) {
         return cons_dropped();
     }
@@ -118,20 +125,12 @@ fn cons_corner(tri: u32, corner: u32, grow: f32) -> ConsVarying {
     }
     out.p01 = vec4<f32>(p[0], p[1]);
     out.p2 = p[2];
+    out.plane = vec4<f32>(pa, pb, pc, 1.0);
     if (degenerate) {
         // Every edge test passes (0 ≤ 0): the grown bounds alone decide.
         e = array<vec3<f32>, 3>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
         out.plane = vec4<f32>(0.0, 0.0, min(min(ndc[0].z, ndc[1].z), ndc[2].z), 1.0);
         out.closable = CONS_DEGENERATE;
-    } else {
-        // The plane through the three NDC points.
-        let d1 = ndc[1] - ndc[0];
-        let d2 = ndc[2] - ndc[0];
-        let det3 = d1.x * d2.y - d2.x * d1.y;
-        let pa = (d1.z * d2.y - d2.z * d1.y) / det3;
-        let pb = (d1.x * d2.z - d2.x * d1.z) / det3;
-        let pc = ndc[0].z - pa * ndc[0].x - pb * ndc[0].y;
-        out.plane = vec4<f32>(pa, pb, pc, 1.0);
     }
     out.e0 = e[0];
     out.e1 = e[1];
