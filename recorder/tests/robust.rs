@@ -73,6 +73,17 @@ fn run_on(g: Geometry, robust: Robust) -> Option<Recording> {
     Some(record(&gpu, &job, None, |_| {}).expect("recording succeeds"))
 }
 
+/// Whether the test device captures fragments, which the envelope bound needs (lavapipe
+/// does; CI runs there). Without a device at all, `run_on` has already skipped.
+fn captures() -> bool {
+    trisort_testkit::gpu().is_some_and(|g| trisort_recorder::can_capture(&g))
+}
+
+/// Which of `ids` frame 0 of `r` keeps in V_f.
+fn kept<const N: usize>(r: &Recording, ids: [u32; N]) -> [bool; N] {
+    ids.map(|id| r.frames[0].visible.contains(&id))
+}
+
 fn robust(patterns: u32, conservative: bool) -> Robust {
     Robust {
         patterns,
@@ -133,14 +144,10 @@ fn the_envelope_keeps_what_a_gap_narrower_than_the_samples_shows() {
     let Some(plain) = run_on(scene_with_a_slit(), Robust::OFF) else {
         return;
     };
-    // The envelope needs a device that captures (lavapipe does; CI runs there).
-    if !trisort_testkit::gpu().is_some_and(|g| trisort_recorder::can_capture(&g)) {
+    if !captures() {
         return;
     }
-    let wall = |r: &Recording| {
-        let v = &r.frames[0].visible;
-        [v.contains(&0), v.contains(&1)]
-    };
+    let wall = |r: &Recording| kept(r, [0, 1]);
     assert_eq!(wall(&plain), [false, false], "no sample sees the wall");
     // The slit crosses the wall's diagonal: both of its triangles show in it.
     let cons = run_on(scene_with_a_slit(), robust(1, true)).unwrap();
@@ -197,13 +204,10 @@ fn slivers_behind_a_surface_are_kept_and_an_ordinary_triangle_is_not() {
     let Some(plain) = run_on(scene_with_a_sliver_behind_a_wall(), Robust::OFF) else {
         return;
     };
-    if !trisort_testkit::gpu().is_some_and(|g| trisort_recorder::can_capture(&g)) {
+    if !captures() {
         return;
     }
-    let behind = |r: &Recording| {
-        let v = &r.frames[0].visible;
-        [v.contains(&2), v.contains(&3), v.contains(&4)]
-    };
+    let behind = |r: &Recording| kept(r, [2, 3, 4]);
     assert_eq!(behind(&plain), [false, false, false]);
     // y = 0 is a pixel boundary, half a pixel from the samples (pixel centres): a tolerance of
     // 5/8 px reaches it.

@@ -35,7 +35,7 @@ fn fs_capture_grown(
 //   (in older versions in x and y), so sample 1 of the 4× pattern, at (0.875, 0.375), takes
 //   its depth at (0.125, 0.375);
 // - depth is that of the plane through the corners snapped to the rasterizer's sub-pixel grid
-//   (4 to 8 bits), bounded by envelope_snapped_depth: on a sliver it extrapolates far (on
+//   (4 to 8 bits), bounded by envelope_depth_range: on a sliver it extrapolates far (on
 //   CarConcept, a sliver 0.04 behind the surface at its sample took a depth 0.03 in front of
 //   it at the mirrored point);
 // - a triangle whose facing snapping may turn (bit 3 of `closable`) is kept either facing and
@@ -69,11 +69,8 @@ fn vs_envelope(@builtin(vertex_index) vi: u32) -> ConsVarying {
     var closable = out.closable;
     // Bit 3: its facing may turn on a rasterizer that snaps each corner to its own grid of
     // 1/16 px (Vulkan's and GLES's least sub-pixel precision): twice its area is within what
-    // moving the corners by up to 1/32 px can change it by.
-    let e1 = p[1] - p[0];
-    let e2 = p[2] - p[0];
-    let moved = 2.0 * sqrt(2.0) / 32.0;
-    if (abs(cross2(e1, e2)) <= moved * (length(e1) + length(e2)) + moved * moved) {
+    // moving the corners by up to 1/32 px in x and y can change it by.
+    if (cons_moved_area2(p, ENVELOPE_SNAP_16) <= 0.0) {
         closable |= 8u;
     }
     for (var k = 0u; k < 3u; k++) {
@@ -99,42 +96,58 @@ fn vs_envelope(@builtin(vertex_index) vi: u32) -> ConsVarying {
     return out;
 }
 
-// How far the depth a rasterizer takes over the box of half-size `r` (pixels) around `c` may
-// lie from the exact plane when it snaps the corners to a grid of `grid` px (rounding: each
-// corner moves by at most e = grid·√2/2) and interpolates the corners' own depths over the
-// snapped triangle. x: the most the snapped triangle's plane departs from the exact plane
-// over the box; y, z: the least and most depth it can take there. Both follow from the
-// barycentric weights λ' of a point of the box in the snapped triangle: with Λ = Σ|λ'|, the
-// snapped plane is the exact plane moved by Σ λ'_k ∇z·δ_k (at most |∇z| e Λ), and a sum of
-// the corner depths weighted to 1 (within (Λ − 1) / 2 of their range). Λ is unbounded for a
-// sliver, whose snapped area may be as small as the grid allows.
-fn envelope_snapped_depth(in: ConsVarying, c: vec2<f32>, r: vec2<f32>, grid: f32) -> vec3<f32> {
-    let e = grid * 0.70710678;
+// How far a corner moves, in pixels, when snapped to the nearest point of a grid of 1/16 px.
+const ENVELOPE_SNAP_16: f32 = 0.044194173;
+
+// The depths (least, most) a rasterizer may take over the box of half-size `r` pixels around
+// `c`, where the exact plane is `z` at `c` and departs from it by at most `slack` over the box:
+// the exact plane's, or those of the plane through the corners snapped to a grid of 2^−b px
+// for b = 4 (Vulkan's and GLES's least sub-pixel precision; SwiftShader's) to 8 (common on
+// desktop GPUs; rounding: each corner moves by at most e = 2^−b·√2/2), with the corners' own
+// depths interpolated over the snapped triangle. The bound is not monotone in the grid (a
+// sliver's least snapped area bottoms out in between), so every b is taken.
+//
+// For a snapped grid, from the barycentric weights λ' of a point of the box in the snapped
+// triangle, with Λ = Σ|λ'|: the snapped plane is the exact plane moved by Σ λ'_k ∇z·δ_k (at
+// most |∇z| e Λ), and a sum of the corner depths weighted to 1 (within (Λ − 1) / 2 of their
+// range). Λ ≤ Σ_k |cross(p'_j − p'_i, q − p'_i)| (bounded over the box and the moves) over
+// the least twice-area the snapped triangle can have and still be drawn (cons_moved_area2,
+// and at least the grid's square): unbounded for a sliver.
+fn envelope_depth_range(in: ConsVarying, c: vec2<f32>, r: vec2<f32>, z: f32, slack: f32) -> vec2<f32> {
     let p = array<vec2<f32>, 3>(in.p01.xy, in.p01.zw, in.p2);
-    let z = array<f32, 3>(cons_plane_at(in, p[0]), cons_plane_at(in, p[1]), cons_plane_at(in, p[2]));
-    let zmin = min(min(z[0], z[1]), z[2]);
-    let zmax = max(max(z[0], z[1]), z[2]);
-    // The least twice-area the snapped triangle can have and still be drawn: moving each corner
-    // by e changes twice the area by at most 2e (|e1| + |e2|) + 4e², and a drawn triangle on
-    // the grid has twice its area at least grid².
-    let e1 = p[1] - p[0];
-    let e2 = p[2] - p[0];
-    let least = max(abs(cross2(e1, e2)) - 2.0 * e * (length(e1) + length(e2)) - 4.0 * e * e,
-        grid * grid);
-    // Σ over corners k of |cross(p'_j − p'_i, q − p'_i)| (i, j the other two), bounded over
-    // the box and the corners' moves.
-    var sum = 0.0;
+    let zk = array<f32, 3>(cons_plane_at(in, p[0]), cons_plane_at(in, p[1]), cons_plane_at(in, p[2]));
+    let zmin = min(min(zk[0], zk[1]), zk[2]);
+    let zmax = max(max(zk[0], zk[1]), zk[2]);
+    let gradient = length(in.plane.xy / cons.px_per_ndc);
+    // Per corner k (i, j the other two): |cross(p_j − p_i, q − p_i)| bounded over the box, and
+    // the lengths the corners' moves multiply.
+    var cross_box: array<f32, 3>;
+    var edge: array<f32, 3>;
+    var reach: array<f32, 3>;
     for (var k = 0u; k < 3u; k++) {
         let a = p[(k + 1u) % 3u];
         let d = p[(k + 2u) % 3u] - a;
         let v = c - a;
-        sum += abs(cross2(d, v)) + abs(d.x) * r.y + abs(d.y) * r.x + 2.0 * e * length(d)
-            + 2.0 * e * (length(v) + length(r)) + 4.0 * e * e;
+        cross_box[k] = abs(cross2(d, v)) + abs(d.x) * r.y + abs(d.y) * r.x;
+        edge[k] = length(d);
+        reach[k] = length(v) + length(r);
     }
-    let weights = sum / least;
-    let gradient = length(in.plane.xy / cons.px_per_ndc);
-    let extra = 0.5 * (weights - 1.0) * (zmax - zmin);
-    return vec3<f32>(gradient * e * weights, zmin - extra, zmax + extra);
+    var range = vec2<f32>(z - slack, z + slack);
+    for (var bits = 4u; bits <= 8u; bits++) {
+        let grid = 1.0 / f32(1u << bits);
+        let e = grid * 0.70710678;
+        let least = max(cons_moved_area2(p, e), grid * grid);
+        var sum = 0.0;
+        for (var k = 0u; k < 3u; k++) {
+            sum += cross_box[k] + 2.0 * e * edge[k] + 2.0 * e * reach[k] + 4.0 * e * e;
+        }
+        let weights = sum / least;
+        let drift = gradient * e * weights;
+        let extra = 0.5 * (weights - 1.0) * (zmax - zmin);
+        range.x = min(range.x, max(z - slack - drift, zmin - extra));
+        range.y = max(range.y, min(z + slack + drift, zmax + extra));
+    }
+    return range;
 }
 
 // Whether segment a–b meets the box of half-size `h` around `c` (separating axes: x, y and the
@@ -173,29 +186,20 @@ fn fs_capture_envelope(
             return;
         }
         // The depth box: the sample's pixel grown by the tolerance (half-size `reach` px
-        // around the pixel's centre `c`; a sample moved within the tolerance is taken to
-        // keep its pixel, as it does at ±1/8 px with the standard patterns). The exact plane over it (not clamped to the
-        // corners' depth range: a depth taken elsewhere in the pixel extrapolates) ...
+        // around the pixel's centre `c`; a sample moved within the tolerance is taken to keep
+        // its pixel, as it does at ±1/8 px with the standard patterns), over which the plane is
+        // not clamped to the corners' depth range (a depth taken elsewhere in the pixel
+        // extrapolates).
         let c = cons_point(vec4<f32>(floor(in.position.xy) + vec2<f32>(0.5), 0.0, 1.0));
         let reach = vec2<f32>(0.5) + cons.tol_px;
         let z = cons_plane_at(in, c);
-        let slack = abs(in.plane.x) * reach.x / cons.px_per_ndc.x
-            + abs(in.plane.y) * reach.y / cons.px_per_ndc.y;
         if ((in.closable & CONS_DEGENERATE) != 0u) {
             near = 0.0;
             far = z;
         } else {
-            // ... and the plane through its corners snapped to 4 sub-pixel bits (Vulkan's and
-            // GLES's least; SwiftShader's) to 8 (common on desktop GPUs), whichever reaches
-            // farther (the bound is not monotone in the grid: a sliver's least snapped area
-            // bottoms out in between), or not snapped at all.
-            near = z - slack;
-            far = z + slack;
-            for (var bits = 4u; bits <= 8u; bits++) {
-                let b = envelope_snapped_depth(in, c, reach, 1.0 / f32(1u << bits));
-                near = min(near, max(z - slack - b.x, b.y));
-                far = max(far, min(z + slack + b.x, b.z));
-            }
+            let range = envelope_depth_range(in, c, reach, z, cons_slack(in.plane, reach));
+            near = range.x;
+            far = range.y;
         }
         // Only a plane inside the depth range over the whole box occludes there: where the
         // near or far plane clips it, it covers nothing.

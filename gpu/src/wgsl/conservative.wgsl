@@ -131,7 +131,7 @@ fn fs_mark(
         if (!cons_inside(in, 1.0)) {
             discard;
         }
-        z = cons_plane_depth(in) - cons_slack(in.plane);
+        z = cons_plane_depth(in) - cons_slack(in.plane, cons.tol_px);
     }
     let coord = vec2<i32>(in.position.xy);
     let occ = LOAD_OCCLUDER;

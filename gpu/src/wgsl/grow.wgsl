@@ -185,10 +185,20 @@ fn cons_inside(in: ConsVarying, grow: f32) -> bool {
     return edges && all(p >= in.bounds.xy) && all(p <= in.bounds.zw);
 }
 
-// The depth range of the plane over the tolerance box around the sample.
-fn cons_slack(plane: vec4<f32>) -> f32 {
-    let tol_ndc = cons.tol_px / cons.px_per_ndc;
-    return abs(plane.x) * tol_ndc.x + abs(plane.y) * tol_ndc.y;
+// How far the plane departs from its value at a point over a box of half-size `half` pixels
+// around it (the tolerance box: `cons.tol_px`).
+fn cons_slack(plane: vec4<f32>, half: vec2<f32>) -> f32 {
+    let h = half / cons.px_per_ndc;
+    return abs(plane.x) * h.x + abs(plane.y) * h.y;
+}
+
+// A lower bound on twice the area of triangle `p` once each corner moves by up to `e` pixels
+// (snapped to another grid): moving the corners changes twice the area by at most
+// 2e (|e1| + |e2|) + 4e². At most 0: snapping may make it degenerate or turn its facing.
+fn cons_moved_area2(p: array<vec2<f32>, 3>, e: f32) -> f32 {
+    let e1 = p[1] - p[0];
+    let e2 = p[2] - p[0];
+    return abs(cross2(e1, e2)) - 2.0 * e * (length(e1) + length(e2)) - 4.0 * e * e;
 }
 
 // The triangle's plane at `p` (pixel units of the NDC frame, as cons_point).
