@@ -12,10 +12,11 @@ import json
 import struct
 import sys
 
-# Versions this reader understands (FORMAT.md § Compatibility): 4; 3 (no vertex tangent and
+# Versions this reader understands (FORMAT.md § Compatibility): 5; 4 (no raster profile in
+# `Robust`); 3 (no vertex tangent and
 # uv1, no material texture slots and PBR factors, no texture colour space and mips, no
 # environment); 2 (no `robust`, no `Geometry.variants`, no `fps` either).
-FORMAT_VERSIONS = (2, 3, 4)
+FORMAT_VERSIONS = (2, 3, 4, 5)
 ORDER_VERSION = 1
 
 
@@ -103,6 +104,8 @@ LAYOUT = ["paper", "compact"]
 BRIDGE = ["hidden", "ignored", "visible"]
 SEEDING = ["interval", "paper"]
 ALPHA_MODE = ["Opaque", "Mask", "Blend"]
+PROFILE_NAME = ["exact", "conformant", "snap4", "browser"]
+DEPTH_AT = ["sample", "pixel"]
 
 
 def read_baked(p, version):
@@ -119,6 +122,10 @@ def read_baked(p, version):
     if version >= 3:
         b["settings"]["robust"] = {"patterns": p.u32(), "tolerance": p.f32(),
                                    "conservative": p.boolean()}
+        if version >= 5:
+            b["settings"]["robust"]["profile"] = {
+                "name": p.enum(PROFILE_NAME), "subpixel_bits_min": p.u32(),
+                "subpixel_bits_max": p.u32(), "depth_at": p.enum(DEPTH_AT)}
     b["device"] = {"adapter": p.string(), "driver": p.string(), "backend": p.string()}
     merge = {
         "strategy": p.enum(STRATEGY), "layout": p.enum(LAYOUT), "bridge": p.enum(BRIDGE),

@@ -37,8 +37,9 @@ use serde::Serialize;
 /// again" message (the checksum matches, the layout does not); 4, physically based
 /// materials ([`crate::TextureSlot`]s, metallic-roughness, clearcoat), vertex tangents and a
 /// second texture coordinate, texture colour spaces and mip chains, and the baked file's
-/// [`crate::Environment`].
-pub const FORMAT_VERSION: u32 = 4;
+/// [`crate::Environment`]; 5, [`crate::Robust`] ends with the bake's
+/// [`crate::RasterProfile`].
+pub const FORMAT_VERSION: u32 = 5;
 
 /// Decompressed payloads larger than this are refused (16 GiB).
 pub const MAX_PAYLOAD: u64 = 16 << 30;

@@ -35,7 +35,8 @@ pub use options::{
     ParseOptionError, Seeding, Shading, Strategy, ToneMap,
 };
 pub use recording::{
-    DeviceInfo, Edge, FrameRecord, Phase, RecordSettings, Recording, Robust, SettingsError,
+    DepthAt, DeviceInfo, Edge, FrameRecord, Phase, ProfileName, RasterProfile, RecordSettings,
+    Recording, Robust, SettingsError,
 };
 
 /// The version of the trisort tool that wrote a file (stored in every file).

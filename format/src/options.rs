@@ -41,7 +41,11 @@ pub struct ParseOptionError {
 }
 
 impl ParseOptionError {
-    fn new<'a>(what: &'static str, found: &str, names: impl IntoIterator<Item = &'a str>) -> Self {
+    pub(crate) fn new<'a>(
+        what: &'static str,
+        found: &str,
+        names: impl IntoIterator<Item = &'a str>,
+    ) -> Self {
         let names: Vec<&str> = names.into_iter().collect();
         let expected = match names.split_last() {
             Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
@@ -131,6 +135,8 @@ macro_rules! option_enum {
         }
     };
 }
+
+pub(crate) use option_enum;
 
 option_enum! {
     /// The order of L = (i, j−1), I = (i, j) and B = (i+1, j) in every window (paper §5.1;

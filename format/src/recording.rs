@@ -1,9 +1,13 @@
 //! The `Recording`: what the recorder saw, per frame, at one sample pattern.
 
+use std::fmt;
+use std::str::FromStr;
+
 use serde::{Deserialize, Serialize};
 
 use crate::camera::FrameState;
 use crate::geometry::Geometry;
+use crate::options::{option_enum, OptionValue, ParseOptionError};
 use crate::Hash;
 
 /// Recording settings: together with the device they define the *sample pattern* at which a
@@ -35,56 +39,161 @@ pub struct RecordSettings {
     pub robust: Robust,
 }
 
-/// How far beyond the recorded sample pattern a recording looks (`record --robust N`,
-/// `--conservative`, `--robust-tolerance PX`).
+/// How far beyond the recorded sample pattern a recording looks (`record --raster-profile
+/// NAME`, `--robust N`, `--conservative`, `--robust-tolerance PX`).
 ///
 /// A triangle belongs to V_f when it wins a sample of the recorded pattern. On another
-/// rasterizer (4 to 8 bits of sub-pixel precision, other tie rules), or with the pattern
-/// moved by a fraction of a pixel, a triangle that won no sample can win one; if the frame
-/// does not draw it, what lies behind shows through (a hole). Robust recording widens V_f (and
-/// E_f, so the extra triangles are ordered) towards "wins a sample under some placement of
-/// the samples within `tolerance` pixels":
+/// rasterizer (other sub-pixel precision, other tie rules, depth taken elsewhere), or with
+/// the pattern moved by a fraction of a pixel, a triangle that won no sample can win one; if
+/// the frame does not draw it, what lies behind shows through (a hole). Robust recording
+/// widens V_f (and E_f, so the extra triangles are ordered) towards "wins a sample on any
+/// rasterizer of the [`RasterProfile`]", whose sample placement is the recorded one moved
+/// within `tolerance` pixels:
 /// - `patterns` N: the union over N sample patterns, the recorded one and N − 1 moved by
 ///   offsets within ±`tolerance` ([`Robust::offsets`]), for phase 1 (visibility) and phase 2
 ///   (covered sets, edges, ties; edge weights add up over the patterns);
 /// - `conservative`: phase 1 also keeps every triangle whose footprint, grown by
-///   `tolerance` in x and y, reaches a sample at a depth (its nearest over the box) not
-///   behind a bound on the nearest opaque surface over the sample's whole ±`tolerance` box
-///   (the recorder's envelope bound; devices that cannot capture estimate it from the samples
-///   nearby), and phase 2 adds the edges of the grown triangles' layers that close no new
-///   cycle.
+///   `tolerance` in x and y, reaches a sample at a depth (its nearest over the profile's depth
+///   box, for corners snapped to the profile's sub-pixel grids) not behind a bound on the
+///   nearest opaque surface over that box (the recorder's envelope bound; devices that cannot
+///   capture estimate it from the samples nearby), and phase 2 adds the edges of the grown
+///   triangles' layers that close no new cycle.
 ///
 /// The recorded pattern stays one of the patterns, so a robust bake is still exact at it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Robust {
     /// Sample patterns unioned (1: the recorded one only).
     pub patterns: u32,
-    /// Tolerance in pixels: the jitter of the extra patterns and the conservative dilation.
+    /// Tolerance in pixels: the jitter of the extra patterns, and how far (in x and y) a
+    /// player's sample may lie from the recorded one relative to the exact geometry, besides
+    /// the snapping of corners, which the conservative recording adds from the profile (half a
+    /// step of its coarsest grid: corners are taken to be rounded to the nearest grid point).
     pub tolerance: f32,
     /// Conservative visibility (grown coverage against the opaque surface's farthest depth
-    /// over the tolerance box) and the grown peel's edges.
+    /// over the profile's depth box) and the grown peel's edges.
     pub conservative: bool,
+    /// What the bake assumes about the rasterizer that plays it, besides the tolerance.
+    pub profile: RasterProfile,
+}
+
+option_enum! {
+    /// The named raster profiles (`record --raster-profile NAME`): what a bake assumes about
+    /// the rasterizer that plays it ([`RasterProfile`], [`Robust::profile_named`]).
+    pub enum ProfileName: "raster profile" {
+        /// The recorded pattern only (`--conservative=false`): exact where played as recorded,
+        /// and only there.
+        Exact = "exact",
+            "the recorded pattern only: exact where played as recorded (--conservative=false)";
+        /// A conformant GPU (the default): the standard sample locations, corners snapped to
+        /// 8 sub-pixel bits (what desktop and mobile GPUs and Mesa's rasterizers report),
+        /// depth at the sample as the Vulkan and GLES specifications ask, and
+        /// [`Robust::CONFORMANT_TOLERANCE`] for snapping and transform rounding.
+        #[default]
+        Conformant = "conformant",
+            "a conformant GPU: standard sample locations, 8 sub-pixel bits, depth at the sample";
+        /// A conformant GPU that snaps to as little as 4 sub-pixel bits (the Vulkan and GLES
+        /// minimum), depth at the sample, [`Robust::SNAP4_TOLERANCE`].
+        Snap4 = "snap4",
+            "as conformant, but corners snapped to 4 to 8 sub-pixel bits (the API minimum)";
+        /// SwiftShader (Chromium's WebGL2 without a GPU): corners snapped to 4 to 8 bits and a
+        /// sample's depth taken anywhere in its pixel, ±1/8 px (the default before profiles).
+        Browser = "browser",
+            "SwiftShader's rules (the web build): 4 to 8 bits, depth anywhere in the pixel, 1/8 px";
+    }
+}
+
+option_enum! {
+    /// Where a rasterizer of a [`RasterProfile`] takes a sample's depth.
+    pub enum DepthAt: "depth position" {
+        /// At the sample, as the Vulkan and GLES specifications ask.
+        #[default]
+        Sample = "sample", "at the sample (the Vulkan and GLES rule)";
+        /// Anywhere in the sample's pixel (SwiftShader takes it at a mirrored offset).
+        Pixel = "pixel", "anywhere in the sample's pixel";
+    }
+}
+
+/// What a bake assumes about the rasterizer that plays it, besides the tolerance
+/// ([`Robust::tolerance`]): the recorded sample pattern (the size and sample count of the
+/// [`RecordSettings`], at the standard 4× positions), the sub-pixel grids its corners may be
+/// snapped to, and where it takes a sample's depth. The conservative recording is exactly as
+/// wide as this asks; the player checks the device against it at load.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RasterProfile {
+    /// The profile's name ([`ProfileName`]); the fields below are what the recorder used.
+    pub name: ProfileName,
+    /// The fewest sub-pixel bits a rasterizer of the profile snaps corners to (4..=16).
+    pub subpixel_bits_min: u32,
+    /// The most sub-pixel bits (at least `subpixel_bits_min`, at most 16). The bound on a
+    /// snapped sliver's depth is not monotone in the grid, so the range is stated, not just
+    /// its least.
+    pub subpixel_bits_max: u32,
+    /// Where a sample's depth is taken.
+    pub depth_at: DepthAt,
+}
+
+impl RasterProfile {
+    /// The profile a name stands for (its tolerance: [`Robust::profile_named`]).
+    pub const fn named(name: ProfileName) -> RasterProfile {
+        let (lo, hi, depth_at) = match name {
+            ProfileName::Exact | ProfileName::Conformant => (8, 8, DepthAt::Sample),
+            ProfileName::Snap4 => (4, 8, DepthAt::Sample),
+            ProfileName::Browser => (4, 8, DepthAt::Pixel),
+        };
+        RasterProfile {
+            name,
+            subpixel_bits_min: lo,
+            subpixel_bits_max: hi,
+            depth_at,
+        }
+    }
 }
 
 impl Robust {
     /// The most patterns [`RecordSettings::validate`] accepts.
     pub const MAX_PATTERNS: u32 = 64;
-    /// Recorded pattern only: a bake exact where it is played as recorded, and only there.
-    pub const OFF: Robust = Robust {
-        patterns: 1,
-        tolerance: 0.125,
-        conservative: false,
-    };
-    /// The default of `record`: conservative within ±1/8 px, so that a bake opens no hole
-    /// where another rasterizer's samples land up to 1/8 px from the recorded ones, or where
-    /// it snaps corners to 4 to 8 sub-pixel bits and takes a sample's depth elsewhere in its
-    /// pixel (measured: none on lavapipe at 1/16 and 1/8 px, none in SwiftShader), at the
-    /// cost of the extra triangles this keeps (BENCHMARKS § Exactness across rasterizers).
-    /// `record --conservative=false` records the pattern only ([`Robust::OFF`]).
-    pub const DEFAULT: Robust = Robust {
-        conservative: true,
-        ..Robust::OFF
-    };
+    /// The conformant profile's tolerance, 1/512 px, for f32 vertex transforms: two
+    /// conformant devices put the same corner of CarConcept's car tour at 1280×480 at most
+    /// 6.3e-4 px apart (twice the largest distance from the exact value over four evaluation
+    /// orders, with and without fused multiply-add, each division moved by Vulkan's 2.5 ulp:
+    /// `cargo run --release -p trisort-recorder --example transform_spread -- SCENE PATH SIZE`,
+    /// BENCHMARKS § Raster profiles), rounded up to a power of two with room for images about
+    /// three times as wide (the error grows with the image). The 8-bit snap (1/512 px) is
+    /// added by the recorder: a sample's box is ±1/256 px in all.
+    pub const CONFORMANT_TOLERANCE: f32 = 1.0 / 512.0;
+    /// The `snap4` profile's tolerance: the conformant one (a 4-bit snap adds 1/32 px).
+    pub const SNAP4_TOLERANCE: f32 = Robust::CONFORMANT_TOLERANCE;
+    /// The `browser` profile's tolerance, 3/32 px: with a 4-bit snap (1/32 px) a sample's box
+    /// is ±1/8 px, the default before raster profiles, measured with no hole in SwiftShader
+    /// (BENCHMARKS § Exactness across rasterizers).
+    pub const BROWSER_TOLERANCE: f32 = 3.0 / 32.0;
+
+    /// Recorded pattern only: a bake exact where it is played as recorded, and only there
+    /// (the `exact` profile; `record --conservative=false`).
+    pub const OFF: Robust = Robust::profile_named(ProfileName::Exact);
+    /// The default of `record`: the conformant-GPU profile ([`ProfileName::Conformant`]):
+    /// conservative within ±[`Robust::CONFORMANT_TOLERANCE`] for corners snapped to 8
+    /// sub-pixel bits and depth at the sample (BENCHMARKS § Raster profiles for its price and
+    /// the holes measured).
+    pub const DEFAULT: Robust = Robust::profile_named(ProfileName::Conformant);
+
+    /// The robust settings of a named profile: one pattern; conservative unless `exact`; the
+    /// profile's tolerance.
+    pub const fn profile_named(name: ProfileName) -> Robust {
+        let tolerance = match name {
+            // Unused while not conservative; the jitter of `--robust N` patterns (1/8 px).
+            ProfileName::Exact => 0.125,
+            ProfileName::Conformant => Robust::CONFORMANT_TOLERANCE,
+            ProfileName::Snap4 => Robust::SNAP4_TOLERANCE,
+            ProfileName::Browser => Robust::BROWSER_TOLERANCE,
+        };
+        Robust {
+            patterns: 1,
+            tolerance,
+            conservative: !matches!(name, ProfileName::Exact),
+            profile: RasterProfile::named(name),
+        }
+    }
 
     /// Whether anything beyond the recorded pattern is gathered.
     pub fn is_on(&self) -> bool {
@@ -175,6 +284,10 @@ impl RecordSettings {
         if !(r.tolerance >= 0.0 && r.tolerance <= 4.0) {
             return Err(SettingsError::Tolerance(r.tolerance));
         }
+        let (lo, hi) = (r.profile.subpixel_bits_min, r.profile.subpixel_bits_max);
+        if !(4..=16).contains(&lo) || !(lo..=16).contains(&hi) {
+            return Err(SettingsError::SubpixelBits(lo, hi));
+        }
         Ok(())
     }
 }
@@ -218,6 +331,9 @@ pub enum SettingsError {
     /// Robust tolerance outside [0, 4] pixels.
     #[error("robust tolerance {0} px must be in [0, 4]")]
     Tolerance(f32),
+    /// The raster profile's sub-pixel bits are not 4 ≤ least ≤ most ≤ 16.
+    #[error("raster profile sub-pixel bits {0}..={1} must satisfy 4 <= least <= most <= 16")]
+    SubpixelBits(u32, u32),
 }
 
 /// The device a recording was made on.

@@ -17,7 +17,7 @@
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
-use trisort_format::{AlphaMode, FrameState, Geometry};
+use trisort_format::{AlphaMode, FrameState, Geometry, Robust};
 use trisort_gpu::pipeline::{bind_group, storage_entry, uniform_entry};
 use trisort_gpu::scene_gpu::{vertex_layout, SceneGpu, View};
 use trisort_gpu::Gpu;
@@ -95,14 +95,15 @@ struct Prepass {
 /// ([`crate::envelope::Adjacency::opposite`]).
 #[derive(Clone, Copy)]
 pub(crate) enum Grow<'a> {
-    Peel(f32),
-    Envelope(f32, &'a [[u32; 4]]),
+    Peel(&'a Robust),
+    Envelope(&'a Robust, &'a [[u32; 4]]),
 }
 
 impl Grow<'_> {
-    fn tolerance(&self) -> f32 {
+    /// The tolerance and raster profile grown by.
+    fn robust(&self) -> &Robust {
         match self {
-            Grow::Peel(t) | Grow::Envelope(t, _) => *t,
+            Grow::Peel(r) | Grow::Envelope(r, _) => r,
         }
     }
 }
@@ -268,8 +269,7 @@ impl<'g> Capture<'g> {
                 (Vec::from(pipelines), None)
             }
             Some(grow) => {
-                let tolerance = grow.tolerance();
-                let buffers = GrowBuffers::new(device, geometry, triangles, view, tolerance);
+                let buffers = GrowBuffers::new(device, geometry, triangles, view, grow.robust());
                 let mut layout_entries = GrowBuffers::layout_entries().to_vec();
                 let mut entries = buffers.entries().to_vec();
                 let opposite = match grow {

@@ -25,7 +25,7 @@
 //! What it adds to V_f costs draws, never exactness: a triangle drawn where it is hidden
 //! changes no pixel.
 
-use trisort_format::{FrameState, Geometry};
+use trisort_format::{DepthAt, FrameState, Geometry, Robust};
 use trisort_gpu::pipeline::{storage_entry, uniform_entry};
 use trisort_gpu::scene_gpu::{SceneGpu, View};
 use trisort_gpu::Gpu;
@@ -68,19 +68,30 @@ pub(crate) struct GrowBuffers {
 
 impl GrowBuffers {
     /// The buffers for drawing `triangles` (indices into `geometry.triangles`, in draw order)
-    /// at `view` with a tolerance of `tolerance` pixels.
+    /// at `view`, grown by `robust`'s tolerance in pixels plus half a step of its raster
+    /// profile's coarsest sub-pixel grid (how far a snapped corner moves in x and y), with the
+    /// profile for the envelope capture (`grow.wgsl`'s `Cons`).
     pub(crate) fn new(
         device: &wgpu::Device,
         geometry: &Geometry,
         triangles: &[u32],
         view: View,
-        tolerance: f32,
+        robust: &Robust,
     ) -> GrowBuffers {
-        let params: [f32; 4] = [
-            tolerance,
-            tolerance,
+        let profile = robust.profile;
+        // The box a sample may move in relative to the exact geometry: the tolerance, plus
+        // half a step of the coarsest grid a corner is snapped to (rounding to nearest).
+        let coarsest = 0.5f32.powi(profile.subpixel_bits_min as i32);
+        let reach = robust.tolerance + 0.5 * coarsest;
+        let params: [f32; 8] = [
+            reach,
+            reach,
             view.width as f32 / 2.0,
             view.height as f32 / 2.0,
+            (profile.depth_at == DepthAt::Pixel) as u32 as f32,
+            coarsest * std::f32::consts::FRAC_1_SQRT_2,
+            profile.subpixel_bits_min as f32,
+            profile.subpixel_bits_max as f32,
         ];
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -240,13 +251,15 @@ pub(crate) fn pulled_pipeline(
 
 impl<'g> Conservative<'g> {
     /// Sets up the passes over every triangle of `geometry` for the path's `frames` at `view`
-    /// with a tolerance of `tolerance` pixels.
+    /// with `robust`'s tolerance in pixels (the passes take no other part of its raster
+    /// profile: they compare depths over ±(tolerance + 0.55) px, wider than any profile's box,
+    /// and assume no snapping beyond the tolerance).
     pub fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
         view: View,
-        tolerance: f32,
+        robust: &Robust,
     ) -> Result<Conservative<'g>, RecordError> {
         let device = &gpu.device;
         let scene = crate::peeler::visibility_scene(gpu, geometry, frames, view);
@@ -255,7 +268,7 @@ impl<'g> Conservative<'g> {
             source: wgpu::ShaderSource::Wgsl(trisort_gpu::conservative_shader(view.samples).into()),
         });
         let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
-        let grow = GrowBuffers::new(device, geometry, &all, view, tolerance);
+        let grow = GrowBuffers::new(device, geometry, &all, view, robust);
         let count = grow.triangles;
         let flags_size = 4 * count.max(1) as u64;
         let flags = device.create_buffer(&wgpu::BufferDescriptor {

@@ -41,7 +41,7 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
-use trisort_format::{FrameState, Geometry};
+use trisort_format::{FrameState, Geometry, Robust};
 use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
 
@@ -202,14 +202,14 @@ pub(crate) struct Envelope<'g> {
 
 impl<'g> Envelope<'g> {
     /// The envelope capture of every triangle of `geometry` for the path's `frames` at `view`
-    /// with a tolerance of `tolerance` pixels. Errors where the device cannot capture, or the
+    /// within `robust`'s tolerance and raster profile. Errors where the device cannot capture, or the
     /// scene has 2^24 triangles or more (the flags share the captured id's word).
     pub fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
         frames: &[FrameState],
         view: View,
-        tolerance: f32,
+        robust: &Robust,
     ) -> Result<Envelope<'g>, RecordError> {
         if !Envelope::fits(geometry) {
             return Err(RecordError::Unsupported(format!(
@@ -220,7 +220,7 @@ impl<'g> Envelope<'g> {
         }
         let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
         let adjacency = Adjacency::new(geometry, &all);
-        let grow = Grow::Envelope(tolerance, &adjacency.opposite);
+        let grow = Grow::Envelope(robust, &adjacency.opposite);
         let capture = Capture::grown(gpu, geometry, &all, frames, view, grow)?;
         Ok(Envelope {
             capture: RefCell::new(capture),

@@ -33,10 +33,8 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
-#[cfg(doc)]
-use trisort_format::Robust;
 use trisort_format::{
-    Edge, FrameRecord, FrameState, Geometry, Hash, Phase, RecordSettings, Recording,
+    Edge, FrameRecord, FrameState, Geometry, Hash, Phase, RecordSettings, Recording, Robust,
 };
 use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
@@ -184,7 +182,7 @@ enum Purpose {
     Graphs,
     /// Phase 2 of `record --conservative`: the triangles grown by this tolerance in pixels
     /// ([`Peeler::grown`]).
-    Grown(f32),
+    Grown(Robust),
 }
 
 impl<'g> Layers<'g> {
@@ -203,8 +201,8 @@ impl<'g> Layers<'g> {
             let c = match purpose {
                 Purpose::Visibility => capture::Capture::new(gpu, g, t, f, view, true)?,
                 Purpose::Graphs => capture::Capture::new(gpu, g, t, f, view, false)?,
-                Purpose::Grown(tolerance) => {
-                    capture::Capture::grown(gpu, g, t, f, view, capture::Grow::Peel(tolerance))?
+                Purpose::Grown(robust) => {
+                    capture::Capture::grown(gpu, g, t, f, view, capture::Grow::Peel(&robust))?
                 }
             };
             return Ok(Layers::Capture(std::cell::RefCell::new(c)));
@@ -212,8 +210,8 @@ impl<'g> Layers<'g> {
         Ok(Layers::Peel(match purpose {
             Purpose::Visibility => Peeler::new(gpu, g, t, f, view)?.with_readback(true, false),
             Purpose::Graphs => Peeler::new(gpu, g, t, f, view)?.with_readback(false, true),
-            Purpose::Grown(tolerance) => {
-                Peeler::grown(gpu, g, t, f, view, tolerance)?.with_readback(false, true)
+            Purpose::Grown(robust) => {
+                Peeler::grown(gpu, g, t, f, view, &robust)?.with_readback(false, true)
             }
         }))
     }
@@ -649,7 +647,7 @@ pub fn record(
                 Purpose::Visibility,
             )?;
             let conservative = if s.robust.conservative {
-                let (g, f, t) = (job.geometry, job.frames, s.robust.tolerance);
+                let (g, f, t) = (job.geometry, job.frames, &s.robust);
                 // The envelope needs a capture, but not the layers' switch: recordings peeled
                 // by `with_peeling` take the same conservative set as captured ones.
                 let passes = CONSERVATIVE_PASSES.with(|c| c.get());
@@ -727,7 +725,7 @@ pub fn record(
                         peeler = Some(layers(Purpose::Graphs)?);
                     }
                     if s.robust.conservative && grown.is_none() {
-                        grown = Some(layers(Purpose::Grown(s.robust.tolerance))?);
+                        grown = Some(layers(Purpose::Grown(s.robust))?);
                     }
                     let r = graph_frame(peeler.as_ref().unwrap(), grown.as_ref(), f, &g, &s)?;
                     if let Some(p) = partial {

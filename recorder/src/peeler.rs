@@ -5,7 +5,7 @@
 
 use std::ops::Range;
 
-use trisort_format::{FrameState, Geometry};
+use trisort_format::{FrameState, Geometry, Robust};
 use trisort_gpu::pipeline::{bind_group, storage_entry, uniform_entry};
 use trisort_gpu::scene_gpu::{
     begin_peel_pass, previous_key_entries, SceneGpu, ScenePipeline, View,
@@ -317,7 +317,8 @@ impl<'g> Peeler<'g> {
         Peeler::build(gpu, geometry, triangles, frames, view, None)
     }
 
-    /// [`Peeler::new`] over the triangles grown by `tolerance` pixels (`peel_grown.wgsl`):
+    /// [`Peeler::new`] over the triangles grown by `robust`'s tolerance in pixels
+    /// (`peel_grown.wgsl`):
     /// each sample's layers list every triangle that could cover it when the pattern moves
     /// within the tolerance, by the depth of its plane at the sample. Phase 2 of
     /// `record --conservative` takes the edges of the triangles it adds from here. Layers
@@ -328,9 +329,9 @@ impl<'g> Peeler<'g> {
         triangles: &[u32],
         frames: &[FrameState],
         view: View,
-        tolerance: f32,
+        robust: &Robust,
     ) -> Result<Self, RecordError> {
-        Peeler::build(gpu, geometry, triangles, frames, view, Some(tolerance))
+        Peeler::build(gpu, geometry, triangles, frames, view, Some(robust))
     }
 
     fn build(
@@ -339,7 +340,7 @@ impl<'g> Peeler<'g> {
         triangles: &[u32],
         frames: &[FrameState],
         view: View,
-        grow: Option<f32>,
+        grow: Option<&Robust>,
     ) -> Result<Self, RecordError> {
         let device = &gpu.device;
         check_device(gpu, view)?;
@@ -378,8 +379,8 @@ impl<'g> Peeler<'g> {
                 .build(device),
                 None,
             ),
-            Some(tolerance) => {
-                let buffers = GrowBuffers::new(device, geometry, triangles, view, tolerance);
+            Some(robust) => {
+                let buffers = GrowBuffers::new(device, geometry, triangles, view, robust);
                 let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                     label: Some("grown peel"),
                     entries: &GrowBuffers::layout_entries(),

@@ -91,10 +91,7 @@ pub(crate) fn variants() -> Vec<RecordSettings> {
             ..base
         },
         RecordSettings {
-            robust: Robust {
-                conservative: true,
-                ..Robust::OFF
-            },
+            robust: Robust::DEFAULT,
             ..base
         },
         RecordSettings { samples: 1, ..base },

@@ -73,7 +73,7 @@ pub fn run(a: BakeArgs) -> Result<ExitCode> {
     // First: a bad light fails before the scene is loaded and split.
     let environment = a.merge.environment()?;
     let (scene, timeline, split) =
-        load_working(&a.scene, &a.path, a.record.fps, &a.record.settings())?;
+        load_working(&a.scene, &a.path, a.record.fps, &a.record.settings()?)?;
     let gpu = crate::common::open_gpu()?;
     let (rec, baked, record_s, merge_s) = bake(
         &gpu,

@@ -73,7 +73,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         "demo",
         &path.frames,
         "the demo path",
-        &record.settings(),
+        &record.settings()?,
     )?;
     let merge = MergeOpts::defaults();
     let gpu = crate::common::open_gpu()?;

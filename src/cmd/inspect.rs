@@ -71,6 +71,10 @@ fn inspect_recording(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
             "  device {} ({}, {})",
             rec.device.adapter, rec.device.backend, rec.device.driver
         );
+        println!(
+            "  raster profile {}",
+            crate::cmd::record::profile_summary(&rec.settings)
+        );
         for f in &rec.frames {
             println!(
                 "  frame {:>5}: visible {:>7} covered {:>7} edges {:>8} layers {:?}{}",
@@ -111,6 +115,8 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
             Some((v.name.clone(), serde_json::Value::from(e.to_string())))
         }).collect::<serde_json::Map<_, _>>(),
         "split_intersections": baked.settings.split_intersections,
+        // What the bake assumes about the rasterizer that plays it (record --raster-profile).
+        "raster_profile": crate::cmd::record::raster_profile_json(&baked.settings),
         // The light stored in the file (`bake --environment`).
         "environment": crate::cmd::merge::environment_json(&baked.environment),
         // The recording device; `mixed: …` (each device with its frames) when the recordings

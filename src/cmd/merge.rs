@@ -142,6 +142,7 @@ pub fn baked_json(b: &Baked, seconds: f64) -> serde_json::Value {
         "heuristic_components": s.heuristic_components,
         "heuristic_unordered_samples": s.heuristic_unordered_samples,
         "environment": environment_json(&b.environment),
+        "raster_profile": crate::cmd::record::raster_profile_json(&b.settings),
         "seconds": seconds,
     })
 }

@@ -16,9 +16,9 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 
-use trisort_format::RecordSettings;
+use trisort_format::{DepthAt, ProfileName, RecordSettings, Robust};
 
-use crate::common::{default_size, parse_range, parse_size, FrameRange};
+use crate::common::{default_size, option_parser, parse_range, parse_size, FrameRange};
 
 /// trisort: bake fixed camera paths into one depth-sorted index buffer with a sliding window
 /// per frame, and play, verify and measure the result.
@@ -86,32 +86,67 @@ pub struct RecordOpts {
     /// or a modest resize opens fewer holes (costs N times the peel).
     #[arg(long, value_name = "N", default_value_t = RecordSettings::default().robust.patterns)]
     pub robust: u32,
-    /// Robust recording: also keep every triangle that may be the nearest surface somewhere in
-    /// a sample's box of ±--robust-tolerance pixels: its footprint grown by the box reaches the
-    /// sample and it is not behind a bound on the nearest opaque surface over the whole box
-    /// (one capture of the grown triangles per frame in phase 1, whose opaque triangles bound
-    /// the box where they close over it; three passes on devices that cannot capture), with
-    /// the edges of the grown triangles' layers (phase 2).
-    /// The default; `--conservative=false` records the recorded pattern only (fewer
-    /// triangles a frame, exact only where played as recorded).
+    /// What the bake assumes about the rasterizer that plays it (BENCHMARKS § Raster
+    /// profiles): `conformant` (the default) for GPUs with the standard sample locations, 8
+    /// sub-pixel bits and depth at the sample; `exact` for the recorded pattern only
+    /// (`--conservative=false`); `snap4` for GPUs snapping to as few as 4 bits; `browser` for
+    /// SwiftShader (the web build). Every profile but `exact` records conservatively: it keeps
+    /// every triangle that may be the nearest surface somewhere in a sample's box of
+    /// ±tolerance pixels, for corners snapped to the profile's grids and depth where the
+    /// profile takes it, with the edges of the grown triangles' layers (phase 2).
+    #[arg(long, value_name = "NAME", value_parser = option_parser::<ProfileName>())]
+    pub raster_profile: Option<ProfileName>,
+    /// Conservative recording on or off. `--conservative=false` is `--raster-profile exact`;
+    /// `--conservative` (true) the default profile. Contradicting --raster-profile is an
+    /// error.
     #[arg(
         long,
         value_name = "BOOL",
         num_args = 0..=1,
         require_equals = true,
-        default_value_t = RecordSettings::default().robust.conservative,
         default_missing_value = "true",
         action = clap::ArgAction::Set
     )]
-    pub conservative: bool,
-    /// Tolerance in pixels of --robust's jittered patterns and of --conservative.
-    #[arg(long, value_name = "PX", default_value_t = RecordSettings::default().robust.tolerance)]
-    pub robust_tolerance: f32,
+    pub conservative: Option<bool>,
+    /// Tolerance in pixels of --robust's jittered patterns and of the conservative recording
+    /// (default: the raster profile's: 1/512 conformant and snap4, 3/32 browser, 1/8 exact).
+    /// The conservative recording adds half a step of the profile's coarsest sub-pixel grid
+    /// (1/512 px at 8 bits, 1/32 px at 4).
+    #[arg(long, value_name = "PX")]
+    pub robust_tolerance: Option<f32>,
+    /// The raster profile's sub-pixel grids, `N` or `LEAST..MOST` bits (4..=16; default: the
+    /// profile's: 8 conformant, 4..8 snap4 and browser).
+    #[arg(long, value_name = "BITS", value_parser = parse_bits)]
+    pub subpixel_bits: Option<(u32, u32)>,
+    /// Where the raster profile's rasterizer takes a sample's depth (default: the profile's:
+    /// `pixel` for browser, `sample` otherwise).
+    #[arg(long, value_name = "WHERE", value_parser = option_parser::<DepthAt>())]
+    pub depth_at: Option<DepthAt>,
+}
+
+/// Parses `--subpixel-bits`: `N` or `LEAST..MOST`.
+fn parse_bits(s: &str) -> Result<(u32, u32), String> {
+    let bits = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{t}` is not a number of bits"))
+    };
+    let (lo, hi) = match s.split_once("..") {
+        Some((a, b)) => (bits(a)?, bits(b.trim_start_matches('='))?),
+        None => (bits(s)?, bits(s)?),
+    };
+    if !(4..=16).contains(&lo) || !(lo..=16).contains(&hi) {
+        return Err(format!(
+            "sub-pixel bits {lo}..{hi} must satisfy 4 <= least <= most <= 16"
+        ));
+    }
+    Ok((lo, hi))
 }
 
 impl RecordOpts {
     /// Options recording the whole path with `settings`, sampling generated paths at `fps`.
     pub fn new(settings: RecordSettings, fps: f64) -> RecordOpts {
+        let r = settings.robust;
         RecordOpts {
             size: (settings.width, settings.height),
             samples: settings.samples,
@@ -121,15 +156,46 @@ impl RecordOpts {
             frames: None,
             fps,
             keep_intersections: !settings.split_intersections,
-            robust: settings.robust.patterns,
-            conservative: settings.robust.conservative,
-            robust_tolerance: settings.robust.tolerance,
+            robust: r.patterns,
+            raster_profile: Some(r.profile.name),
+            conservative: Some(r.conservative),
+            robust_tolerance: Some(r.tolerance),
+            subpixel_bits: Some((r.profile.subpixel_bits_min, r.profile.subpixel_bits_max)),
+            depth_at: Some(r.profile.depth_at),
         }
     }
 
-    /// The settings stored in the recording.
-    pub fn settings(&self) -> RecordSettings {
-        RecordSettings {
+    /// The settings stored in the recording: the named raster profile (by default the
+    /// conformant one, `exact` under `--conservative=false`) with the knobs given on top.
+    pub fn settings(&self) -> Result<RecordSettings> {
+        let name = match (self.raster_profile, self.conservative) {
+            (Some(ProfileName::Exact), Some(true)) => anyhow::bail!(
+                "--raster-profile exact records the pattern only; it cannot be --conservative"
+            ),
+            (Some(n), Some(false)) if n != ProfileName::Exact => anyhow::bail!(
+                "--raster-profile {n} records conservatively; --conservative=false is \
+                 --raster-profile exact"
+            ),
+            (Some(n), _) => n,
+            (None, Some(false)) => ProfileName::Exact,
+            (None, _) => Robust::DEFAULT.profile.name,
+        };
+        let mut robust = Robust::profile_named(name);
+        robust.patterns = self.robust;
+        if let Some(t) = self.robust_tolerance {
+            robust.tolerance = t;
+        }
+        if let Some(c) = self.conservative {
+            robust.conservative = c;
+        }
+        if let Some((lo, hi)) = self.subpixel_bits {
+            robust.profile.subpixel_bits_min = lo;
+            robust.profile.subpixel_bits_max = hi;
+        }
+        if let Some(d) = self.depth_at {
+            robust.profile.depth_at = d;
+        }
+        Ok(RecordSettings {
             width: self.size.0,
             height: self.size.1,
             samples: self.samples,
@@ -137,12 +203,8 @@ impl RecordOpts {
             glass_opacity: self.glass_opacity,
             max_layers: self.max_layers,
             split_intersections: !self.keep_intersections,
-            robust: trisort_format::Robust {
-                patterns: self.robust,
-                tolerance: self.robust_tolerance,
-                conservative: self.conservative,
-            },
-        }
+            robust,
+        })
     }
 }
 

@@ -63,6 +63,50 @@ pub struct RecordArgs {
     json: bool,
 }
 
+/// The raster profile in one line, for summaries: `conformant (±0.001953125 px, corners
+/// snapped to 8 sub-pixel bits, depth at the sample)`.
+pub fn profile_summary(s: &trisort_format::RecordSettings) -> String {
+    let r = &s.robust;
+    let (lo, hi) = (r.profile.subpixel_bits_min, r.profile.subpixel_bits_max);
+    let bits = if lo == hi {
+        format!("{lo}")
+    } else {
+        format!("{lo} to {hi}")
+    };
+    if !r.conservative {
+        return format!("{} (the recorded pattern only)", r.profile.name);
+    }
+    format!(
+        "{} (±{} px, corners snapped to {bits} sub-pixel bits, depth {})",
+        r.profile.name,
+        r.tolerance,
+        match r.profile.depth_at {
+            trisort_format::DepthAt::Sample => "at the sample",
+            trisort_format::DepthAt::Pixel => "anywhere in the pixel",
+        }
+    )
+}
+
+/// `--json`'s `raster_profile` (record, merge, bake, inspect): what the bake assumes about
+/// the rasterizer that plays it (DESIGN's CLI contract, third wave): the profile's `name`, its
+/// `tolerance` in pixels, the sub-pixel grids (`subpixel_bits`: `[least, most]`), where depth
+/// is taken (`depth_at`), the recorded sample pattern (`size`, `samples`, `sample_locations`:
+/// `standard`), whether the recording was `conservative`, and its jittered `patterns`.
+pub fn raster_profile_json(s: &trisort_format::RecordSettings) -> serde_json::Value {
+    let r = &s.robust;
+    json!({
+        "name": r.profile.name,
+        "tolerance": r.tolerance,
+        "subpixel_bits": [r.profile.subpixel_bits_min, r.profile.subpixel_bits_max],
+        "depth_at": r.profile.depth_at,
+        "size": [s.width, s.height],
+        "samples": s.samples,
+        "sample_locations": "standard",
+        "conservative": r.conservative,
+        "patterns": r.patterns,
+    })
+}
+
 /// The `--json` figures of a recording (DESIGN's CLI contract).
 pub fn recording_json(rec: &Recording, seconds: Option<f64>) -> serde_json::Value {
     let g = rec.unique_visible.len();
@@ -101,6 +145,7 @@ pub fn recording_json(rec: &Recording, seconds: Option<f64>) -> serde_json::Valu
             "tolerance": rec.settings.robust.tolerance,
             "conservative": rec.settings.robust.conservative,
         },
+        "raster_profile": raster_profile_json(&rec.settings),
         "per_frame": per_frame,
         "seconds": seconds,
     })
@@ -132,7 +177,7 @@ pub fn record_to_file(
         frames: &timeline.frames,
         scene_hash: scene.hash(),
         path_hash: timeline.hash(),
-        settings: opts.settings(),
+        settings: opts.settings()?,
         range,
         phase,
         known_visible,
@@ -165,7 +210,8 @@ pub fn record_to_file(
 
 pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
-    let (scene, timeline, split) = load_working(&a.scene, &a.path, a.opts.fps, &a.opts.settings())?;
+    let (scene, timeline, split) =
+        load_working(&a.scene, &a.path, a.opts.fps, &a.opts.settings()?)?;
     if let Some(shard) = a.shard {
         let (i, n) = shard.resolve(&|k| std::env::var(k).ok())?;
         let range = shard_range(i, n, timeline.frames.len() as u32)?;
@@ -191,7 +237,7 @@ pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
             (Phase::Graphs, None)
         }
         PhaseArg::Graphs => {
-            let known = union_of_visibility(&a.visibility, &scene, &timeline, &a.opts.settings())?;
+            let known = union_of_visibility(&a.visibility, &scene, &timeline, &a.opts.settings()?)?;
             let (g, devices) = known.unzip();
             visibility_devices = devices.unwrap_or_default();
             (Phase::Graphs, g)
@@ -404,7 +450,7 @@ fn write_union(
             a.path
         );
     }
-    let differ = trisort_merger::settings_differences(&rec.settings, &a.opts.settings());
+    let differ = trisort_merger::settings_differences(&rec.settings, &a.opts.settings()?);
     if !differ.is_empty() {
         bail!(
             "{}: recorded with other settings than this command line's: {}",

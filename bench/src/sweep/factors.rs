@@ -3,7 +3,7 @@
 
 use std::str::FromStr;
 
-use trisort_format::{RecordSettings, Robust};
+use trisort_format::{ProfileName, RecordSettings, Robust};
 use trisort_merger::{Bridge, Choice, Layout, MergeOptions, Strategy};
 
 use super::SweepConfig;
@@ -122,7 +122,15 @@ pub(super) struct Variant {
     pub(super) merge: MergeOptions,
 }
 
-type SettingsKey = (u32, u32, u32, u32, u32, u32, (u32, u32, bool));
+type SettingsKey = (
+    u32,
+    u32,
+    u32,
+    u32,
+    u32,
+    u32,
+    (u32, u32, bool, trisort_format::RasterProfile),
+);
 
 fn settings_key(s: &RecordSettings) -> SettingsKey {
     (
@@ -136,16 +144,18 @@ fn settings_key(s: &RecordSettings) -> SettingsKey {
             s.robust.patterns,
             s.robust.tolerance.to_bits(),
             s.robust.conservative,
+            s.robust.profile,
         ),
     )
 }
 
-/// A robust setting as the sweep names it (`1`, `4`, `conservative`, `conservative+4`).
+/// A robust setting as the sweep names it (`1`, `4`: patterns; `conformant`, `browser+4`: a
+/// conservative raster profile, with patterns beyond the first).
 pub(super) fn robust_name(r: &Robust) -> String {
     match (r.conservative, r.patterns) {
         (false, n) => n.to_string(),
-        (true, 1) => "conservative".into(),
-        (true, n) => format!("conservative+{n}"),
+        (true, 1) => r.profile.name.to_string(),
+        (true, n) => format!("{}+{n}", r.profile.name),
     }
 }
 
@@ -254,19 +264,21 @@ pub(super) fn variants(config: &SweepConfig, base: RecordSettings) -> Vec<Varian
                 }
             }
             Factor::Robust => {
+                // The recorded pattern unioned with up to 7 jittered ones (±1/8 px), then the
+                // conformant profile (the default) and the widest, `browser` (±1/8 px), alone and
+                // with 4 patterns.
                 let mut values: Vec<Robust> = [1, 2, 4, 8]
                     .into_iter()
                     .map(|patterns| Robust {
                         patterns,
-                        conservative: false,
-                        ..base.robust
+                        ..Robust::OFF
                     })
                     .collect();
+                values.push(Robust::DEFAULT);
                 for patterns in [1, 4] {
                     values.push(Robust {
                         patterns,
-                        conservative: true,
-                        ..base.robust
+                        ..Robust::profile_named(ProfileName::Browser)
                     });
                 }
                 if !values.contains(&base.robust) {
@@ -325,7 +337,7 @@ mod tests {
         assert_eq!(count(Factor::Bridge), 3);
         assert_eq!(count(Factor::StrategyLayout), 13);
         assert_eq!(count(Factor::Segment), 4);
-        assert_eq!(count(Factor::Robust), 6);
+        assert_eq!(count(Factor::Robust), 7);
         let robust: Vec<_> = v
             .iter()
             .filter(|x| x.factor == Factor::Robust)
@@ -333,7 +345,7 @@ mod tests {
             .collect();
         assert_eq!(
             robust,
-            ["1", "2", "4", "8", "conservative", "conservative+4"]
+            ["1", "2", "4", "8", "conformant", "browser", "browser+4"]
         );
         // Each factor has exactly one default point, and it is the same bake.
         for f in Factor::ALL {

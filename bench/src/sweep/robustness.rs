@@ -35,10 +35,10 @@ pub struct Condition {
     pub offset: [f64; 2],
 }
 
-/// The conditions for playback `size`: offsets of 1/16, 1/8 and 1/4 px in x, then 1.5× and
-/// 2× the size.
+/// The conditions for playback `size`: offsets of 1/128 (the conformant raster profile's
+/// tolerance), 1/16, 1/8 and 1/4 px in x, then 1.5× and 2× the size.
 pub fn conditions(size: (u32, u32)) -> Vec<Condition> {
-    let mut out: Vec<Condition> = [(16, "1/16"), (8, "1/8"), (4, "1/4")]
+    let mut out: Vec<Condition> = [(128, "1/128"), (16, "1/16"), (8, "1/8"), (4, "1/4")]
         .into_iter()
         .map(|(d, name)| Condition {
             name: format!("offset {name}"),

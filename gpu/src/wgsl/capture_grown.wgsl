@@ -27,20 +27,23 @@ fn fs_capture_grown(
 // nearest depth over the depth box (as its depth), its farthest (as its opacity) and, above
 // the id's ENVELOPE_ID_BITS, the flags below.
 //
-// Three allowances for rasterizers other than the recording one (BENCHMARKS § Exactness
-// across rasterizers; found on SwiftShader, the browser's WebGL2):
-// - depth is compared over the sample's whole pixel grown by the tolerance, not at the
-//   sample: a rasterizer may take a sample's depth elsewhere in its pixel. SwiftShader does:
-//   it evaluates the depth plane with the sample's offset from the pixel centre negated in x
-//   (in older versions in x and y), so sample 1 of the 4× pattern, at (0.875, 0.375), takes
-//   its depth at (0.125, 0.375);
-// - depth is that of the plane through the corners snapped to the rasterizer's sub-pixel grid
-//   (4 to 8 bits), bounded by envelope_depth_range: on a sliver it extrapolates far (on
-//   CarConcept, a sliver 0.04 behind the surface at its sample took a depth 0.03 in front of
-//   it at the mirrored point);
-// - a triangle whose facing snapping may turn (bit 3 of `closable`) is kept either facing and
-//   never occludes; one degenerate in f32 (CONS_DEGENERATE), which snapping may give area,
-//   has no depth to go by at all and is listed at depth 0.
+// Three allowances for rasterizers other than the recording one, each as wide as the bake's
+// raster profile asks (`cons.profile`; BENCHMARKS § Raster profiles; all three were found on
+// SwiftShader, the browser's WebGL2, whose `browser` profile takes the widest):
+// - depth is compared over the sample's tolerance box where the profile takes depth at the
+//   sample (the Vulkan and GLES rule), and over the sample's whole pixel grown by the
+//   tolerance where it takes it anywhere in the pixel. SwiftShader does: it evaluates the
+//   depth plane with the sample's offset from the pixel centre negated in x (in older
+//   versions in x and y), so sample 1 of the 4× pattern, at (0.875, 0.375), takes its depth at
+//   (0.125, 0.375);
+// - depth is that of the plane through the corners snapped to the profile's sub-pixel grids,
+//   bounded by envelope_depth_range: on a sliver it extrapolates far (on CarConcept, a sliver
+//   0.04 behind the surface at its sample took a depth 0.03 in front of it at the mirrored
+//   point, snapped to 1/16 px);
+// - a triangle whose facing snapping to the profile's coarsest grid may turn (bit 3 of
+//   `closable`) is kept either facing and never occludes; one degenerate in f32
+//   (CONS_DEGENERATE), which snapping may give area, has no depth to go by at all and is
+//   listed at depth 0.
 
 // Per triangle of the drawn list: for edge k (corner k to corner k + 1), the vertex of the
 // triangle across it opposite the edge, or 0xffffffff where the edge has no single neighbour.
@@ -67,10 +70,11 @@ fn vs_envelope(@builtin(vertex_index) vi: u32) -> ConsVarying {
     let p = array<vec2<f32>, 3>(out.p01.xy, out.p01.zw, out.p2);
     // CONS_DEGENERATE from cons_corner, where set.
     var closable = out.closable;
-    // Bit 3: its facing may turn on a rasterizer that snaps each corner to its own grid of
-    // 1/16 px (Vulkan's and GLES's least sub-pixel precision): twice its area is within what
-    // moving the corners by up to 1/32 px in x and y can change it by.
-    if (cons_moved_area2(p, ENVELOPE_SNAP_16) <= 0.0) {
+    // Bit 3: its facing may turn on a rasterizer that snaps each corner to the profile's
+    // coarsest grid (1/16 px for 4 bits, Vulkan's and GLES's least sub-pixel precision; 1/256
+    // px for 8): twice its area is within what moving the corners by up to half a grid step in
+    // x and y can change it by.
+    if (cons_moved_area2(p, cons.profile.y) <= 0.0) {
         closable |= 8u;
     }
     for (var k = 0u; k < 3u; k++) {
@@ -96,16 +100,14 @@ fn vs_envelope(@builtin(vertex_index) vi: u32) -> ConsVarying {
     return out;
 }
 
-// How far a corner moves, in pixels, when snapped to the nearest point of a grid of 1/16 px.
-const ENVELOPE_SNAP_16: f32 = 0.044194173;
-
 // The depths (least, most) a rasterizer may take over the box of half-size `r` pixels around
 // `c`, where the exact plane is `z` at `c` and departs from it by at most `slack` over the box:
 // the exact plane's, or those of the plane through the corners snapped to a grid of 2^−b px
-// for b = 4 (Vulkan's and GLES's least sub-pixel precision; SwiftShader's) to 8 (common on
-// desktop GPUs; rounding: each corner moves by at most e = 2^−b·√2/2), with the corners' own
+// for every b of the profile's sub-pixel bits (`cons.profile.zw`; 4 is Vulkan's and GLES's
+// least precision and SwiftShader's, 8 that of desktop and mobile GPUs and Mesa's
+// rasterizers; rounding: each corner moves by at most e = 2^−b·√2/2), with the corners' own
 // depths interpolated over the snapped triangle. The bound is not monotone in the grid (a
-// sliver's least snapped area bottoms out in between), so every b is taken.
+// sliver's least snapped area bottoms out in between), so every b of the range is taken.
 //
 // For a snapped grid, from the barycentric weights λ' of a point of the box in the snapped
 // triangle, with Λ = Σ|λ'|: the snapped plane is the exact plane moved by Σ λ'_k ∇z·δ_k (at
@@ -133,7 +135,7 @@ fn envelope_depth_range(in: ConsVarying, c: vec2<f32>, r: vec2<f32>, z: f32, sla
         reach[k] = length(v) + length(r);
     }
     var range = vec2<f32>(z - slack, z + slack);
-    for (var bits = 4u; bits <= 8u; bits++) {
+    for (var bits = u32(cons.profile.z); bits <= u32(cons.profile.w); bits++) {
         let grid = 1.0 / f32(1u << bits);
         let e = grid * 0.70710678;
         let least = max(cons_moved_area2(p, e), grid * grid);
@@ -185,13 +187,17 @@ fn fs_capture_envelope(
         if (!cons_inside(in, 1.0)) {
             return;
         }
-        // The depth box: the sample's pixel grown by the tolerance (half-size `reach` px
-        // around the pixel's centre `c`; a sample moved within the tolerance is taken to keep
-        // its pixel, as it does at ±1/8 px with the standard patterns), over which the plane is
-        // not clamped to the corners' depth range (a depth taken elsewhere in the pixel
-        // extrapolates).
-        let c = cons_point(vec4<f32>(floor(in.position.xy) + vec2<f32>(0.5), 0.0, 1.0));
-        let reach = vec2<f32>(0.5) + cons.tol_px;
+        // The depth box (half-size `reach` px around `c`), over which the plane is not
+        // clamped to the corners' depth range (a depth taken off the triangle extrapolates):
+        // the sample's tolerance box where the profile takes depth at the sample; else the
+        // sample's pixel grown by the tolerance (a sample moved within the tolerance is taken
+        // to keep its pixel, as it does at ±1/8 px with the standard patterns).
+        var c = cons_point(in.position);
+        var reach = cons.tol_px;
+        if (cons.profile.x > 0.5) {
+            c = cons_point(vec4<f32>(floor(in.position.xy) + vec2<f32>(0.5), 0.0, 1.0));
+            reach = vec2<f32>(0.5) + cons.tol_px;
+        }
         let z = cons_plane_at(in, c);
         if ((in.closable & CONS_DEGENERATE) != 0u) {
             near = 0.0;
@@ -214,9 +220,9 @@ fn fs_capture_envelope(
             let far_corner = max(max(abs(p[0]), abs(p[1])), abs(p[2]));
             let margin = max(far_corner.x, far_corner.y) / 262144.0;
             let h = cons.tol_px * (1.0 + 1.0 / 64.0) + vec2<f32>(1.0 / 1024.0 + margin);
-            let c = cons_point(in.position);
+            let at = cons_point(in.position);
             for (var k = 0u; k < 3u; k++) {
-                if (envelope_crosses(p[k], p[(k + 1u) % 3u], c, h)) {
+                if (envelope_crosses(p[k], p[(k + 1u) % 3u], at, h)) {
                     flags |= 2u << k;
                 }
             }

@@ -13,6 +13,11 @@ struct Cons {
     // Tolerance in pixels (x, y), pixels per NDC unit (width / 2, height / 2).
     tol_px: vec2<f32>,
     px_per_ndc: vec2<f32>,
+    // The bake's raster profile (format's RasterProfile), read by the envelope capture: x, 1
+    // where a rasterizer may take a sample's depth anywhere in its pixel (0: at the sample);
+    // y, how far a corner moves when snapped to the profile's coarsest grid (round to nearest
+    // in x and y: 2^−bits · √2 / 2 px); z and w, the least and most sub-pixel bits.
+    profile: vec4<f32>,
 }
 
 @group(CONS_GROUP) @binding(0) var<uniform> cons: Cons;
