@@ -183,7 +183,8 @@ fn self_check_holes(dir: &std::path::Path, baked: &str, offset: &str) -> (u64, b
     (holes, out.status.success())
 }
 
-/// The default bake is conservative too: no hole anywhere in its ±1/8 px box.
+/// The default bake (the conformant raster profile) opens no hole and stays exact within
+/// its tolerance; the browser profile none within its wider ±1/8 px box, for more triangles.
 #[test]
 fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
     let Some(dir) = gpu_tempdir() else { return };
@@ -193,12 +194,36 @@ fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
         d,
         &[args(&bake), args("-o plain.baked --conservative=false")].concat(),
     );
-    // The default records conservatively within ±1/8 px.
+    // The default records conservatively for a conformant GPU: ±1/512 px for transforms
+    // and a 1/512 px snap (8 bits), depth at the sample.
     let default = run_json(d, &[args(&bake), vec!["-o", "default.baked"]].concat());
     assert_eq!(
-        default["robust"],
-        serde_json::json!({"patterns": 1, "tolerance": 0.125, "conservative": true}),
+        default["raster_profile"],
+        serde_json::json!({
+            "name": "conformant", "tolerance": 1.0 / 512.0, "subpixel_bits": [8, 8],
+            "depth_at": "sample", "size": [64, 64], "samples": 4,
+            "sample_locations": "standard", "conservative": true, "patterns": 1,
+        }),
         "{default}"
+    );
+    assert_eq!(
+        default["robust"],
+        serde_json::json!({"patterns": 1, "tolerance": 1.0 / 512.0, "conservative": true}),
+        "{default}"
+    );
+    let browser = run_json(
+        d,
+        &[
+            args(&bake),
+            args("-o browser.baked --raster-profile browser"),
+        ]
+        .concat(),
+    );
+    assert_eq!(browser["raster_profile"]["name"], "browser", "{browser}");
+    assert_eq!(browser["raster_profile"]["depth_at"], "pixel", "{browser}");
+    assert_eq!(
+        browser["raster_profile"]["subpixel_bits"],
+        serde_json::json!([4, 8])
     );
     let robust = run_json(
         d,
@@ -214,39 +239,148 @@ fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
         "{robust}"
     );
     assert_eq!(
-        plain["robust"],
-        serde_json::json!({"patterns": 1, "tolerance": 0.125, "conservative": false}),
-        "{plain}"
+        plain["raster_profile"]["name"], "exact",
+        "--conservative=false is the exact profile: {plain}"
     );
+    assert_eq!(plain["robust"]["conservative"], false, "{plain}");
     let tris = |v: &serde_json::Value| v["source_triangles"].as_u64().unwrap();
     assert!(tris(&robust) > tris(&plain), "{robust}\n{plain}");
     assert!(tris(&default) > tris(&plain), "{default}\n{plain}");
-    // Still a valid bake, exact at its recorded pattern.
-    run(
-        d,
-        &args("verify robust.baked --recording robust.baked.rec"),
-        true,
-    );
+    assert!(tris(&browser) > tris(&default), "{browser}\n{default}");
+    // Still valid bakes, exact at their recorded pattern.
+    for b in ["robust", "default", "browser"] {
+        run(
+            d,
+            &args(&format!("verify {b}.baked --recording {b}.baked.rec")),
+            true,
+        );
+    }
     run(
         d,
         &args("verify robust.baked --recording robust.baked.rec --scene demo:10000 --mode depth"),
         true,
     );
-    // Moved by 1/8 px (the tolerance), the plain bake shows holes, the conservative one none.
+    // Moved by 1/8 px, the plain bake shows holes, the robust one (±1/8 px) none.
     let (plain_holes, plain_ok) = self_check_holes(d, "plain.baked", "1/8,0");
     assert!(plain_holes > 0 && !plain_ok, "{plain_holes}");
     let (robust_holes, robust_ok) = self_check_holes(d, "robust.baked", "1/8,0");
     assert_eq!((robust_holes, robust_ok), (0, true));
-    for offset in ["1/16,0", "1/8,0", "0,-1/8", "-0.1,0.1"] {
+    // The default, moved anywhere within its tolerance: no hole, and in blend mode no pixel
+    // differs from the exact reference moved alike beyond what the recorded pattern shows.
+    for offset in ["1/512,0", "0,-1/512", "-1/512,1/512", "1/1024,1/512"] {
         assert_eq!(
             self_check_holes(d, "default.baked", offset),
             (0, true),
             "the default bake moved by {offset} px"
         );
     }
+    for offset in ["1/16,0", "1/8,0", "0,-1/8", "-0.1,0.1"] {
+        assert_eq!(
+            self_check_holes(d, "browser.baked", offset),
+            (0, true),
+            "the browser bake moved by {offset} px"
+        );
+    }
+    // Moved by 1/16 px, far beyond its tolerance, the default bake is no longer hole-free
+    // on this scene, as the pattern-only bake is not at 1/512 px: the profile's box is what
+    // it pays for.
+    assert!(self_check_holes(d, "default.baked", "1/16,0").0 > 0);
+    assert!(self_check_holes(d, "plain.baked", "1/512,1/512").0 > 0);
+}
+
+/// `play` checks the device against the bake's raster profile: lavapipe satisfies the
+/// conformant one (8 sub-pixel bits by the API and by the probe, standard positions); a probe
+/// run on a shifted pattern does not, which gives a warning naming the sample positions, and
+/// `--strict-profile` refuses to play.
+#[test]
+fn play_checks_the_device_against_the_raster_profile() {
+    let Some(dir) = gpu_tempdir() else { return };
+    let d = dir.path();
     run(
         d,
-        &args("verify default.baked --recording default.baked.rec"),
+        &args(&format!(
+            "bake {SCENE} --path orbit:frames=1 --size 48x48 --samples 4 -o car.baked"
+        )),
         true,
     );
+    let inspect = run_json(d, &args("inspect car.baked"));
+    assert_eq!(inspect["raster_profile"]["name"], "conformant", "{inspect}");
+    let v = run_json(d, &args("play car.baked"));
+    let c = &v["profile_check"];
+    assert_eq!(c["ok"], true, "{c}");
+    assert_eq!(c["differences"], serde_json::json!([]));
+    assert_eq!(c["profile"]["name"], "conformant");
+    assert_eq!(
+        c["probe"]["consistent_subpixel_bits"],
+        serde_json::json!([8]),
+        "{c}"
+    );
+    if v["backend"] == "Vulkan" {
+        assert_eq!(c["api"]["subpixel_bits"], 8, "{c}");
+        assert_eq!(c["api"]["standard_sample_locations"], true, "{c}");
+    }
+    // The probe moved by 1/64 px, as the player is: no longer the standard positions.
+    let out = trisort(d)
+        .args(["play", "car.baked", "--json", "--subpixel-offset", "1/64,0"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let c = &v["profile_check"];
+    assert_eq!(c["ok"], false, "{c}");
+    let why = c["differences"][0].as_str().unwrap();
+    assert!(why.starts_with("sample positions"), "{why}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("outside the raster profile `conformant`")
+            && stderr.contains("sample positions"),
+        "{stderr}"
+    );
+    let out = trisort(d)
+        .args([
+            "play",
+            "car.baked",
+            "--strict-profile",
+            "--subpixel-offset",
+            "1/64,0",
+            "--out-dir",
+            "frames",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--strict-profile") && stderr.contains("sample positions"),
+        "{stderr}"
+    );
+    assert!(!d.join("frames").join("frame-00000.png").exists());
+    // A profile asking for what no device here has: 4-bit snapping only.
+    run(
+        d,
+        &args(&format!(
+            "bake {SCENE} --path orbit:frames=1 --size 48x48 --samples 4 --raster-profile snap4 --subpixel-bits 4 -o snap.baked"
+        )),
+        true,
+    );
+    let out = trisort(d)
+        .args(["play", "snap.baked", "--strict-profile"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("sub-pixel precision") && stderr.contains("asks 4"),
+        "{stderr}"
+    );
+    // Contradicting options are refused before anything is recorded.
+    let out = trisort(d)
+        .args(args(&format!(
+            "bake {SCENE} --path orbit:frames=1 --size 48x48 --raster-profile browser --conservative=false -o x.baked"
+        )))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--raster-profile exact"));
+    assert!(!d.join("x.baked").exists());
 }

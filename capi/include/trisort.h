@@ -14,8 +14,23 @@
 // 3 added [`TrisortStatus::Absent`], the environment ([`trisort_environment_info`],
 // [`trisort_environment_name`], [`trisort_environment_level`]), material variants
 // ([`trisort_variant_count`], [`trisort_variant_name`], [`trisort_variant_materials`]) and
-// the frame rate ([`trisort_fps`]); the functions of 2 are unchanged.
-#define TRISORT_ABI_VERSION 3
+// the frame rate ([`trisort_fps`]); the functions of 2 are unchanged. 4 added the raster
+// profile ([`trisort_raster_profile`], [`trisort_check_device`],
+// [`TrisortStatus::ProfileMismatch`]); the functions of 3 are unchanged.
+#define TRISORT_ABI_VERSION 4
+
+// [`TrisortRasterProfile::name`]: the recorded pattern only (`--raster-profile exact`).
+#define TRISORT_PROFILE_EXACT 0
+
+// [`TrisortRasterProfile::name`]: a conformant GPU (the default): standard sample
+// locations, 8 sub-pixel bits, depth at the sample.
+#define TRISORT_PROFILE_CONFORMANT 1
+
+// [`TrisortRasterProfile::name`]: as conformant, snapping to 4 to 8 sub-pixel bits.
+#define TRISORT_PROFILE_SNAP4 2
+
+// [`TrisortRasterProfile::name`]: SwiftShader's rules (the web build).
+#define TRISORT_PROFILE_BROWSER 3
 
 // The ORDER file version this build writes and reads.
 #define TRISORT_ORDER_VERSION 1
@@ -42,6 +57,9 @@ typedef enum TrisortStatus {
   // The file holds no such thing: no frame rate ([`trisort_fps`]), no material variant of
   // that name ([`trisort_variant_materials`]). The message says what is missing.
   TRISORT_STATUS_ABSENT = 8,
+  // The device is outside the bake's raster profile ([`trisort_check_device`]); the
+  // message names each difference.
+  TRISORT_STATUS_PROFILE_MISMATCH = 9,
 } TrisortStatus;
 
 // How frames are drawn (the player's `--mode`).
@@ -228,6 +246,41 @@ typedef struct TrisortTextureInfo {
   // `max(1, width >> k)` × `max(1, height >> k)`; 1 for a 1×1 texture).
   uint32_t level_count;
 } TrisortTextureInfo;
+
+// What a baked file assumes about the rasterizer that plays it (`trisort inspect`'s
+// `raster_profile`): frames played on a device outside it may show holes.
+typedef struct TrisortRasterProfile {
+  // The profile's name: one of `TRISORT_PROFILE_EXACT`, `_CONFORMANT`, `_SNAP4`,
+  // `_BROWSER`.
+  uint32_t name;
+  // How far (pixels, in x and y) a sample may lie from the recorded one relative to the
+  // exact geometry, besides the snapping of corners.
+  float tolerance;
+  // The fewest sub-pixel bits a device of the profile snaps corners to.
+  uint32_t subpixel_bits_min;
+  // The most sub-pixel bits.
+  uint32_t subpixel_bits_max;
+  // Whether the profile's devices take a sample's depth at the sample (the Vulkan and GLES
+  // rule); false: anywhere in its pixel.
+  bool depth_at_sample;
+  // Whether the recording was conservative (false: the recorded pattern only).
+  bool conservative;
+  // Sample patterns unioned (1: the recorded one only).
+  uint32_t patterns;
+} TrisortRasterProfile;
+
+// What the host's graphics API reports about the device it plays on, for
+// [`trisort_check_device`].
+typedef struct TrisortDeviceRaster {
+  // Sub-pixel precision in bits (Vulkan's `VkPhysicalDeviceLimits::subPixelPrecisionBits`,
+  // GL's `GL_SUBPIXEL_BITS`); 0 when unknown.
+  uint32_t subpixel_bits;
+  // 1 where the device uses the standard sample locations (Vulkan's
+  // `standardSampleLocations`), 0 where it does not, −1 when unknown.
+  int32_t standard_sample_locations;
+  // The MSAA sample count the host plays at.
+  uint32_t samples;
+} TrisortDeviceRaster;
 
 // The light a baked file is shaded with (trisort's image-based light and optional sun), in
 // world space (+Y up, glTF's convention).
@@ -480,6 +533,27 @@ enum TrisortStatus trisort_texture_level(const struct TrisortBaked *h,
 // # Safety
 // `h` is an open handle; `out` is valid for one write.
 enum TrisortStatus trisort_fps(const struct TrisortBaked *h, double *out);
+
+// Stores the file's raster profile in `*out`.
+//
+// # Safety
+// `h` is an open handle; `out` is valid for one write.
+enum TrisortStatus trisort_raster_profile(const struct TrisortBaked *h,
+                                          struct TrisortRasterProfile *out);
+
+// Checks what the host's API reports about its device against the file's raster profile:
+// the sample count, the sub-pixel precision and whether the sample locations are the
+// standard ones (each where known). Returns [`TrisortStatus::Ok`] when nothing reported
+// differs, else [`TrisortStatus::ProfileMismatch`] with every difference in the last error
+// (`trisort_last_error`): a host that must refuse such a device (as `trisort play
+// --strict-profile` does) stops there; one that plays anyway should log it. The raster probe
+// of `trisort play` also measures the sample positions and snapping; this call takes the
+// API's word.
+//
+// # Safety
+// `h` is an open handle; `device` is valid for one read.
+enum TrisortStatus trisort_check_device(const struct TrisortBaked *h,
+                                        const struct TrisortDeviceRaster *device);
 
 // Stores the figures of the light the file is shaded with in `*out` (its name:
 // [`trisort_environment_name`]; its texels: [`trisort_environment_level`]).

@@ -35,8 +35,20 @@ use crate::order::{Order, OrderRange, OrderSource};
 /// 3 added [`TrisortStatus::Absent`], the environment ([`trisort_environment_info`],
 /// [`trisort_environment_name`], [`trisort_environment_level`]), material variants
 /// ([`trisort_variant_count`], [`trisort_variant_name`], [`trisort_variant_materials`]) and
-/// the frame rate ([`trisort_fps`]); the functions of 2 are unchanged.
-pub const TRISORT_ABI_VERSION: u32 = 3;
+/// the frame rate ([`trisort_fps`]); the functions of 2 are unchanged. 4 added the raster
+/// profile ([`trisort_raster_profile`], [`trisort_check_device`],
+/// [`TrisortStatus::ProfileMismatch`]); the functions of 3 are unchanged.
+pub const TRISORT_ABI_VERSION: u32 = 4;
+
+/// [`TrisortRasterProfile::name`]: the recorded pattern only (`--raster-profile exact`).
+pub const TRISORT_PROFILE_EXACT: u32 = 0;
+/// [`TrisortRasterProfile::name`]: a conformant GPU (the default): standard sample
+/// locations, 8 sub-pixel bits, depth at the sample.
+pub const TRISORT_PROFILE_CONFORMANT: u32 = 1;
+/// [`TrisortRasterProfile::name`]: as conformant, snapping to 4 to 8 sub-pixel bits.
+pub const TRISORT_PROFILE_SNAP4: u32 = 2;
+/// [`TrisortRasterProfile::name`]: SwiftShader's rules (the web build).
+pub const TRISORT_PROFILE_BROWSER: u32 = 3;
 
 /// The result of a call.
 #[repr(C)]
@@ -62,6 +74,48 @@ pub enum TrisortStatus {
     /// The file holds no such thing: no frame rate ([`trisort_fps`]), no material variant of
     /// that name ([`trisort_variant_materials`]). The message says what is missing.
     Absent = 8,
+    /// The device is outside the bake's raster profile ([`trisort_check_device`]); the
+    /// message names each difference.
+    ProfileMismatch = 9,
+}
+
+/// What a baked file assumes about the rasterizer that plays it (`trisort inspect`'s
+/// `raster_profile`): frames played on a device outside it may show holes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TrisortRasterProfile {
+    /// The profile's name: one of `TRISORT_PROFILE_EXACT`, `_CONFORMANT`, `_SNAP4`,
+    /// `_BROWSER`.
+    pub name: u32,
+    /// How far (pixels, in x and y) a sample may lie from the recorded one relative to the
+    /// exact geometry, besides the snapping of corners.
+    pub tolerance: f32,
+    /// The fewest sub-pixel bits a device of the profile snaps corners to.
+    pub subpixel_bits_min: u32,
+    /// The most sub-pixel bits.
+    pub subpixel_bits_max: u32,
+    /// Whether the profile's devices take a sample's depth at the sample (the Vulkan and GLES
+    /// rule); false: anywhere in its pixel.
+    pub depth_at_sample: bool,
+    /// Whether the recording was conservative (false: the recorded pattern only).
+    pub conservative: bool,
+    /// Sample patterns unioned (1: the recorded one only).
+    pub patterns: u32,
+}
+
+/// What the host's graphics API reports about the device it plays on, for
+/// [`trisort_check_device`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TrisortDeviceRaster {
+    /// Sub-pixel precision in bits (Vulkan's `VkPhysicalDeviceLimits::subPixelPrecisionBits`,
+    /// GL's `GL_SUBPIXEL_BITS`); 0 when unknown.
+    pub subpixel_bits: u32,
+    /// 1 where the device uses the standard sample locations (Vulkan's
+    /// `standardSampleLocations`), 0 where it does not, −1 when unknown.
+    pub standard_sample_locations: i32,
+    /// The MSAA sample count the host plays at.
+    pub samples: u32,
 }
 
 /// A baked file opened by [`trisort_open_path`] or [`trisort_open_bytes`].
@@ -1113,6 +1167,81 @@ pub unsafe extern "C" fn trisort_fps(h: *const TrisortBaked, out: *mut f64) -> T
                 format!("{}: the file stores no frame rate", h.path.display()),
             )),
         }
+    })
+}
+
+/// Stores the file's raster profile in `*out`.
+///
+/// # Safety
+/// `h` is an open handle; `out` is valid for one write.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_raster_profile(
+    h: *const TrisortBaked,
+    out: *mut TrisortRasterProfile,
+) -> TrisortStatus {
+    guard(|| {
+        let r = &handle(h, "handle")?.baked.settings.robust;
+        let name = match r.profile.name {
+            trisort_format::ProfileName::Exact => TRISORT_PROFILE_EXACT,
+            trisort_format::ProfileName::Conformant => TRISORT_PROFILE_CONFORMANT,
+            trisort_format::ProfileName::Snap4 => TRISORT_PROFILE_SNAP4,
+            trisort_format::ProfileName::Browser => TRISORT_PROFILE_BROWSER,
+        };
+        let profile = TrisortRasterProfile {
+            name,
+            tolerance: r.tolerance,
+            subpixel_bits_min: r.profile.subpixel_bits_min,
+            subpixel_bits_max: r.profile.subpixel_bits_max,
+            depth_at_sample: r.profile.depth_at == trisort_format::DepthAt::Sample,
+            conservative: r.conservative,
+            patterns: r.patterns,
+        };
+        store(out, profile, "out")
+    })
+}
+
+/// Checks what the host's API reports about its device against the file's raster profile:
+/// the sample count, the sub-pixel precision and whether the sample locations are the
+/// standard ones (each where known). Returns [`TrisortStatus::Ok`] when nothing reported
+/// differs, else [`TrisortStatus::ProfileMismatch`] with every difference in the last error
+/// (`trisort_last_error`): a host that must refuse such a device (as `trisort play
+/// --strict-profile` does) stops there; one that plays anyway should log it. The raster probe
+/// of `trisort play` also measures the sample positions and snapping; this call takes the
+/// API's word.
+///
+/// # Safety
+/// `h` is an open handle; `device` is valid for one read.
+#[no_mangle]
+pub unsafe extern "C" fn trisort_check_device(
+    h: *const TrisortBaked,
+    device: *const TrisortDeviceRaster,
+) -> TrisortStatus {
+    guard(|| {
+        let h = handle(h, "handle")?;
+        let d = *handle(device, "device")?;
+        let s = &h.baked.settings;
+        let standard = match d.standard_sample_locations {
+            1 => Some(true),
+            0 => Some(false),
+            _ => None,
+        };
+        let bits = (d.subpixel_bits > 0).then_some(d.subpixel_bits);
+        let differences = s
+            .robust
+            .profile
+            .device_differences(s, bits, standard, d.samples);
+        if differences.is_empty() {
+            return Ok(());
+        }
+        Err(Failure(
+            TrisortStatus::ProfileMismatch,
+            format!(
+                "{}: the device is outside the raster profile `{}`: {}",
+                h.path.display(),
+                s.robust.profile.name,
+                differences.join("; ")
+            ),
+        ))
     })
 }
 

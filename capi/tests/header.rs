@@ -36,7 +36,7 @@ fn header_is_current() {
 #[test]
 fn header_declares_the_abi_version_and_every_entry_point() {
     let h = generate();
-    assert!(h.contains("#define TRISORT_ABI_VERSION 3"), "{h}");
+    assert!(h.contains("#define TRISORT_ABI_VERSION 4"), "{h}");
     for f in [
         "trisort_abi_version",
         "trisort_last_error",
@@ -66,6 +66,8 @@ fn header_declares_the_abi_version_and_every_entry_point() {
         "trisort_variant_count",
         "trisort_variant_name",
         "trisort_variant_materials",
+        "trisort_raster_profile",
+        "trisort_check_device",
     ] {
         assert!(h.contains(&format!(" {f}(")), "{f} missing from the header");
     }

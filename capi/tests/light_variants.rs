@@ -313,6 +313,53 @@ fn the_environment_and_frame_rate_of_a_demo_bake_are_what_the_rust_reader_reads(
         "{msg}"
     );
 
+    // The raster profile the file was baked for (the default: conformant), and a host's
+    // device checked against it: lavapipe-like figures pass; 4 sub-pixel bits, non-standard
+    // locations or another sample count each give the mismatch status, named in the message.
+    let mut p = TrisortRasterProfile::default();
+    assert_eq!(
+        unsafe { trisort_raster_profile(h, &mut p) },
+        TrisortStatus::Ok
+    );
+    assert_eq!(p.name, TRISORT_PROFILE_CONFORMANT);
+    assert_eq!((p.subpixel_bits_min, p.subpixel_bits_max), (8, 8));
+    assert!(p.depth_at_sample && p.conservative && p.patterns == 1);
+    assert_eq!(p.tolerance, b.settings.robust.tolerance);
+    let device = |bits, standard, samples| TrisortDeviceRaster {
+        subpixel_bits: bits,
+        standard_sample_locations: standard,
+        samples,
+    };
+    let check = |d: TrisortDeviceRaster| unsafe { trisort_check_device(h, &d) };
+    let samples = b.settings.samples;
+    assert_eq!(check(device(8, 1, samples)), TrisortStatus::Ok);
+    assert_eq!(
+        check(device(0, -1, samples)),
+        TrisortStatus::Ok,
+        "unknown: not a difference"
+    );
+    assert_eq!(check(device(4, 1, samples)), TrisortStatus::ProfileMismatch);
+    let msg = last_error();
+    assert!(
+        msg.contains("<bytes>") && msg.contains("4 bits") && msg.contains("`conformant` asks 8"),
+        "{msg}"
+    );
+    assert_eq!(check(device(8, 0, samples)), TrisortStatus::ProfileMismatch);
+    assert!(last_error().contains("non-standard sample locations"));
+    assert_eq!(
+        check(device(8, 1, 5 - samples)),
+        TrisortStatus::ProfileMismatch
+    );
+    assert!(last_error().contains("sample count"));
+    assert_eq!(
+        unsafe { trisort_check_device(h, null()) },
+        TrisortStatus::NullArgument
+    );
+    assert_eq!(
+        unsafe { trisort_raster_profile(h, null_mut()) },
+        TrisortStatus::NullArgument
+    );
+
     // Null pointers.
     let mut info = TrisortEnvironmentInfo::default();
     let mut n = 0u32;

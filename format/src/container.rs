@@ -392,14 +392,14 @@ mod tests {
         assert!(matches!(
             err,
             FormatError::Version {
-                found: 3,
-                supported: 4,
+                found: 4,
+                supported: 5,
                 ..
             }
         ));
         assert_eq!(
             err.to_string(),
-            "old.baked: format version 3 is not supported (this trisort reads version 4); \
+            "old.baked: format version 4 is not supported (this trisort reads version 5); \
              record or merge it again with this trisort"
         );
     }

@@ -133,6 +133,54 @@ pub struct RasterProfile {
 }
 
 impl RasterProfile {
+    /// What a device reports against the profile of a bake recorded with `settings`, in
+    /// words (empty: nothing reported differs): its sub-pixel precision where known (Vulkan's
+    /// `subPixelPrecisionBits`, GL's `GL_SUBPIXEL_BITS`), whether it uses the standard sample
+    /// locations where known, and the sample count it plays at. The player adds what its
+    /// raster probe measures (`trisort_gpu::raster_probe`); the C API's
+    /// `trisort_check_device` takes what the host's API reports.
+    pub fn device_differences(
+        &self,
+        settings: &RecordSettings,
+        subpixel_bits: Option<u32>,
+        standard_sample_locations: Option<bool>,
+        samples: u32,
+    ) -> Vec<String> {
+        let mut out = vec![];
+        if samples != settings.samples {
+            out.push(format!(
+                "sample count: played at {samples}x, the bake's pattern is {}x",
+                settings.samples
+            ));
+        }
+        if let Some(bits) = subpixel_bits {
+            if !(self.subpixel_bits_min..=self.subpixel_bits_max).contains(&bits) {
+                out.push(format!(
+                    "sub-pixel precision: the device reports {bits} bits, the profile `{}` asks {}",
+                    self.name,
+                    self.bits_text()
+                ));
+            }
+        }
+        if standard_sample_locations == Some(false) {
+            out.push(
+                "sample locations: the device reports non-standard sample locations, the \
+                 profile assumes the standard ones"
+                    .into(),
+            );
+        }
+        out
+    }
+
+    /// The sub-pixel bits as words: `8`, `4 to 8`.
+    pub fn bits_text(&self) -> String {
+        if self.subpixel_bits_min == self.subpixel_bits_max {
+            format!("{}", self.subpixel_bits_min)
+        } else {
+            format!("{} to {}", self.subpixel_bits_min, self.subpixel_bits_max)
+        }
+    }
+
     /// The profile a name stands for (its tolerance: [`Robust::profile_named`]).
     pub const fn named(name: ProfileName) -> RasterProfile {
         let (lo, hi, depth_at) = match name {
@@ -621,5 +669,48 @@ mod tests {
             let err = r.check_structure().unwrap_err();
             assert!(err.contains(needle), "{err:?} lacks {needle:?}");
         }
+    }
+
+    #[test]
+    fn named_profiles_say_what_they_assume_and_bad_bits_are_refused() {
+        assert_eq!(
+            Robust::DEFAULT,
+            Robust::profile_named(ProfileName::Conformant)
+        );
+        assert_eq!(
+            RecordSettings::default().robust.profile.name,
+            ProfileName::Conformant
+        );
+        let c = Robust::DEFAULT;
+        assert!(c.conservative && c.tolerance == Robust::CONFORMANT_TOLERANCE);
+        assert_eq!(
+            (
+                c.profile.subpixel_bits_min,
+                c.profile.subpixel_bits_max,
+                c.profile.depth_at
+            ),
+            (8, 8, DepthAt::Sample)
+        );
+        assert!(!Robust::OFF.conservative && Robust::OFF.profile.name == ProfileName::Exact);
+        let b = Robust::profile_named(ProfileName::Browser);
+        assert_eq!(
+            (
+                b.profile.subpixel_bits_min,
+                b.profile.subpixel_bits_max,
+                b.profile.depth_at
+            ),
+            (4, 8, DepthAt::Pixel)
+        );
+        // The browser box is the old default's ±1/8 px: its tolerance and a 4-bit snap.
+        assert_eq!(b.tolerance + 0.5 / 16.0, 0.125);
+        assert_eq!("snap4".parse::<ProfileName>(), Ok(ProfileName::Snap4));
+        assert!("swiftshader".parse::<ProfileName>().is_err());
+        for (lo, hi) in [(3, 8), (8, 4), (4, 17)] {
+            let mut s = RecordSettings::default();
+            s.robust.profile.subpixel_bits_min = lo;
+            s.robust.profile.subpixel_bits_max = hi;
+            assert_eq!(s.validate(), Err(SettingsError::SubpixelBits(lo, hi)));
+        }
+        RecordSettings::default().validate().unwrap();
     }
 }

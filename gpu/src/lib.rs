@@ -15,6 +15,7 @@ mod data_textures;
 pub mod device;
 pub mod pipeline;
 pub mod present;
+pub mod raster_probe;
 pub mod readback;
 pub mod target;
 mod timer;

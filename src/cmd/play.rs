@@ -70,6 +70,12 @@ pub struct PlayArgs {
     /// frame has a hole; `--json` adds per frame `holes`.
     #[arg(long)]
     self_check: bool,
+    /// Refuse to play on a device outside the bake's raster profile (`inspect`'s
+    /// `raster_profile`): the sub-pixel precision the Vulkan API reports, and what a raster
+    /// probe of sub-pixel test quads measures (the sample positions and the snapping). Without
+    /// it such a device gets a warning naming what differs; `--json` has `profile_check`.
+    #[arg(long)]
+    strict_profile: bool,
     #[command(flatten)]
     shading: ShadingArgs,
     #[command(flatten)]
@@ -234,6 +240,60 @@ pub fn play_frames_on_path(
     Ok((out, path))
 }
 
+/// Checks the device against the bake's raster profile at `samples` with the projection moved
+/// by `offset` ([`trisort_gpu::raster_probe::check_profile`]): a warning naming what differs,
+/// or with `strict` an error.
+pub fn check_profile(
+    gpu: &trisort_gpu::Gpu,
+    baked: &Baked,
+    samples: u32,
+    offset: [f64; 2],
+    file: &std::path::Path,
+    strict: bool,
+) -> Result<trisort_gpu::raster_probe::ProfileCheck> {
+    let check = trisort_gpu::raster_probe::check_profile(gpu, &baked.settings, samples, offset)
+        .context("probing the device's rasterizer")?;
+    if !check.ok {
+        let what = format!(
+            "{} is outside the raster profile `{}` that {} was baked for: {}",
+            gpu.info.name,
+            baked.settings.robust.profile.name,
+            file.display(),
+            check.differences.join("; ")
+        );
+        if strict {
+            anyhow::bail!("--strict-profile: {what}");
+        }
+        eprintln!("trisort: warning: {what} (frames may show holes or order errors there)");
+    }
+    Ok(check)
+}
+
+/// `play --json`'s `profile_check`: `ok`, `differences` (in words), the `profile` checked
+/// against (the bake's `raster_profile`), what the API reported (`api`: `subpixel_bits`,
+/// `standard_sample_locations`, null where it cannot say) and what the probe measured
+/// (`probe`: `consistent_subpixel_bits`, the coverage steps `x` and `y` in pixels).
+pub fn profile_check_json(
+    baked: &Baked,
+    c: &trisort_gpu::raster_probe::ProfileCheck,
+) -> serde_json::Value {
+    json!({
+        "ok": c.ok,
+        "differences": c.differences,
+        "profile": crate::cmd::record::raster_profile_json(&baked.settings),
+        "api": {
+            "subpixel_bits": c.api.subpixel_bits,
+            "standard_sample_locations": c.api.standard_sample_locations,
+        },
+        "probe": {
+            "samples": c.probe.samples,
+            "consistent_subpixel_bits": c.probe.consistent_bits,
+            "x": c.probe.drops[0],
+            "y": c.probe.drops[1],
+        },
+    })
+}
+
 pub fn run(a: PlayArgs) -> Result<ExitCode> {
     if a.window {
         if a.device.options() != GpuOptions::default() {
@@ -280,6 +340,14 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
     }
     let gpu = crate::common::open_gpu_with(a.device.options())?;
     let offset = a.subpixel_offset.unwrap_or([0.0, 0.0]);
+    let profile = check_profile(
+        &gpu,
+        &baked,
+        config.samples,
+        offset,
+        &a.baked,
+        a.strict_profile,
+    )?;
     if offset != [0.0, 0.0] {
         eprintln!(
             "trisort: warning: projection shifted by ({}, {}) px: the sorted order was recorded for the unshifted sample pattern",
@@ -335,6 +403,7 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
             "texture_bytes": path.texture_bytes,
             "variant": a.variant,
             "subpixel_offset": offset,
+            "profile_check": profile_check_json(&baked, &profile),
             "frames": list,
         });
         if checks.is_some() {

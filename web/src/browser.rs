@@ -30,6 +30,7 @@ pub struct WebPlayer {
     on_screen: OnScreen,
     backend: &'static str,
     fps: Option<f64>,
+    robust: trisort_format::Robust,
     warnings: Vec<String>,
     uncaptured: UncapturedError,
 }
@@ -103,6 +104,7 @@ impl WebPlayer {
             OnScreen::new(&gpu, &baked, &blit, (width, height), settings).map_err(js_error)?;
         let warnings = on_screen.player().warnings().to_vec();
         let fps = baked.fps;
+        let robust = baked.settings.robust;
         Ok(WebPlayer {
             gpu,
             surface,
@@ -112,6 +114,7 @@ impl WebPlayer {
             on_screen,
             backend: backend_name,
             fps,
+            robust,
             warnings,
             uncaptured,
         })
@@ -215,6 +218,29 @@ impl WebPlayer {
             .player()
             .set_variant(&self.gpu.queue, name)
             .map_err(js_error)
+    }
+
+    /// The raster profile the file was baked for (`exact`, `conformant`, `snap4`, `browser`):
+    /// what it assumes about the rasterizer that plays it. A browser without a GPU
+    /// (SwiftShader) needs `browser`, which `web/build.sh` bakes with.
+    pub fn raster_profile(&self) -> String {
+        self.robust.profile.name.to_string()
+    }
+
+    /// The profile's tolerance in pixels (besides the snapping of corners).
+    pub fn raster_tolerance(&self) -> f32 {
+        self.robust.tolerance
+    }
+
+    /// The profile's sub-pixel bits, `[least, most]`.
+    pub fn raster_subpixel_bits(&self) -> Vec<u32> {
+        let p = &self.robust.profile;
+        vec![p.subpixel_bits_min, p.subpixel_bits_max]
+    }
+
+    /// Where the profile's rasterizer takes a sample's depth: `sample` or `pixel`.
+    pub fn raster_depth_at(&self) -> String {
+        self.robust.profile.depth_at.to_string()
     }
 
     /// `WebGPU` or `WebGL2`.

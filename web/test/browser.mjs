@@ -96,6 +96,7 @@ try {
     return {
       backend: p.backend(), adapter: p.adapter(), bindings: p.bindings(),
       draw_path: p.draw_path(), frames: p.frame_count(), width: p.width(), height: p.height(),
+      raster_profile: p.raster_profile(), raster_depth_at: p.raster_depth_at(),
       user_agent: navigator.userAgent,
     };
   });

@@ -114,6 +114,10 @@ const holeFrames = b.self_check.filter((f) => f.holes > 0).length;
 console.log(`  self-check (depth mode vs the file's z-buffer, in the browser): ${holes.mean.toFixed(1)} ` +
   `holes/frame (worst ${holes.worst}, ${holeFrames} of ${b.self_check.length} frames with any)`);
 if (b.device.backend !== "WebGL2") bad.push(`played on ${b.device.backend}, not WebGL2`);
+// The page's bake is for SwiftShader's rules (web/build.sh: --raster-profile browser).
+if (b.device.raster_profile !== "browser" || b.device.raster_depth_at !== "pixel") {
+  bad.push(`expected the browser raster profile, got ${b.device.raster_profile} (depth at ${b.device.raster_depth_at})`);
+}
 if (b.device.bindings !== "textures" || b.device.draw_path !== "direct") {
   bad.push(`expected the WebGL2 tier (textures, direct), got ${b.device.bindings}, ${b.device.draw_path}`);
 }

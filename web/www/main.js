@@ -102,7 +102,8 @@ async function open(bytes, name) {
   $("play").disabled = false;
   $("device").textContent =
     `${name} · ${p.width()}×${p.height()} · ${p.backend()} on ${p.adapter()} · ` +
-    `${p.bindings()} bindings, ${p.draw_path()} draws · ${mode} mode`;
+    `${p.bindings()} bindings, ${p.draw_path()} draws · ${mode} mode · ` +
+    `baked for the ${p.raster_profile()} raster profile`;
   for (const w of p.warnings()) console.warn("trisort:", w);
   // The path's frame rate as baked, where the file says.
   if (p.fps()) $("fps").value = String(Math.round(p.fps()));

@@ -35,10 +35,10 @@ pub struct Condition {
     pub offset: [f64; 2],
 }
 
-/// The conditions for playback `size`: offsets of 1/128 (the conformant raster profile's
+/// The conditions for playback `size`: offsets of 1/512 (the conformant raster profile's
 /// tolerance), 1/16, 1/8 and 1/4 px in x, then 1.5× and 2× the size.
 pub fn conditions(size: (u32, u32)) -> Vec<Condition> {
-    let mut out: Vec<Condition> = [(128, "1/128"), (16, "1/16"), (8, "1/8"), (4, "1/4")]
+    let mut out: Vec<Condition> = [(512, "1/512"), (16, "1/16"), (8, "1/8"), (4, "1/4")]
         .into_iter()
         .map(|(d, name)| Condition {
             name: format!("offset {name}"),
@@ -179,12 +179,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn conditions_are_three_offsets_and_two_sizes() {
+    fn conditions_are_four_offsets_and_two_sizes() {
         let c = conditions((128, 64));
         let names: Vec<_> = c.iter().map(|c| c.name.as_str()).collect();
         assert_eq!(
             names,
             [
+                "offset 1/512",
                 "offset 1/16",
                 "offset 1/8",
                 "offset 1/4",
@@ -192,9 +193,10 @@ mod tests {
                 "size 2x"
             ]
         );
-        assert_eq!(c[0].offset, [0.0625, 0.0]);
+        assert_eq!(c[0].offset, [1.0 / 512.0, 0.0]);
+        assert_eq!(c[1].offset, [0.0625, 0.0]);
         assert_eq!(c[0].size, (128, 64));
-        assert_eq!((c[3].size, c[4].size), ((192, 96), (256, 128)));
-        assert_eq!(c[4].offset, [0.0, 0.0]);
+        assert_eq!((c[4].size, c[5].size), ((192, 96), (256, 128)));
+        assert_eq!(c[5].offset, [0.0, 0.0]);
     }
 }
