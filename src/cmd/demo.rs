@@ -116,6 +116,10 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     let gpu_ms: Vec<f64> = played.iter().filter_map(|f| f.gpu_ms).collect();
     println!("frames:                 {}", baked.frames.len());
     println!(
+        "raster profile:         {}",
+        crate::cmd::record::profile_summary(&baked.settings)
+    );
+    println!(
         "|G| (visible at least once): {} of {} triangles",
         s.unique_visible, rec.scene_triangles
     );

@@ -331,4 +331,8 @@ pub fn print_summary(b: &Baked, seconds: f64) {
         s.heuristic_components,
         seconds
     );
+    println!(
+        "raster profile: {}",
+        crate::cmd::record::profile_summary(&b.settings)
+    );
 }
