@@ -313,6 +313,8 @@ def baked_summary(data):
         "width": b["settings"]["width"],
         "height": b["settings"]["height"],
         "samples": b["settings"]["samples"],
+        # Version 5: the raster profile the file was baked for (null before).
+        "raster_profile": b["settings"].get("robust", {}).get("profile"),
     }
 
 

@@ -71,7 +71,18 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
     }
     assert_eq!(ours["stats_index_triangles"], inspect["index_triangles"]);
     assert_eq!(ours["triangles"], ours["unique_visible"]);
-    assert_eq!(ours["format_version"], 4);
+    assert_eq!(ours["format_version"], 5);
+    // Version 5: the raster profile, as inspect reports it.
+    let profile = &inspect["raster_profile"];
+    assert_eq!(ours["raster_profile"]["name"], profile["name"]);
+    assert_eq!(ours["raster_profile"]["depth_at"], profile["depth_at"]);
+    assert_eq!(
+        serde_json::json!([
+            ours["raster_profile"]["subpixel_bits_min"],
+            ours["raster_profile"]["subpixel_bits_max"]
+        ]),
+        profile["subpixel_bits"]
+    );
     assert_eq!(ours["textures"], 1, "the demo car's licence plate");
     // Version 4: the plate is sRGB with its mips (64x16 down to 1x1), the file has its light.
     assert_eq!(ours["srgb_textures"], 1);
