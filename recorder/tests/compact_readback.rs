@@ -3,7 +3,7 @@
 //! readback recorded: byte-identical `Recording`s, both made in this process, on the demo car
 //! and a real scene, plain, robust and conservative, at 4× and 1× MSAA.
 
-use trisort_format::{Phase, RecordSettings, Recording, Robust};
+use trisort_format::{Phase, ProfileName, RecordSettings, Recording, Robust};
 use trisort_recorder::{record, with_interleaved_readback, with_peeling, RecordJob};
 use trisort_scene::Scene;
 
@@ -90,11 +90,18 @@ pub(crate) fn variants() -> Vec<RecordSettings> {
             },
             ..base
         },
+        // The widest profile (the conservative default before raster profiles): many grown
+        // fragments a sample, which the band test needs.
+        RecordSettings {
+            robust: Robust::profile_named(ProfileName::Browser),
+            ..base
+        },
+        RecordSettings { samples: 1, ..base },
+        // The default (conformant) profile.
         RecordSettings {
             robust: Robust::DEFAULT,
             ..base
         },
-        RecordSettings { samples: 1, ..base },
     ]
 }
 
