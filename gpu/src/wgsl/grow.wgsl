@@ -10,7 +10,9 @@
 // bounding box at its nearest corner's depth, and never shrunk.
 
 struct Cons {
-    // Tolerance in pixels (x, y), pixels per NDC unit (width / 2, height / 2).
+    // The box a sample may move in, half-size in pixels (x, y): the bake's tolerance plus half
+    // a step of its profile's coarsest sub-pixel grid (recorder's GrowBuffers); pixels per NDC
+    // unit (width / 2, height / 2).
     tol_px: vec2<f32>,
     px_per_ndc: vec2<f32>,
     // The bake's raster profile (format's RasterProfile), read by the envelope capture: x, 1
