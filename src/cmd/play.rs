@@ -316,6 +316,7 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
             shading: a.shading,
             exit_after: a.window_frames,
             json: a.json,
+            strict_profile: a.strict_profile,
         });
     }
     let baked: Baked = trisort_format::read_file(FileKind::Baked, &a.baked)?;

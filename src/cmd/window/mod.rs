@@ -76,6 +76,9 @@ pub struct WindowArgs<'a> {
     pub exit_after: Option<u64>,
     /// Print the summary as JSON.
     pub json: bool,
+    /// Refuse a device outside the bake's raster profile (`play --strict-profile`); without
+    /// it, warn.
+    pub strict_profile: bool,
 }
 
 /// Whether the environment names a display server. Only Linux and the BSDs need one named;
@@ -135,6 +138,7 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
         period: Duration::from_secs_f64(1.0 / fps),
         variant: a.variant,
         exit_after: a.exit_after,
+        strict_profile: a.strict_profile,
         path: a.baked.to_path_buf(),
         name,
         baked,
@@ -196,6 +200,7 @@ struct Viewer {
     /// Material variant, applied to every player built.
     variant: Option<String>,
     exit_after: Option<u64>,
+    strict_profile: bool,
     path: PathBuf,
     name: String,
     baked: Baked,
@@ -432,6 +437,15 @@ impl Viewer {
         };
         let gfx = Gfx::open(window, event_loop.owned_display_handle(), &self.baked, play)
             .with_context(|| format!("playing {}", self.path.display()))?;
+        // The window's device against the bake's raster profile: a warning, or a refusal.
+        crate::cmd::play::check_profile(
+            &gfx.gpu,
+            &self.baked,
+            self.samples,
+            [0.0, 0.0],
+            &self.path,
+            self.strict_profile,
+        )?;
         (gfx.targets.player()).set_variant(&gfx.gpu.queue, self.variant.as_deref())?;
         self.print_warnings(gfx.targets.player().warnings());
         Ok(gfx)
