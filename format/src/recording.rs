@@ -85,7 +85,8 @@ option_enum! {
         Exact = "exact",
             "the recorded pattern only: exact where played as recorded (--conservative=false)";
         /// A conformant GPU (the default): the standard sample locations, corners snapped to
-        /// 8 sub-pixel bits (what desktop and mobile GPUs and Mesa's rasterizers report),
+        /// 8 sub-pixel bits (what Mesa's lavapipe reports and its llvmpipe-GL measures; the
+        /// player checks any other device at load),
         /// depth at the sample as the Vulkan and GLES specifications ask, and
         /// [`Robust::CONFORMANT_TOLERANCE`] for snapping and transform rounding.
         #[default]

@@ -104,9 +104,9 @@ fn vs_envelope(@builtin(vertex_index) vi: u32) -> ConsVarying {
 // `c`, where the exact plane is `z` at `c` and departs from it by at most `slack` over the box:
 // the exact plane's, or those of the plane through the corners snapped to a grid of 2^−b px
 // for every b of the profile's sub-pixel bits (`cons.profile.zw`; 4 is Vulkan's and GLES's
-// least precision and SwiftShader's, 8 that of desktop and mobile GPUs and Mesa's
-// rasterizers; rounding: each corner moves by at most e = 2^−b·√2/2), with the corners' own
-// depths interpolated over the snapped triangle. The bound is not monotone in the grid (a
+// least precision and SwiftShader's, 8 that of Mesa's rasterizers (lavapipe reports it);
+// rounding: each corner moves by at most e = 2^−b·√2/2), with the corners' own depths
+// interpolated over the snapped triangle. The bound is not monotone in the grid (a
 // sliver's least snapped area bottoms out in between), so every b of the range is taken.
 //
 // For a snapped grid, from the barycentric weights λ' of a point of the box in the snapped
