@@ -201,16 +201,7 @@ pub fn probe(gpu: &Gpu, samples: u32, offset: [f64; 2]) -> Result<ProbeResult, G
         depth_or_array_layers: 1,
     };
     let texture = |label, samples: u32, usage| {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size,
-            mip_level_count: 1,
-            sample_count: samples,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
+        crate::pipeline::texture_2d(device, label, (STEPS, 2), samples, format, usage)
     };
     let resolved = texture(
         "raster probe resolved",
