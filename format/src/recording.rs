@@ -173,6 +173,28 @@ impl RasterProfile {
         out
     }
 
+    /// How far a corner moves in x and y when a rasterizer of the profile snaps it to its
+    /// coarsest grid, rounding to nearest: half a step of 2^−`subpixel_bits_min` px.
+    pub fn snap_reach(&self) -> f32 {
+        0.5 * 0.5f32.powi(self.subpixel_bits_min as i32)
+    }
+
+    /// Checks sub-pixel bits `lo..=hi`: 4 ≤ least ≤ most ≤ 16.
+    pub fn check_bits(lo: u32, hi: u32) -> Result<(), SettingsError> {
+        if !(4..=16).contains(&lo) || !(lo..=16).contains(&hi) {
+            return Err(SettingsError::SubpixelBits(lo, hi));
+        }
+        Ok(())
+    }
+
+    /// Where depth is taken, in words: `at the sample`, `anywhere in the pixel`.
+    pub fn depth_text(&self) -> &'static str {
+        match self.depth_at {
+            DepthAt::Sample => "at the sample",
+            DepthAt::Pixel => "anywhere in the pixel",
+        }
+    }
+
     /// The sub-pixel bits as words: `8`, `4 to 8`.
     pub fn bits_text(&self) -> String {
         if self.subpixel_bits_min == self.subpixel_bits_max {
@@ -242,6 +264,14 @@ impl Robust {
             conservative: !matches!(name, ProfileName::Exact),
             profile: RasterProfile::named(name),
         }
+    }
+
+    /// The half-size in pixels (x and y) of the box a player's sample may lie in relative to
+    /// the exact geometry: the tolerance plus how far a corner moves when snapped to the
+    /// profile's coarsest grid ([`RasterProfile::snap_reach`]). The conservative recording
+    /// grows coverage by it.
+    pub fn sample_box(&self) -> f32 {
+        self.tolerance + self.profile.snap_reach()
     }
 
     /// Whether anything beyond the recorded pattern is gathered.
@@ -333,11 +363,7 @@ impl RecordSettings {
         if !(r.tolerance >= 0.0 && r.tolerance <= 4.0) {
             return Err(SettingsError::Tolerance(r.tolerance));
         }
-        let (lo, hi) = (r.profile.subpixel_bits_min, r.profile.subpixel_bits_max);
-        if !(4..=16).contains(&lo) || !(lo..=16).contains(&hi) {
-            return Err(SettingsError::SubpixelBits(lo, hi));
-        }
-        Ok(())
+        RasterProfile::check_bits(r.profile.subpixel_bits_min, r.profile.subpixel_bits_max)
     }
 }
 

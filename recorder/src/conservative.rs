@@ -79,17 +79,16 @@ impl GrowBuffers {
         robust: &Robust,
     ) -> GrowBuffers {
         let profile = robust.profile;
-        // The box a sample may move in relative to the exact geometry: the tolerance, plus
-        // half a step of the coarsest grid a corner is snapped to (rounding to nearest).
-        let coarsest = 0.5f32.powi(profile.subpixel_bits_min as i32);
-        let reach = robust.tolerance + 0.5 * coarsest;
+        let reach = robust.sample_box();
         let params: [f32; 8] = [
             reach,
             reach,
             view.width as f32 / 2.0,
             view.height as f32 / 2.0,
             (profile.depth_at == DepthAt::Pixel) as u32 as f32,
-            coarsest * std::f32::consts::FRAC_1_SQRT_2,
+            // The snap's reach along a diagonal (√2 times its reach in x and y), written as
+            // the grid step over √2 so that it rounds as it always did.
+            2.0 * profile.snap_reach() * std::f32::consts::FRAC_1_SQRT_2,
             profile.subpixel_bits_min as f32,
             profile.subpixel_bits_max as f32,
         ];

@@ -135,11 +135,7 @@ fn parse_bits(s: &str) -> Result<(u32, u32), String> {
         Some((a, b)) => (bits(a)?, bits(b.trim_start_matches('='))?),
         None => (bits(s)?, bits(s)?),
     };
-    if !(4..=16).contains(&lo) || !(lo..=16).contains(&hi) {
-        return Err(format!(
-            "sub-pixel bits {lo}..{hi} must satisfy 4 <= least <= most <= 16"
-        ));
-    }
+    trisort_format::RasterProfile::check_bits(lo, hi).map_err(|e| e.to_string())?;
     Ok((lo, hi))
 }
 

@@ -67,23 +67,15 @@ pub struct RecordArgs {
 /// snapped to 8 sub-pixel bits, depth at the sample)`.
 pub fn profile_summary(s: &trisort_format::RecordSettings) -> String {
     let r = &s.robust;
-    let (lo, hi) = (r.profile.subpixel_bits_min, r.profile.subpixel_bits_max);
-    let bits = if lo == hi {
-        format!("{lo}")
-    } else {
-        format!("{lo} to {hi}")
-    };
     if !r.conservative {
         return format!("{} (the recorded pattern only)", r.profile.name);
     }
     format!(
-        "{} (±{} px, corners snapped to {bits} sub-pixel bits, depth {})",
+        "{} (±{} px, corners snapped to {} sub-pixel bits, depth {})",
         r.profile.name,
         r.tolerance,
-        match r.profile.depth_at {
-            trisort_format::DepthAt::Sample => "at the sample",
-            trisort_format::DepthAt::Pixel => "anywhere in the pixel",
-        }
+        r.profile.bits_text(),
+        r.profile.depth_text()
     )
 }
 
