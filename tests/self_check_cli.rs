@@ -355,20 +355,10 @@ fn play_checks_the_device_against_the_raster_profile() {
             && stderr.contains("sample positions"),
         "{stderr}"
     );
-    let out = trisort(d)
-        .args([
-            "play",
-            "car.baked",
-            "--strict-profile",
-            "--subpixel-offset",
-            "1/64,0",
-            "--out-dir",
-            "frames",
-        ])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = refused(
+        d,
+        "play car.baked --strict-profile --subpixel-offset 1/64,0 --out-dir frames",
+    );
     assert!(
         stderr.contains("--strict-profile") && stderr.contains("sample positions"),
         "{stderr}"
@@ -382,24 +372,23 @@ fn play_checks_the_device_against_the_raster_profile() {
         )),
         true,
     );
-    let out = trisort(d)
-        .args(["play", "snap.baked", "--strict-profile"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = refused(d, "play snap.baked --strict-profile");
     assert!(
         stderr.contains("sub-pixel precision") && stderr.contains("asks 4"),
         "{stderr}"
     );
     // Contradicting options are refused before anything is recorded.
-    let out = trisort(d)
-        .args(args(&format!(
+    let stderr = refused(
+        d,
+        &format!(
             "bake {SCENE} --path orbit:frames=1 --size 48x48 --raster-profile browser --conservative=false -o x.baked"
-        )))
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--raster-profile exact"));
+        ),
+    );
+    assert!(stderr.contains("--raster-profile exact"), "{stderr}");
     assert!(!d.join("x.baked").exists());
+}
+
+/// The stderr of `trisort LINE` run in `dir`, which must fail ([`run`] checks that).
+fn refused(dir: &std::path::Path, line: &str) -> String {
+    String::from_utf8_lossy(&run(dir, &args(line), false).stderr).into_owned()
 }
