@@ -28,11 +28,13 @@ mod coverage_test;
 mod envelope;
 pub mod partial;
 mod peeler;
+pub mod tie_rule;
 
 use std::collections::HashMap;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
+use crate::tie_rule::TieRule;
 use trisort_format::{
     Edge, FrameRecord, FrameState, Geometry, Hash, Phase, RecordSettings, Recording, Robust,
 };
@@ -426,6 +428,7 @@ fn graph_frame(
     frame: u32,
     g: &[u32],
     s: &RecordSettings,
+    rule: &TieRule,
 ) -> Result<Graph, RecordError> {
     let mut parts = GraphParts::new(g);
     let (mut layers, mut truncated) = (0, false);
@@ -438,8 +441,8 @@ fn graph_frame(
             source.set_frame_subpixel_offset(frame, offset);
         }
         let (l, t) = match source {
-            Layers::Capture(c) => capture_graph(c, frame, s, &mut parts, None)?,
-            Layers::Peel(peeler) => peel_graph(peeler, frame, s, &mut parts, None)?,
+            Layers::Capture(c) => capture_graph(c, frame, s, rule, &mut parts, None)?,
+            Layers::Peel(peeler) => peel_graph(peeler, frame, s, rule, &mut parts, None)?,
         };
         layers += l;
         truncated |= t;
@@ -449,8 +452,10 @@ fn graph_frame(
     }
     if let Some(grown) = grown {
         let (l, t) = match grown {
-            Layers::Capture(c) => capture_graph(c, frame, s, &mut parts, Some(&mut grown_edges))?,
-            Layers::Peel(p) => peel_graph(p, frame, s, &mut parts, Some(&mut grown_edges))?,
+            Layers::Capture(c) => {
+                capture_graph(c, frame, s, rule, &mut parts, Some(&mut grown_edges))?
+            }
+            Layers::Peel(p) => peel_graph(p, frame, s, rule, &mut parts, Some(&mut grown_edges))?,
         };
         layers += l;
         truncated |= t;
@@ -493,6 +498,7 @@ fn capture_graph(
     capture: &std::cell::RefCell<capture::Capture>,
     frame: u32,
     s: &RecordSettings,
+    rule: &TieRule,
     parts: &mut GraphParts,
     mut grown: Option<&mut HashMap<(u32, u32), u32>>,
 ) -> Result<(u32, bool), RecordError> {
@@ -507,10 +513,14 @@ fn capture_graph(
     let (mut most, mut left) = (0usize, false);
     capture.borrow_mut().frame(frame, |band| {
         let runs = band.walk(
-            || (Pairs::new(g), HashMap::new(), 0usize, false),
-            |(run, run_grown, most, left), list| {
+            || (Pairs::new(g), HashMap::new(), 0usize, false, Vec::new()),
+            |(run, run_grown, most, left, scratch), list| {
                 *left |= list.len() > max;
-                let taken = &list[..list.len().min(max)];
+                scratch.clear();
+                scratch.extend_from_slice(&list[..list.len().min(max)]);
+                // The tie rule's order (the peel's layers go through the same window).
+                rule.order(scratch, |f| f.id - 1);
+                let taken = &scratch[..];
                 *most = (*most).max(taken.len());
                 for (k, f) in taken.iter().enumerate() {
                     covered[(f.id - 1) as usize].store(true, Relaxed);
@@ -522,7 +532,7 @@ fn capture_graph(
                 }
             },
         );
-        for (run, run_grown, m, l) in runs {
+        for (run, run_grown, m, l, _) in runs {
             parts.pairs.absorb(run);
             if let Some(grown) = grown.as_deref_mut() {
                 for (key, w) in run_grown {
@@ -538,38 +548,49 @@ fn capture_graph(
 }
 
 /// Peels frame `frame` completely with `peeler` into `parts` (into `grown` for the grown
-/// peel's edges); returns layers peeled and whether `max_layers` truncated the peel.
+/// peel's edges), each sample's fragments put in the tie rule's order as they come (a window
+/// of [`tie_rule::MOVES`] per sample); returns layers peeled and whether `max_layers`
+/// truncated the peel.
 fn peel_graph(
     peeler: &Peeler,
     frame: u32,
     s: &RecordSettings,
+    rule: &TieRule,
     parts: &mut GraphParts,
     mut grown: Option<&mut HashMap<(u32, u32), u32>>,
 ) -> Result<(u32, bool), RecordError> {
     let slots = peeler.slots();
-    let mut last_id = vec![0u32; slots];
-    let mut last_depth = vec![0f32; slots];
-    peeler.peel(frame, s.max_layers, |_, layer, _| {
+    let mut last = vec![(0u32, 0f32); slots];
+    let mut windows = vec![tie_rule::Window::default(); slots];
+    let mut settle = |i: usize, (id, depth): (u32, f32), parts: &mut GraphParts| {
+        let (prev, prev_depth) = last[i];
+        if prev != 0 {
+            parts
+                .pairs
+                .pair(prev, id, (prev_depth, depth), grown.as_deref_mut());
+        }
+        last[i] = (id, depth);
+    };
+    let result = peeler.peel(frame, s.max_layers, |_, layer, _| {
         for i in 0..slots {
             let id = layer.ids[i];
             if id == 0 {
                 continue;
             }
             parts.covered[(id - 1) as usize].store(true, Relaxed);
-            let prev = last_id[i];
-            if prev != 0 {
-                parts.pairs.pair(
-                    prev,
-                    id,
-                    (last_depth[i], layer.depth[i]),
-                    grown.as_deref_mut(),
-                );
+            // Drawn positions go through the rule 0-based, as the capture's do.
+            if let Some((p, d)) = rule.push(&mut windows[i], (id - 1, layer.depth[i])) {
+                settle(i, (p + 1, d), parts);
             }
-            last_id[i] = id;
-            last_depth[i] = layer.depth[i];
         }
         Ok(true)
-    })
+    })?;
+    for (i, w) in windows.iter_mut().enumerate() {
+        for (p, d) in w.drain() {
+            settle(i, (p + 1, d), parts);
+        }
+    }
+    Ok(result)
 }
 
 /// Adds the grown peel's edges to the patterns' `edges` (weights add up), except those that
@@ -727,7 +748,16 @@ pub fn record(
                     if s.robust.conservative && grown.is_none() {
                         grown = Some(layers(Purpose::Grown(s.robust))?);
                     }
-                    let r = graph_frame(peeler.as_ref().unwrap(), grown.as_ref(), f, &g, &s)?;
+                    // The rule moves up only triangles visible in this frame (phase 1): the
+                    // player draws no other, so no other may take a sample's front.
+                    let drawn: Vec<bool> = g
+                        .iter()
+                        .map(|t| rec.visible.binary_search(t).is_ok())
+                        .collect();
+                    let rule =
+                        TieRule::new(job.geometry, &g, &job.frames[f as usize]).moving_only(drawn);
+                    let source = peeler.as_ref().unwrap();
+                    let r = graph_frame(source, grown.as_ref(), f, &g, &s, &rule)?;
                     if let Some(p) = partial {
                         p.store_graph(f, &r)?;
                     }

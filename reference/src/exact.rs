@@ -10,14 +10,19 @@
 //! pixel as in the player. The pass resolves MSAA like the headless player and the result is
 //! quantized once with [`quantize_rgba16f`].
 //!
-//! `depth`: the player's depth mode shows, per sample, the nearest fragment (the lowest id on a
-//! depth tie) composited *over* the background, because it draws front to back and the first
-//! fragment's depth write hides every later one. The reference composites the first peel layer
-//! alone the same way. For opaque scenes that is exactly DESIGN's "plain z-buffer of all
-//! triangles in ascending id order with `Less`" ([`whole_scene_baked`] played in depth mode;
-//! a test checks both agree bit for bit); with transparency the z-buffer in id order blends a
-//! near transparent fragment over whatever farther fragment happened to have a lower id, which
-//! no sorted front-to-back player draws, so it cannot be the reference there.
+//! Each sample's fragments are taken in the tie rule's order (`trisort_recorder::tie_rule`),
+//! which the recorder followed: the peel's (depth, id) order, with pairs of triangles that lie
+//! in one plane, or that one's plane separates, put as the rule says whatever their depths.
+//!
+//! `depth`: the player's depth mode draws front to back with the depth test (`Less`, depth
+//! writes) and *over*, so a sample shows, composited in that order, every fragment nearer than
+//! all those drawn before it. The reference lets through the same fragments of the rule's
+//! order. For opaque scenes that is the nearest fragment (on an exact tie, the one the rule
+//! puts first: the lower id unless the rule says otherwise), DESIGN's "plain z-buffer of all
+//! triangles in ascending id order with `Less`" ([`whole_scene_baked`] played in depth mode)
+//! except at exact ties the rule breaks otherwise; with transparency the z-buffer in id order
+//! blends a near transparent fragment over whatever farther fragment happened to have a lower
+//! id, which no sorted front-to-back player draws, so it cannot be the reference there.
 //!
 //! The player draws only the triangles visible before saturation; the reference composites
 //! every layer. What lies behind a saturated sample contributes at most the residual
@@ -34,6 +39,7 @@ use trisort_gpu::scene_gpu::{Lighting, SceneGpu, ScenePipeline, View};
 use trisort_gpu::Gpu;
 use trisort_gpu::{clear_colour, halves, quantize_rgba16f, BACKGROUND, COLOR_FORMAT};
 use trisort_player::{blend_state, Mode};
+use trisort_recorder::tie_rule::{TieRule, Window};
 use trisort_recorder::Peeler;
 use wgpu::util::DeviceExt;
 
@@ -94,6 +100,10 @@ pub struct UnorderedEdges {
     per_frame: Vec<HashSet<(u32, u32)>>,
     /// Per frame: their total weight in samples.
     recorded: Vec<u64>,
+    /// Per frame: the triangles the player draws there (scene ids, ascending), the only ones
+    /// the tie rule may move up (`TieRule::moving_only`): the recording's V_f, or the
+    /// triangles of the baked frame's draws.
+    drawn: Vec<Vec<u32>>,
 }
 
 impl UnorderedEdges {
@@ -110,6 +120,7 @@ impl UnorderedEdges {
             edges.add_g(&r.unique_visible, "a recording")?;
             for fr in &r.frames {
                 let source = if depth_only { &fr.ties } else { &fr.edges };
+                edges.set_drawn(fr.frame as usize, fr.visible.clone());
                 edges.set_frame(
                     fr.frame as usize,
                     trisort_verify::cycle_edges(source)
@@ -131,6 +142,18 @@ impl UnorderedEdges {
         edges.add_g(&baked.scene_ids, "the baked file")?;
         let scene = |t: u32| baked.scene_ids.get(t as usize).copied().unwrap_or(u32::MAX);
         for (f, removed) in baked.removed_edges.iter().enumerate() {
+            let mut drawn: Vec<u32> = baked
+                .frame_draws(f)
+                .iter()
+                .flat_map(|d| {
+                    let (a, b) = (d.first_index / 3, (d.first_index + d.index_count) / 3);
+                    baked.copies.get(a as usize..b as usize).unwrap_or_default()
+                })
+                .map(|&c| scene(c))
+                .collect();
+            drawn.sort_unstable();
+            drawn.dedup();
+            edges.set_drawn(f, drawn);
             edges.set_frame(
                 f,
                 removed
@@ -146,7 +169,17 @@ impl UnorderedEdges {
             in_g: vec![false; scene_triangles],
             per_frame: Vec::new(),
             recorded: Vec::new(),
+            drawn: Vec::new(),
         }
+    }
+
+    /// Frame `f`'s drawn triangles (scene ids).
+    fn set_drawn(&mut self, f: usize, mut drawn: Vec<u32>) {
+        if self.drawn.len() <= f {
+            self.drawn.resize_with(f + 1, Vec::new);
+        }
+        drawn.sort_unstable();
+        self.drawn[f] = drawn;
     }
 
     /// Marks the members of `g` (scene ids, from `what`) as triangles of G.
@@ -196,8 +229,8 @@ pub struct ReferenceFrame {
     /// Number of samples whose consecutive fragments form one of the [`UnorderedEdges`], as
     /// the peel finds them.
     pub unordered_samples: u64,
-    /// Peel layers peeled (`depth` mode stops after the first where the frame has no
-    /// unordered edge).
+    /// Peel layers peeled (every mode peels to the end: the tie rule may put a later
+    /// fragment first).
     pub layers: u32,
     /// Whether the peel stopped at `max_layers` with fragments left.
     pub truncated: bool,
@@ -216,6 +249,10 @@ pub struct ExactReference<'g> {
     config: ReferenceConfig,
     /// Every scene triangle (vertex indices), to build each layer's index list.
     triangles: Vec<[u32; 3]>,
+    /// The scene's positions, triangles and nodes with the path's frames: the tie rule's
+    /// planes ([`TieRule`]).
+    shape: Geometry,
+    frames: Vec<FrameState>,
     peeler: Peeler<'g>,
     scene: SceneGpu,
     pipeline: wgpu::RenderPipeline,
@@ -283,7 +320,8 @@ impl<'g> ExactReference<'g> {
         check_pattern(config.size, config.samples)?;
         let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
         let view = config.view();
-        let peeler = Peeler::new(gpu, geometry, &all, frames, view)?;
+        // Depths too: the tie rule keeps exact ties in the peel's order.
+        let peeler = Peeler::new(gpu, geometry, &all, frames, view)?.with_readback(false, true);
         let device = &gpu.device;
         let shading = lighting.shading;
         let scene = lit_scene(gpu, geometry, frames, view, lighting);
@@ -333,6 +371,13 @@ impl<'g> ExactReference<'g> {
             gpu,
             config,
             triangles: geometry.triangles.clone(),
+            shape: Geometry {
+                vertices: geometry.vertices.clone(),
+                triangles: geometry.triangles.clone(),
+                nodes: geometry.nodes.clone(),
+                ..Geometry::default()
+            },
+            frames: frames.to_vec(),
             peeler,
             scene,
             pipeline,
@@ -373,30 +418,73 @@ impl<'g> ExactReference<'g> {
         let mut unordered_samples = 0u64;
         let no_edges = HashSet::new();
         let edges = unordered.map(|r| r.per_frame.get(frame as usize).unwrap_or(&no_edges));
-        // `depth` composites only the first layer; it peels on only to find unordered samples.
-        let full = !depth_mode || edges.is_some_and(|e| !e.is_empty());
+        // Every mode peels every layer and takes each sample's fragments in the tie rule's
+        // order, which the recorder followed (`trisort_recorder::tie_rule`): they go through a
+        // window as they come, and the k-th to leave it goes to composited layer k (in `depth`,
+        // the k-th that the depth test lets through).
+        let state = self
+            .frames
+            .get(frame as usize)
+            .ok_or_else(|| ReferenceError::Invalid(format!("frame {frame} is beyond the path")))?;
+        let all: Vec<u32> = (0..self.triangles.len() as u32).collect();
+        // Without a recording (or a file's draws) the rule moves nothing: the rasterizer's order.
+        let mut moves = vec![false; all.len()];
+        if let Some(d) = unordered.and_then(|r| r.drawn.get(frame as usize)) {
+            for &t in d {
+                if let Some(m) = moves.get_mut(t as usize) {
+                    *m = true;
+                }
+            }
+        }
+        let rule = TieRule::new(&self.shape, &all, state).moving_only(moves);
+        let mut windows = vec![Window::default(); slots];
+        let mut placed = vec![0u32; slots];
+        // `depth`: the player draws a sample's fragments in that order with the depth test
+        // (`Less`, depth writes, cleared to 1): a fragment shows, *over* what came before, where
+        // it is nearer than every fragment drawn before it. Per sample, the depth written so far.
+        let mut written = vec![1.0f32; if depth_mode { slots } else { 0 }];
+        let mut settle = |i: usize, (id, depth): (u32, f32), layer_ids: &mut Vec<Vec<u32>>| {
+            if let (Some(r), Some(edges)) = (unordered, edges) {
+                if r.in_g.get((id - 1) as usize) == Some(&true) {
+                    let prev = last_g[i];
+                    if prev != 0 && edges.contains(&(prev - 1, id - 1)) {
+                        unordered_samples += 1;
+                        unordered_sample[i / samples] = true;
+                    }
+                    last_g[i] = id;
+                }
+            }
+            if depth_mode {
+                if !(depth < written[i]) {
+                    return;
+                }
+                written[i] = depth;
+            }
+            let k = placed[i] as usize;
+            placed[i] += 1;
+            if layer_ids.len() <= k {
+                layer_ids.push(vec![0; slots]);
+            }
+            layer_ids[k][i] = id;
+        };
         let (layers, truncated) =
             self.peeler
-                .peel(frame, self.config.max_layers, |k, layer, _| {
-                    if let (Some(r), Some(edges)) = (unordered, edges) {
-                        for (i, &id) in layer.ids.iter().enumerate() {
-                            let in_g = id != 0 && r.in_g.get((id - 1) as usize) == Some(&true);
-                            if !in_g {
-                                continue;
-                            }
-                            let prev = last_g[i];
-                            if prev != 0 && edges.contains(&(prev - 1, id - 1)) {
-                                unordered_samples += 1;
-                                unordered_sample[i / samples] = true;
-                            }
-                            last_g[i] = id;
+                .peel(frame, self.config.max_layers, |_, layer, _| {
+                    for (i, &id) in layer.ids.iter().enumerate() {
+                        if id == 0 {
+                            continue;
+                        }
+                        if let Some((p, d)) = rule.push(&mut windows[i], (id - 1, layer.depth[i])) {
+                            settle(i, (p + 1, d), &mut layer_ids);
                         }
                     }
-                    if !depth_mode || k == 0 {
-                        layer_ids.push(layer.ids.clone());
-                    }
-                    Ok(full)
+                    Ok(true)
                 })?;
+        for (i, w) in windows.iter_mut().enumerate() {
+            for (p, d) in w.drain() {
+                settle(i, (p + 1, d), &mut layer_ids);
+            }
+        }
         let draws = self.layer_draws(&layer_ids)?;
         let order: Vec<&LayerDraw> = match self.config.mode {
             Mode::Blend => draws.iter().rev().collect(),
@@ -421,7 +509,7 @@ impl<'g> ExactReference<'g> {
             unordered: unordered_sample,
             unordered_samples,
             layers,
-            truncated: truncated && full,
+            truncated,
         })
     }
 

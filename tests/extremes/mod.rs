@@ -162,7 +162,10 @@ fn bake_with(
     // The known answers below are the recorded pattern's (which triangle wins which sample,
     // ties, depth precision): recorded at that pattern only, not conservatively (the
     // default), unless a test asks otherwise.
-    if !extra.iter().any(|a| a.starts_with("--conservative")) {
+    if !extra
+        .iter()
+        .any(|a| a.starts_with("--conservative") || a.starts_with("--raster-profile"))
+    {
         args.push("--conservative=false");
     }
     args.extend_from_slice(extra);

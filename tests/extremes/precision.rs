@@ -2,6 +2,7 @@
 //! surfaces closer than f32 resolves.
 
 use super::*;
+use trisort_format::ProfileName;
 
 /// Coplanar decals: where two opaque surfaces share a plane, the lower id is in front, so a
 /// decal is visible only if its ids are lower than its base's. Left: decal before its base
@@ -396,5 +397,109 @@ fn surfaces_closer_than_f32_resolution_tie_by_id() {
         let last_far = order.iter().rposition(|&t| t < 2).unwrap();
         let first_near = order.iter().position(|&t| t >= 2).unwrap();
         assert!(last_far < first_near, "frame {f}: {order:?}");
+    }
+}
+
+/// The tie rule (DESIGN § Recorder, "Ties"; `recorder/src/tie_rule.rs`) with the default
+/// raster profile (conformant: the recorded pattern and every sample moved by up to its
+/// tolerance): three scenes whose surfaces the rasterizer's depths cannot order verify exact
+/// in every mode, with no unordered sample:
+/// - a transparent decal on an opaque panel, in one plane, seen obliquely (their interpolated
+///   depths cross in the last bit): the decal comes first in the file, so it is on top;
+/// - transparent sheets 10⁻⁴ apart under a near plane of 10⁻⁴ and a far plane of 10⁵, where
+///   f32 depth ties them: the sheet on the eye's side of the other's plane comes first;
+/// - a transparent door touching its opaque frame along the hinge, open at 20°, seen across
+///   the hinge: the two share an edge, and near it their depths cross in the last bits.
+#[test]
+fn ties_verify_exact_in_every_mode_with_the_default_profile() {
+    let dir = tempfile::tempdir().unwrap();
+    let red = Mat([0.9, 0.2, 0.1, 1.0]);
+    let glass = Mat([0.1, 0.3, 0.9, 0.5]);
+    let decal = glb(
+        &[
+            part(1, quad(-0.4, 0.4, -0.3, 0.3, -2.0)),
+            part(0, quad(-1.5, 1.5, -1.0, 1.0, -2.0)),
+        ],
+        &[red, glass],
+    );
+    let oblique = |d: f64| {
+        path_toml(
+            70.0,
+            Some((0.1, 10.0)),
+            &[
+                ([0.9 * d, 0.4 * d, 0.0], [0.0, 0.0, -2.0]),
+                ([-0.7 * d, -0.3 * d, 0.2 * d], [0.0, 0.0, -2.0]),
+            ],
+        )
+    };
+    let mut sheets = vec![part(0, quad(-2.0, 2.0, -2.0, 2.0, -2.5))];
+    for k in 0..3 {
+        let dz = -2.0 + 1.0e-4 * k as f32;
+        let x = -0.5 + 0.3 * k as f32;
+        sheets.push(part(1, quad(x, x + 0.8, -0.5, 0.5, dz)));
+    }
+    let sheets = glb(&sheets, &[red, glass]);
+    let far_clip = path_toml(
+        60.0,
+        Some((1.0e-4, 1.0e5)),
+        &[
+            ([0.6, 0.3, 0.0], [0.0, 0.0, -2.0]),
+            ([-0.4, -0.2, 0.0], [0.0, 0.0, -2.0]),
+        ],
+    );
+    // The frame: a panel in z = −2 left of the hinge (x = 0); the door: a panel from the hinge
+    // swung 20° towards the eye.
+    let (c, s) = (20f32.to_radians().cos(), 20f32.to_radians().sin());
+    let door_far = [0.9 * c, 0.0, -2.0 + 0.9 * s];
+    let door = vec![
+        [
+            [0.0, -0.6, -2.0],
+            [door_far[0], -0.6, door_far[2]],
+            [door_far[0], 0.6, door_far[2]],
+        ],
+        [
+            [0.0, -0.6, -2.0],
+            [door_far[0], 0.6, door_far[2]],
+            [0.0, 0.6, -2.0],
+        ],
+    ];
+    let hinge = glb(
+        &[part(0, quad(-1.0, 0.0, -0.6, 0.6, -2.0)), part(1, door)],
+        &[red, glass],
+    );
+    let across = path_toml(
+        60.0,
+        Some((0.1, 10.0)),
+        &[
+            ([-1.2, 0.2, -0.3], [0.2, 0.0, -2.0]),
+            ([1.4, -0.3, -0.6], [-0.1, 0.0, -2.0]),
+        ],
+    );
+    for (name, scene, path) in [
+        ("tie_decal", &decal, oblique(1.0)),
+        ("tie_clip", &sheets, far_clip),
+        ("tie_hinge", &hinge, across),
+    ] {
+        let extra = ["--raster-profile", "conformant"];
+        let Some(b) = bake_with(dir.path(), name, scene, &path, 64, 4, &extra) else {
+            return;
+        };
+        assert_eq!(
+            b.baked.settings.robust.profile.name,
+            ProfileName::Conformant
+        );
+        let removed: u64 = b
+            .baked
+            .removed_edges
+            .iter()
+            .flatten()
+            .map(|e| e.weight as u64)
+            .sum();
+        assert_eq!(removed, 0, "{name}: no unordered sample");
+        let blend = assert_verifies(dir.path(), name);
+        for f in blend["frames"].as_array().unwrap() {
+            assert!(f["max_channel_diff"].as_u64().unwrap() <= 1, "{name}: {f}");
+            assert_eq!(f["unordered_samples"], 0, "{name}: {f}");
+        }
     }
 }

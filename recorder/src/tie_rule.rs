@@ -1,0 +1,316 @@
+//! The tie rule (DESIGN § Recorder, "Ties"): one order for fragments the rasterizer's depths
+//! cannot be trusted to order, used alike by the recorder (both phases, the grown capture
+//! included) and the exact reference of `blend` and `saturate`.
+//!
+//! At a sample the peel lists fragments by (depth, id). Two of them next to each other, `p`
+//! then `q`, are put the other way round, whatever their depths (an exact tie included), when
+//! their triangles, in camera space,
+//! - lie in one plane (each corner of each within 10⁻⁶ of the larger triangle's longest edge
+//!   of the other's plane: a decal on its panel) and `q` has the lower id: coplanar surfaces
+//!   are layered in glTF order, the earlier on top, wherever rounding puts their depths; or
+//! - are *separable*: one lies wholly on one side of the other's plane (beyond that tolerance
+//!   where it does not touch it), and `q` is the one on the eye's side. Where both cover a
+//!   point, that one is nearer, so this is their order at every sample: two triangles sharing
+//!   a corner or an edge (a panel meeting its neighbour at a crease, a door at its hinge) whose
+//!   interpolated depths cross in the last bits near the shared corner, and the conservative
+//!   recording's depths extended past a triangle's edges, no longer give both orders.
+//!
+//! Pairs that pass through each other (the splitter cut those it found) or are skew keep the
+//! rasterizer's order. Applied as an insertion sort with the rule as the comparison of adjacent
+//! fragments; a fragment moves up only past fragments the rule puts after it.
+//!
+//! Measured on CarConcept (BENCHMARKS § Ties): every edge the merger had to leave unordered in
+//! the close-up, at the recorded pattern and conformantly, was one of a separable pair.
+
+use glam::{DMat4, DVec3};
+use trisort_format::{world_transforms, FrameState, Geometry};
+
+/// A triangle in camera space (eye at the origin): corners, unit normal, longest edge.
+#[derive(Clone, Copy, Debug)]
+struct Plane {
+    corners: [DVec3; 3],
+    normal: DVec3,
+    size: f64,
+}
+
+/// The tie rule for one frame over a drawn list of triangles (positions in the list are the
+/// fragment ids, 0-based).
+pub struct TieRule {
+    /// Per drawn triangle: its plane, `None` when degenerate in f64.
+    planes: Vec<Option<Plane>>,
+    /// Per drawn triangle: whether the rule may move it up ([`TieRule::moving_only`]).
+    moves: Option<Vec<bool>>,
+}
+
+/// How close to a plane, relative to the pair's longest edge, a corner counts as in it.
+const IN_PLANE: f64 = 1e-6;
+
+impl TieRule {
+    /// The rule at `frame` for `triangles` (scene ids, in draw order) of `geometry`.
+    pub fn new(geometry: &Geometry, triangles: &[u32], frame: &FrameState) -> TieRule {
+        let world: Vec<DMat4> = world_transforms(&geometry.nodes, &frame.poses);
+        let eye = frame.camera.eye();
+        let planes = triangles
+            .iter()
+            .map(|&t| {
+                let corners = geometry.triangles[t as usize].map(|v| {
+                    let v = &geometry.vertices[v as usize];
+                    let p = DVec3::from(v.position.map(f64::from));
+                    world[v.node as usize].transform_point3(p) - eye
+                });
+                let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+                let size = (corners[1] - corners[0])
+                    .length()
+                    .max((corners[2] - corners[1]).length())
+                    .max((corners[0] - corners[2]).length());
+                let normal = normal.try_normalize()?;
+                (size.is_finite() && size > 0.0).then_some(Plane {
+                    corners,
+                    normal,
+                    size,
+                })
+            })
+            .collect();
+        TieRule {
+            planes,
+            moves: None,
+        }
+    }
+
+    /// The rule moving up only the drawn triangles `moves` marks (the frame's visible set V_f,
+    /// which is all the player draws): one it leaves unmarked keeps the rasterizer's place.
+    /// The recorder and the reference mark the same set, the recording's V_f, so a triangle
+    /// hidden at the recorded pattern is never brought to the front of a sample.
+    pub fn moving_only(mut self, moves: Vec<bool>) -> TieRule {
+        self.moves = Some(moves);
+        self
+    }
+
+    /// Whether fragment `q` (a drawn position), listed right after `p` at a sample, comes
+    /// first by the rule.
+    pub fn precedes(&self, q: u32, p: u32) -> bool {
+        if let Some(m) = &self.moves {
+            if !m.get(q as usize).copied().unwrap_or(false) {
+                return false;
+            }
+        }
+        let (Some(Some(a)), Some(Some(b))) =
+            (self.planes.get(p as usize), self.planes.get(q as usize))
+        else {
+            return false;
+        };
+        let eps = IN_PLANE * a.size.max(b.size);
+        let sides = |s: &Plane, o: &Plane| o.corners.map(|c| s.normal.dot(c - s.corners[0]));
+        let (q_of_p, p_of_q) = (sides(a, b), sides(b, a));
+        let flat = |d: &[f64; 3]| d.iter().all(|x| x.abs() <= eps);
+        if flat(&q_of_p) && flat(&p_of_q) {
+            return q < p;
+        }
+        // The side of plane `s` that triangle `o` lies on (+1, −1), if it lies on one, not in it.
+        let side = |d: &[f64; 3]| -> Option<f64> {
+            if d.iter().all(|&x| x >= -eps) && d.iter().any(|&x| x > eps) {
+                Some(1.0)
+            } else if d.iter().all(|&x| x <= eps) && d.iter().any(|&x| x < -eps) {
+                Some(-1.0)
+            } else {
+                None
+            }
+        };
+        // The eye's side of plane `s` (the eye is the origin), if it is not in it.
+        let eye = |s: &Plane| {
+            let e = -s.normal.dot(s.corners[0]);
+            (e.abs() > eps).then_some(e.signum())
+        };
+        if let (Some(q_side), Some(e)) = (side(&q_of_p), eye(a)) {
+            return q_side == e;
+        }
+        if let (Some(p_side), Some(e)) = (side(&p_of_q), eye(b)) {
+            return p_side != e;
+        }
+        false
+    }
+
+    /// Takes fragment `next` (drawn position, depth) of a sample whose earlier fragments went
+    /// through `window`, in peel order ((depth, id) ascending), and returns the fragment that
+    /// leaves the window, if one does: fragments come out in the rule's order. `next` moves up
+    /// past the fragments before it that the rule puts after it, at most [`MOVES`] places (the
+    /// depth rides along; the rule does not read it); the oldest of a full window can then move no more. The same
+    /// order whether a sample's fragments come as one list (a capture) or a layer at a time
+    /// (a peel). [`Window::drain`] empties it at the end of the sample.
+    pub fn push(&self, window: &mut Window, next: (u32, f32)) -> Option<(u32, f32)> {
+        push_with(&|q, p| self.precedes(q, p), window, next)
+    }
+
+    /// Puts `list` (one sample's fragments in peel order) in the rule's order, in place: the
+    /// order [`TieRule::push`] gives them one at a time (an insertion sort in which a fragment
+    /// moves up at most [`MOVES`] places), with `id` reading a fragment's drawn position.
+    pub fn order<T>(&self, list: &mut [T], id: impl Fn(&T) -> u32) {
+        for i in 1..list.len() {
+            let mut j = i;
+            while j > 0 && i - j < MOVES {
+                let (p, q) = (&list[j - 1], &list[j]);
+                if !self.precedes(id(q), id(p)) {
+                    break;
+                }
+                list.swap(j - 1, j);
+                j -= 1;
+            }
+        }
+    }
+}
+
+/// [`TieRule::push`] with `precedes` as the rule.
+fn push_with(
+    precedes: &impl Fn(u32, u32) -> bool,
+    window: &mut Window,
+    next: (u32, f32),
+) -> Option<(u32, f32)> {
+    let n = window.len as usize;
+    let mut items = window.items;
+    let mut out = None;
+    let mut j = n;
+    let mut all = [(0u32, 0f32); MOVES + 1];
+    all[..n].copy_from_slice(&items[..n]);
+    all[n] = next;
+    while j > 0 {
+        let (p, q) = (all[j - 1], all[j]);
+        if !precedes(q.0, p.0) {
+            break;
+        }
+        all.swap(j - 1, j);
+        j -= 1;
+    }
+    let len = if n == MOVES {
+        out = Some(all[0]);
+        items.copy_from_slice(&all[1..]);
+        MOVES
+    } else {
+        items[..=n].copy_from_slice(&all[..=n]);
+        n + 1
+    };
+    window.items = items;
+    window.len = len as u8;
+    out
+}
+
+/// How many places the rule moves a fragment up at most (see [`TieRule::push`]).
+pub const MOVES: usize = 3;
+
+/// The fragments of one sample not yet in their final place (see [`TieRule::push`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Window {
+    items: [(u32, f32); MOVES],
+    len: u8,
+}
+
+impl Window {
+    /// The fragments left, in order; empties the window.
+    pub fn drain(&mut self) -> impl Iterator<Item = (u32, f32)> {
+        let items = self.items;
+        let n = self.len as usize;
+        self.len = 0;
+        (0..n).map(move |k| items[k])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rule(tris: &[[DVec3; 3]]) -> TieRule {
+        TieRule {
+            planes: tris
+                .iter()
+                .map(|&corners| {
+                    let normal = (corners[1] - corners[0])
+                        .cross(corners[2] - corners[0])
+                        .try_normalize()?;
+                    Some(Plane {
+                        corners,
+                        normal,
+                        size: 1.0,
+                    })
+                })
+                .collect(),
+            moves: None,
+        }
+    }
+
+    fn tri(z0: f64, z1: f64, z2: f64, x: f64) -> [DVec3; 3] {
+        [
+            DVec3::new(x, 0.0, z0),
+            DVec3::new(x + 1.0, 0.0, z1),
+            DVec3::new(x, 1.0, z2),
+        ]
+    }
+
+    #[test]
+    fn separable_pairs_take_the_eyes_side_first() {
+        // 0 at z = −2, 1 at z = −3 (farther): 0 comes first whichever the list holds first.
+        let r = rule(&[tri(-2.0, -2.0, -2.0, 0.0), tri(-3.0, -3.0, -3.0, 0.0)]);
+        assert!(r.precedes(0, 1));
+        assert!(!r.precedes(1, 0));
+        // Sharing a corner, tilted: 1 leans away from the eye from the shared corner.
+        let r = rule(&[tri(-2.0, -2.0, -2.0, 0.0), tri(-2.0, -2.5, -2.5, 0.0)]);
+        assert!(r.precedes(0, 1));
+        assert!(!r.precedes(1, 0));
+    }
+
+    #[test]
+    fn coplanar_pairs_take_the_lower_id_first() {
+        let r = rule(&[tri(-2.0, -2.0, -2.0, 0.3), tri(-2.0, -2.0, -2.0, 0.0)]);
+        assert!(r.precedes(0, 1));
+        assert!(!r.precedes(1, 0));
+    }
+
+    #[test]
+    fn crossing_pairs_keep_the_rasterizers_order() {
+        // 1 passes through 0's plane and 0 through 1's.
+        let r = rule(&[
+            tri(-2.0, -2.0, -2.0, 0.0),
+            [
+                DVec3::new(0.2, 0.2, -1.0),
+                DVec3::new(0.4, 0.2, -3.0),
+                DVec3::new(0.2, 0.6, -3.0),
+            ],
+        ]);
+        assert!(!r.precedes(0, 1));
+        assert!(!r.precedes(1, 0));
+    }
+
+    #[test]
+    fn order_moves_up_past_what_the_rule_puts_after_exact_ties_included() {
+        let r = rule(&[tri(-2.0, -2.0, -2.0, 0.0), tri(-3.0, -3.0, -3.0, 0.0)]);
+        let mut list = [(1u32, 0.5f32), (0, 0.5001)];
+        r.order(&mut list, |f| f.0);
+        assert_eq!(list, [(0, 0.5001), (1, 0.5)]);
+        let mut tie = [(1u32, 0.5f32), (0, 0.5)];
+        r.order(&mut tie, |f| f.0);
+        assert_eq!(
+            tie,
+            [(0, 0.5), (1, 0.5)],
+            "an exact tie too: the rasterizer's depths decide nothing"
+        );
+    }
+
+    #[test]
+    fn a_list_and_a_stream_come_out_alike() {
+        // Four planes at growing distance, listed farthest first at depths that say otherwise:
+        // the rule reverses them, each moving up at most MOVES places.
+        let tris: Vec<[DVec3; 3]> = (0..6)
+            .map(|k| tri(-2.0 - k as f64, -2.0 - k as f64, -2.0 - k as f64, 0.0))
+            .collect();
+        let r = rule(&tris);
+        let input: Vec<(u32, f32)> = (0..6u32).rev().map(|k| (k, 0.1 * (6 - k) as f32)).collect();
+        let mut list = input.clone();
+        r.order(&mut list, |f| f.0);
+        let mut window = Window::default();
+        let mut stream: Vec<(u32, f32)> = Vec::new();
+        for &f in &input {
+            stream.extend(r.push(&mut window, f));
+        }
+        stream.extend(window.drain());
+        assert_eq!(list, stream);
+        assert_eq!(list[0].0, 2, "moved up {MOVES} places: {list:?}");
+    }
+}
