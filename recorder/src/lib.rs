@@ -572,14 +572,14 @@ fn peel_graph(
         last[i] = (id, depth);
     };
     let result = peeler.peel(frame, s.max_layers, |_, layer, _| {
-        for i in 0..slots {
+        for (i, window) in windows.iter_mut().enumerate() {
             let id = layer.ids[i];
             if id == 0 {
                 continue;
             }
             parts.covered[(id - 1) as usize].store(true, Relaxed);
             // Drawn positions go through the rule 0-based, as the capture's do.
-            if let Some((p, d)) = rule.push(&mut windows[i], (id - 1, layer.depth[i])) {
+            if let Some((p, d)) = rule.push(window, (id - 1, layer.depth[i])) {
                 settle(i, (p + 1, d), parts);
             }
         }

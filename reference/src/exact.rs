@@ -455,7 +455,7 @@ impl<'g> ExactReference<'g> {
                 }
             }
             if depth_mode {
-                if !(depth < written[i]) {
+                if depth.partial_cmp(&written[i]) != Some(std::cmp::Ordering::Less) {
                     return;
                 }
                 written[i] = depth;
