@@ -211,7 +211,8 @@ impl<'g> Layers<'g> {
         }
         Ok(Layers::Peel(match purpose {
             Purpose::Visibility => Peeler::new(gpu, g, t, f, view)?.with_readback(true, false),
-            Purpose::Graphs => Peeler::new(gpu, g, t, f, view)?.with_readback(false, true),
+            // Opacity too: the tie rule's order may reach a triangle before saturation.
+            Purpose::Graphs => Peeler::new(gpu, g, t, f, view)?.with_readback(true, true),
             Purpose::Grown(robust) => {
                 Peeler::grown(gpu, g, t, f, view, &robust)?.with_readback(false, true)
             }
@@ -406,6 +407,9 @@ impl<'a> Pairs<'a> {
 /// parallel walks: a union), and the pairs.
 struct GraphParts<'a> {
     covered: Vec<AtomicBool>,
+    /// Per drawn triangle: reached before its sample saturates in the tie rule's order at the
+    /// recorded pattern, which may bring a triangle phase 1 found hidden to the front.
+    reached: Vec<AtomicBool>,
     pairs: Pairs<'a>,
 }
 
@@ -414,6 +418,7 @@ impl<'a> GraphParts<'a> {
     fn new(g: &'a [u32]) -> Self {
         GraphParts {
             covered: g.iter().map(|_| AtomicBool::new(false)).collect(),
+            reached: g.iter().map(|_| AtomicBool::new(false)).collect(),
             pairs: Pairs::new(g),
         }
     }
@@ -462,6 +467,7 @@ fn graph_frame(
     }
     let GraphParts {
         covered,
+        reached,
         pairs: Pairs {
             mut edges, ties, ..
         },
@@ -481,7 +487,20 @@ fn graph_frame(
         v.sort_unstable();
         v
     };
-    Ok((covered, to_edges(edges), to_edges(ties), layers, truncated))
+    let reached: Vec<u32> = reached
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.load(Relaxed))
+        .map(|(k, _)| g[k])
+        .collect();
+    Ok((
+        covered,
+        to_edges(edges),
+        to_edges(ties),
+        layers,
+        truncated,
+        reached,
+    ))
 }
 
 /// Captures frame `frame` with `capture` into `parts` (into `grown` for the grown capture's
@@ -510,6 +529,8 @@ fn capture_graph(
     };
     let g = parts.pairs.g;
     let covered = &parts.covered;
+    let reached = &parts.reached;
+    let residual = 1.0 - s.saturation;
     let (mut most, mut left) = (0usize, false);
     capture.borrow_mut().frame(frame, |band| {
         let runs = band.walk(
@@ -522,6 +543,16 @@ fn capture_graph(
                 rule.order(scratch, |f| f.id - 1);
                 let taken = &scratch[..];
                 *most = (*most).max(taken.len());
+                if !is_grown {
+                    let mut transmittance = 1.0f32;
+                    for f in taken {
+                        if transmittance <= residual {
+                            break;
+                        }
+                        reached[(f.id - 1) as usize].store(true, Relaxed);
+                        transmittance *= 1.0 - f.alpha;
+                    }
+                }
                 for (k, f) in taken.iter().enumerate() {
                     covered[(f.id - 1) as usize].store(true, Relaxed);
                     if k > 0 {
@@ -560,9 +591,12 @@ fn peel_graph(
     mut grown: Option<&mut HashMap<(u32, u32), u32>>,
 ) -> Result<(u32, bool), RecordError> {
     let slots = peeler.slots();
+    let is_grown = grown.is_some();
+    let residual = 1.0 - s.saturation;
     let mut last = vec![(0u32, 0f32); slots];
-    let mut windows = vec![tie_rule::Window::default(); slots];
-    let mut settle = |i: usize, (id, depth): (u32, f32), parts: &mut GraphParts| {
+    let mut transmittance = vec![1.0f32; if is_grown { 0 } else { slots }];
+    let mut windows = vec![tie_rule::Window::<(f32, f32)>::default(); slots];
+    let mut settle = |i: usize, (id, (depth, alpha)): (u32, (f32, f32)), parts: &mut GraphParts| {
         let (prev, prev_depth) = last[i];
         if prev != 0 {
             parts
@@ -570,6 +604,10 @@ fn peel_graph(
                 .pair(prev, id, (prev_depth, depth), grown.as_deref_mut());
         }
         last[i] = (id, depth);
+        if !is_grown && transmittance[i] > residual {
+            parts.reached[(id - 1) as usize].store(true, Relaxed);
+            transmittance[i] *= 1.0 - alpha;
+        }
     };
     let result = peeler.peel(frame, s.max_layers, |_, layer, _| {
         for (i, window) in windows.iter_mut().enumerate() {
@@ -578,8 +616,10 @@ fn peel_graph(
                 continue;
             }
             parts.covered[(id - 1) as usize].store(true, Relaxed);
+            // The grown peel reads no opacity (it reaches nothing).
+            let alpha = layer.alpha.get(i).copied().unwrap_or(1.0);
             // Drawn positions go through the rule 0-based, as the capture's do.
-            if let Some((p, d)) = rule.push(window, (id - 1, layer.depth[i])) {
+            if let Some((p, d)) = rule.push(window, (id - 1, (layer.depth[i], alpha))) {
                 settle(i, (p + 1, d), parts);
             }
         }
@@ -748,14 +788,9 @@ pub fn record(
                     if s.robust.conservative && grown.is_none() {
                         grown = Some(layers(Purpose::Grown(s.robust))?);
                     }
-                    // The rule moves up only triangles visible in this frame (phase 1): the
-                    // player draws no other, so no other may take a sample's front.
-                    let drawn: Vec<bool> = g
-                        .iter()
-                        .map(|t| rec.visible.binary_search(t).is_ok())
-                        .collect();
-                    let rule =
-                        TieRule::new(job.geometry, &g, &job.frames[f as usize]).moving_only(drawn);
+                    // The rule may move any triangle of G: one it brings before saturation
+                    // joins V_f (`reached`), and the reference moves those of V_f.
+                    let rule = TieRule::new(job.geometry, &g, &job.frames[f as usize]);
                     let source = peeler.as_ref().unwrap();
                     let r = graph_frame(source, grown.as_ref(), f, &g, &s, &rule)?;
                     if let Some(p) = partial {
@@ -764,7 +799,11 @@ pub fn record(
                     r
                 }
             };
-            let (covered, edges, ties, layers, truncated) = result;
+            let (covered, edges, ties, layers, truncated, reached) = result;
+            // V_f gains what the tie rule brings before saturation (sorted, no duplicates).
+            rec.visible.extend(reached);
+            rec.visible.sort_unstable();
+            rec.visible.dedup();
             rec.covered = covered;
             rec.edges = edges;
             rec.ties = ties;

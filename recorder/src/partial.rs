@@ -20,8 +20,9 @@ pub struct PartialDir {
 
 /// Phase-1 result of a frame: visible set, layers, truncated.
 pub(crate) type Visibility = (Vec<u32>, u32, bool);
-/// Phase-2 result of a frame: covered, edges, ties, layers, truncated.
-pub(crate) type Graph = (Vec<u32>, Vec<Edge>, Vec<Edge>, u32, bool);
+/// Phase-2 result of a frame: covered, edges, ties, layers, truncated, and the triangles the
+/// tie rule brings before saturation (they join V_f).
+pub(crate) type Graph = (Vec<u32>, Vec<Edge>, Vec<Edge>, u32, bool, Vec<u32>);
 
 /// The partial folder that belongs to output file `out`: `OUT.partial/`.
 pub fn partial_path(out: &Path) -> PathBuf {

@@ -1,6 +1,7 @@
 //! The tie rule (DESIGN § Recorder, "Ties"): one order for fragments the rasterizer's depths
-//! cannot be trusted to order, used alike by the recorder (both phases, the grown capture
-//! included) and the exact reference of `blend` and `saturate`.
+//! cannot be trusted to order, used alike by the recorder's phase 2 (capture and peel, the
+//! grown capture included) and the exact reference (`blend` and `saturate` composite in it;
+//! `depth` lets through, in it, what the depth test would).
 //!
 //! At a sample the peel lists fragments by (depth, id). Two of them next to each other, `p`
 //! then `q`, are put the other way round, whatever their depths (an exact tie included), when
@@ -17,10 +18,19 @@
 //!
 //! Pairs that pass through each other (the splitter cut those it found) or are skew keep the
 //! rasterizer's order. Applied as an insertion sort with the rule as the comparison of adjacent
-//! fragments; a fragment moves up only past fragments the rule puts after it.
+//! fragments; a fragment moves up only past fragments the rule puts after it, at most
+//! [`MOVES`] places.
 //!
-//! Measured on CarConcept (BENCHMARKS § Ties): every edge the merger had to leave unordered in
-//! the close-up, at the recorded pattern and conformantly, was one of a separable pair.
+//! Phase 1 (visibility) peels in the rasterizer's order, so the rule can bring a triangle that
+//! phase 1 found hidden to the front of a sample: phase 2 walks each sample's list in the
+//! rule's order until it saturates, as phase 1 does, and what it reaches joins V_f. The
+//! reference lets the rule move only triangles of the recording's V_f
+//! ([`TieRule::moving_only`]): the player draws no other, and one the recorder moved but did
+//! not reach lies past saturation, where order changes no pixel.
+//!
+//! Measured on CarConcept (BENCHMARKS § Raster profiles, "Ties"): every edge the merger had to
+//! leave unordered in the close-up, at the recorded pattern and conformantly, was one of a
+//! separable pair; with the rule none is left.
 
 use glam::{DMat4, DVec3};
 use trisort_format::{world_transforms, FrameState, Geometry};
@@ -79,8 +89,7 @@ impl TieRule {
 
     /// The rule moving up only the drawn triangles `moves` marks (the frame's visible set V_f,
     /// which is all the player draws): one it leaves unmarked keeps the rasterizer's place.
-    /// The recorder and the reference mark the same set, the recording's V_f, so a triangle
-    /// hidden at the recorded pattern is never brought to the front of a sample.
+    /// The reference marks the recording's V_f (see the module documentation).
     pub fn moving_only(mut self, moves: Vec<bool>) -> TieRule {
         self.moves = Some(moves);
         self
@@ -137,7 +146,11 @@ impl TieRule {
     /// depth rides along; the rule does not read it); the oldest of a full window can then move no more. The same
     /// order whether a sample's fragments come as one list (a capture) or a layer at a time
     /// (a peel). [`Window::drain`] empties it at the end of the sample.
-    pub fn push(&self, window: &mut Window, next: (u32, f32)) -> Option<(u32, f32)> {
+    pub fn push<T: Copy + Default>(
+        &self,
+        window: &mut Window<T>,
+        next: (u32, T),
+    ) -> Option<(u32, T)> {
         push_with(&|q, p| self.precedes(q, p), window, next)
     }
 
@@ -160,16 +173,16 @@ impl TieRule {
 }
 
 /// [`TieRule::push`] with `precedes` as the rule.
-fn push_with(
+fn push_with<T: Copy + Default>(
     precedes: &impl Fn(u32, u32) -> bool,
-    window: &mut Window,
-    next: (u32, f32),
-) -> Option<(u32, f32)> {
+    window: &mut Window<T>,
+    next: (u32, T),
+) -> Option<(u32, T)> {
     let n = window.len as usize;
     let mut items = window.items;
     let mut out = None;
     let mut j = n;
-    let mut all = [(0u32, 0f32); MOVES + 1];
+    let mut all = [(0u32, T::default()); MOVES + 1];
     all[..n].copy_from_slice(&items[..n]);
     all[n] = next;
     while j > 0 {
@@ -196,16 +209,17 @@ fn push_with(
 /// How many places the rule moves a fragment up at most (see [`TieRule::push`]).
 pub const MOVES: usize = 3;
 
-/// The fragments of one sample not yet in their final place (see [`TieRule::push`]).
+/// The fragments of one sample not yet in their final place (see [`TieRule::push`]), each a
+/// drawn position with what rides along (`T`: a depth, or a depth and an opacity).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Window {
-    items: [(u32, f32); MOVES],
+pub struct Window<T: Copy + Default = f32> {
+    items: [(u32, T); MOVES],
     len: u8,
 }
 
-impl Window {
+impl<T: Copy + Default> Window<T> {
     /// The fragments left, in order; empties the window.
-    pub fn drain(&mut self) -> impl Iterator<Item = (u32, f32)> {
+    pub fn drain(&mut self) -> impl Iterator<Item = (u32, T)> {
         let items = self.items;
         let n = self.len as usize;
         self.len = 0;
