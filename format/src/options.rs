@@ -295,7 +295,7 @@ pub trait Choosable: OptionValue {
 
 impl Choosable for Strategy {
     const AUTO_HELP: &'static str =
-        "Try all, keep the best (index triangles, then worst-frame draws)";
+        "Try all, keep the best (index triangles, then worst-frame draws), on the first segment where the path has several";
 }
 
 impl Choosable for Layout {

@@ -226,7 +226,8 @@ pub enum MergeError {
 /// seeded, split until valid, its adjacent copies joined where the rules allow, and
 /// serialized; the result kept is the best by the objective (fewest index triangles, then
 /// fewest draws in the worst frame, then the first in [`Strategy::ALL`] × [`Layout::ALL`]
-/// order). With several combinations, ILB and IBL compact run first and the others are
+/// order). A path of several segments picks the combination by that objective on its first
+/// segment and merges every segment with it. With several combinations, ILB and IBL compact run first and the others are
 /// abandoned once their copies exceed 1.5 × the better of those two (`PRUNE_FACTOR`). Output ids are G-local. The result is
 /// deterministic — the same inputs give the same bytes whatever the thread count — so
 /// `stats.seconds` is left 0 (callers measure and report the time). The file is lit by the
@@ -326,6 +327,30 @@ fn merge_checked(
     Ok(baked)
 }
 
+/// The best combination of `combos` for `segments` (see [`merge`]). With several segments and
+/// several combinations, the combinations compete on the first segment alone
+/// ([`best_of`]) and only the winner merges the whole path: every combination over every
+/// segment cost 20× the winner's merge on the car tour (1,581 s against 79 s, 301 frames,
+/// BENCHMARKS § Raster profiles), and segments of one path favour the same combination. One
+/// segment (paths up to the segment length) decides as before. Should the winner exceed a
+/// 32-bit limit over the whole path, every combination is tried there after all.
+fn best_combination(
+    cx: &split::Context<'_>,
+    segments: &[Range<u32>],
+    combos: &[(Strategy, Layout)],
+    seeding: Seeding,
+    first: &Recording,
+) -> Result<assemble::Assembled, MergeError> {
+    if segments.len() > 1 && combos.len() > 1 {
+        let probe = best_of(cx, &segments[..1], combos, seeding, first)?;
+        let winner = [(probe.strategy, probe.layout)];
+        if let Ok(a) = best_of(cx, segments, &winner, seeding, first) {
+            return Ok(a);
+        }
+    }
+    best_of(cx, segments, combos, seeding, first)
+}
+
 /// Runs every combination of `combos` and keeps the best (see [`merge`]). Combinations run
 /// in `PRIORITY` order (the ones that usually win first). The first `LEADERS` run to the
 /// end; the others share a fixed bound derived from the leaders' best result and stop once
@@ -333,7 +358,7 @@ fn merge_checked(
 /// leaders' results, never on timing, so the output is the same whatever the thread count.
 /// A combination whose counts exceed a 32-bit limit ([`Limit`]) is skipped; if every one
 /// does, the first one's error (in `PRIORITY` order) is returned.
-fn best_combination(
+fn best_of(
     cx: &split::Context<'_>,
     segments: &[Range<u32>],
     combos: &[(Strategy, Layout)],

@@ -93,3 +93,50 @@ fn ten_thousand_frames_in_segments() {
         baked.merge.cells.len()
     );
 }
+
+/// `auto` on a path of several segments: the combinations compete on the first segment and the
+/// winner merges the whole path, so the result is that combination's own merge, and it is the
+/// best on the first segment alone.
+#[test]
+fn auto_chooses_on_the_first_segment() {
+    let rec = turntable(&Turntable {
+        objects: 10,
+        sides: 12,
+        frames: 40,
+        samples: 96,
+        degrees: 120.0,
+        ..Turntable::default()
+    });
+    let recs = std::slice::from_ref(&rec);
+    let auto = MergeOptions {
+        segment: Some(16),
+        ..MergeOptions::default()
+    };
+    let baked = merge(recs, &auto).unwrap();
+    assert!(check_graph(recs, &baked).ok);
+    let only = |s, l, segment| MergeOptions {
+        strategy: Choice::Only(s),
+        layout: Choice::Only(l),
+        segment,
+        ..MergeOptions::default()
+    };
+    let (s, l) = (baked.merge.strategy, baked.merge.layout);
+    let direct = merge(recs, &only(s, l, Some(16))).unwrap();
+    assert_eq!(baked.copies, direct.copies);
+    assert_eq!(baked.draws, direct.draws);
+    // On the first segment (frames 0..16) alone, no combination beats it.
+    let mut first = rec.clone();
+    first.frames.truncate(16);
+    first.frame_states.truncate(16);
+    let head = std::slice::from_ref(&first);
+    let best = merge(head, &only(s, l, Some(16))).unwrap();
+    for s2 in Strategy::ALL {
+        for l2 in Layout::ALL {
+            let other = merge(head, &only(s2, l2, Some(16))).unwrap();
+            assert!(
+                other.copies.len() >= best.copies.len(),
+                "{s2:?} {l2:?} beats {s:?} {l:?} on the first segment"
+            );
+        }
+    }
+}
