@@ -390,6 +390,12 @@ impl<'a> Pairs<'a> {
         grown: Option<&mut HashMap<(u32, u32), u32>>,
     ) {
         let key = (self.g[(prev - 1) as usize], self.g[(id - 1) as usize]);
+        // Two fragments of one triangle at one sample (the near plane's clipper cuts a
+        // triangle into a fan whose pieces can both cover a sample): no order between them.
+        // The tie rule can bring them together (one moves up past what lay between).
+        if key.0 == key.1 {
+            return;
+        }
         match grown {
             // Depths extended past a triangle's edges: order, never ties.
             Some(grown) => *grown.entry(key).or_default() += 1,
@@ -860,5 +866,19 @@ mod tests {
         let mut got: Vec<_> = edges.into_iter().collect();
         got.sort();
         assert_eq!(got, vec![((1, 2), 7), ((2, 3), 4), ((3, 4), 7)]);
+    }
+
+    #[test]
+    fn a_triangle_after_itself_orders_nothing() {
+        // Drawn list: scene triangles 5 and 7 (ids 1 and 2). Sample lists A A B (two pieces of
+        // one clipped triangle, brought together) and A B.
+        let g = [5u32, 7];
+        let mut pairs = Pairs::new(&g);
+        pairs.pair(1, 1, (0.5, 0.5), None);
+        pairs.pair(1, 2, (0.5, 0.6), None);
+        pairs.pair(1, 1, (0.5, 0.5), None);
+        let edges: Vec<_> = pairs.edges.into_iter().collect();
+        assert_eq!(edges, vec![((5, 7), 1)]);
+        assert!(pairs.ties.is_empty());
     }
 }
