@@ -226,8 +226,8 @@ pub fn load_working(
 }
 
 /// Makes `scene` the scene a recording with `settings` is made of: with
-/// `settings.split_intersections`, its triangles that pass through each other within a rigid
-/// group are split along their intersection (`trisort_intersect::working_geometry`), which
+/// `settings.split_intersections`, its triangles that pass through each other (within a rigid
+/// group, then across groups as the first frame poses them) are split along their intersection (`trisort_intersect::working_geometry`), which
 /// changes the scene's triangles and hash. Says on stderr what was split; returns the report.
 ///
 /// `frames` come from `frames_from` (a path, a recording or a baked file, for the message):
@@ -254,11 +254,13 @@ pub fn working_scene(
         return Ok(None);
     };
     let r = split.report;
-    if r.pairs_split > 0 || r.pairs_skipped_sliver > 0 {
+    if r.pairs_split > 0 || r.pairs_skipped_sliver > 0 || r.pairs_split_across_groups > 0 {
         eprintln!(
-            "trisort: split {} pairs of triangles that pass through each other (+{} triangles; \
-             {} pairs left, their pieces would be slivers) in {:.2} s",
-            r.pairs_split,
+            "trisort: split {} pairs of triangles that pass through each other ({} of them of \
+             parts that move apart, as the first frame poses them; +{} triangles; {} pairs \
+             left, their pieces would be slivers) in {:.2} s",
+            r.pairs_split + r.pairs_split_across_groups,
+            r.pairs_split_across_groups,
             r.triangles_added,
             r.pairs_skipped_sliver,
             t0.elapsed().as_secs_f64()

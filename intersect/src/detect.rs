@@ -20,6 +20,9 @@ pub(crate) struct Prepared {
     pub groups: Vec<u32>,
     /// Number of rigid groups.
     pub group_count: usize,
+    /// Across groups ([`Prepared::across_groups`]): per node, its rigid group; only triangles
+    /// of different ones are paired.
+    pub rigid: Option<Vec<u32>>,
 }
 
 /// What the detector found.
@@ -35,7 +38,17 @@ pub(crate) struct Found {
 impl Prepared {
     /// Prepares `geometry` for the rigid groups of `frames`.
     pub fn new(geometry: &Geometry, frames: &[FrameState]) -> Prepared {
-        let space = CommonSpace::new(geometry, frames);
+        Prepared::in_space(geometry, CommonSpace::new(geometry, frames), None)
+    }
+
+    /// Prepares `geometry` for pairing triangles of *different* rigid groups of `frames`, all
+    /// compared in world space as the first frame places them.
+    pub fn across_groups(geometry: &Geometry, frames: &[FrameState]) -> Prepared {
+        let (space, rigid) = CommonSpace::first_frame(geometry, frames);
+        Prepared::in_space(geometry, space, Some(rigid))
+    }
+
+    fn in_space(geometry: &Geometry, space: CommonSpace, rigid: Option<Vec<u32>>) -> Prepared {
         let common: Vec<DVec3> = geometry
             .vertices
             .par_iter()
@@ -65,6 +78,7 @@ impl Prepared {
             node,
             groups: space.groups,
             group_count: space.group_count,
+            rigid,
         }
     }
 
@@ -141,6 +155,12 @@ impl Prepared {
             let b = members[j as usize];
             if b == a || (b < a && asked(b)) {
                 return;
+            }
+            if let Some(rigid) = &self.rigid {
+                let group = |t: u32| rigid[self.node[t as usize] as usize];
+                if group(a) == group(b) {
+                    return;
+                }
             }
             candidates += 1;
             match contact(tri_a, self.tri(b)) {

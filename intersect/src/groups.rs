@@ -118,6 +118,21 @@ pub(crate) struct CommonSpace {
 }
 
 impl CommonSpace {
+    /// One space for every node: world space as the path's first frame places it (the rest
+    /// pose without frames), every node in group 0; `groups` keeps each node's rigid group,
+    /// for the detector to pair only triangles of different groups.
+    pub fn first_frame(geometry: &Geometry, frames: &[FrameState]) -> (CommonSpace, Vec<u32>) {
+        let rigid = rigid_groups(geometry, frames);
+        let poses = frames.first().map_or(&[][..], |f| &f.poses[..]);
+        let world = world_transforms(&geometry.nodes, poses);
+        let space = CommonSpace {
+            groups: vec![0; geometry.nodes.len()],
+            group_count: usize::from(!geometry.nodes.is_empty()),
+            to_common: world,
+        };
+        (space, rigid)
+    }
+
     /// The rigid groups of `frames`, and per group the local space of its first node at frame 0
     /// (rest pose without frames) as the common space. The first node's own triangles are
     /// therefore compared in their exact local coordinates, as are those of every node whose

@@ -7,11 +7,15 @@
 //!
 //! # What is compared
 //!
-//! Only triangles of one *rigid group* ([`rigid_groups`]): nodes whose relative world
-//! transform is the same on every frame of the path. Triangles of nodes that move relative to
-//! each other are never paired (their crossings, if any, come and go with the animation). A
-//! group is compared in one common space: the local space of its first node at frame 0, in
-//! f64, so that one-node groups are compared in their exact stored coordinates.
+//! First the triangles of one *rigid group* ([`rigid_groups`]): nodes whose relative world
+//! transform is the same on every frame of the path. A group is compared in one common space:
+//! the local space of its first node at frame 0, in f64, so that one-node groups are compared
+//! in their exact stored coordinates. Then, on that pass's output, the pairs of triangles of
+//! *different* groups, in world space as the path's first frame places them
+//! ([`SplitOptions::across_groups`]): their crossings come and go with the animation (a door's
+//! inner panel passing through the cabin trim while closed), so one pose is taken, and pieces
+//! cut there are still whole surfaces in every other pose. Crossings that only other poses
+//! have are left (the recorder's unordered samples report them).
 //! Zero-area triangles are skipped.
 //!
 //! # When a pair crosses
@@ -106,6 +110,16 @@ pub struct SplitOptions {
     /// triangle's plane) and adds fewer triangles; both sides make the crossing an edge of
     /// both surfaces.
     pub cut_both_sides: bool,
+    /// Also split crossing pairs of triangles of *different* rigid groups, as the path's first
+    /// frame places them (default true): a door's inner panel through the cabin's trim with
+    /// the door closed. Their crossings come and go with the animation, so one pose is taken:
+    /// the first frame's; pieces cut there stay valid surfaces in every other pose.
+    #[serde(default = "yes")]
+    pub across_groups: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Default for SplitOptions {
@@ -114,6 +128,7 @@ impl Default for SplitOptions {
             min_piece_area_fraction: DEFAULT_MIN_PIECE_AREA_FRACTION,
             close_t_junctions: true,
             cut_both_sides: false,
+            across_groups: true,
         }
     }
 }
@@ -145,6 +160,11 @@ pub struct SplitReport {
     /// Points on an edge that a triangle sharing the edge could not take without a sliver:
     /// T-junctions left.
     pub t_junctions_left: u64,
+    /// Crossing pairs of triangles of different rigid groups resolved
+    /// at the first frame's pose ([`SplitOptions::across_groups`]), not counted in
+    /// `pairs_split`.
+    #[serde(default)]
+    pub pairs_split_across_groups: u64,
 }
 
 /// The scene with its crossing pairs split.

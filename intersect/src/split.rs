@@ -23,11 +23,61 @@ use crate::{SplitOptions, SplitReport, SplitScene};
 /// Most rounds of cutting (the first included).
 pub(crate) const MAX_ROUNDS: u32 = 4;
 
-/// See [`crate::split_intersections`].
+/// See [`crate::split_intersections`]: the pairs of each rigid group, then (with
+/// [`SplitOptions::across_groups`] and more than one group) the pairs of different groups as
+/// the first frame places them, on the first pass's output.
 pub(crate) fn split(
     geometry: &Geometry,
     frames: &[FrameState],
     options: &SplitOptions,
+) -> SplitScene {
+    let within = split_pass(geometry, frames, options, false);
+    if !options.across_groups || within.report.groups <= 1 {
+        return within;
+    }
+    let across = split_pass(&within.geometry, frames, options, true);
+    let r = across.report;
+    let mut report = within.report;
+    report.pairs_split_across_groups = r.pairs_split;
+    report.pairs_skipped_sliver += r.pairs_skipped_sliver;
+    report.pairs_below_precision += r.pairs_below_precision;
+    report.candidate_pairs += r.candidate_pairs;
+    report.rounds += r.rounds;
+    report.neighbours_split += r.neighbours_split;
+    report.t_junctions_left += r.t_junctions_left;
+    report.triangles_added = (across.geometry.triangles.len() - geometry.triangles.len()) as u64;
+    let origin: Vec<u32> = across
+        .origin
+        .iter()
+        .map(|&t| within.origin[t as usize])
+        .collect();
+    report.triangles_split = origin
+        .windows(2)
+        .enumerate()
+        .filter(|&(k, w)| w[0] == w[1] && (k == 0 || origin[k - 1] != w[0]))
+        .count() as u64;
+    let mut skipped = within.skipped;
+    skipped.extend(across.skipped.iter().map(|&[a, b]| {
+        let (a, b) = (within.origin[a as usize], within.origin[b as usize]);
+        [a.min(b), a.max(b)]
+    }));
+    skipped.sort_unstable();
+    skipped.dedup();
+    SplitScene {
+        geometry: across.geometry,
+        origin,
+        skipped,
+        report,
+    }
+}
+
+/// One pass of rounds of detection and cuts: within rigid groups, or (`across`) between
+/// different groups in the first frame's world space.
+fn split_pass(
+    geometry: &Geometry,
+    frames: &[FrameState],
+    options: &SplitOptions,
+    across: bool,
 ) -> SplitScene {
     let n = geometry.triangles.len();
     let mut current = Cow::Borrowed(geometry);
@@ -38,10 +88,17 @@ pub(crate) fn split(
     let mut input_pairs = Vec::new();
     let mut left;
     loop {
-        let prepared = Prepared::new(&current, frames);
+        let prepared = if across {
+            Prepared::across_groups(&current, frames)
+        } else {
+            Prepared::new(&current, frames)
+        };
         let found = prepared.find(query.as_deref());
         if report.rounds == 0 {
-            report.groups = prepared.group_count;
+            report.groups = match &prepared.rigid {
+                Some(rigid) => rigid.iter().map(|&g| g as usize + 1).max().unwrap_or(0),
+                None => prepared.group_count,
+            };
             report.candidate_pairs = found.candidates;
             report.pairs_below_precision = found.below_precision;
             input_pairs.clone_from(&found.pairs);

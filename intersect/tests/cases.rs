@@ -158,13 +158,30 @@ fn two_nodes(frames: &[trisort_format::FrameState]) -> (Geometry, SplitScene) {
     (g, out)
 }
 
+/// Nodes moving relative to each other are two groups: their crossing at the first frame is
+/// split by the pass across groups (as posed there), not by the pass within groups, and the
+/// pieces cross no more; without that pass they are left alone.
 #[test]
-fn nodes_moving_relative_to_each_other_are_not_split() {
+fn nodes_moving_relative_to_each_other_are_split_as_the_first_frame_poses_them() {
     let moved = DMat4::from_translation(DVec3::new(1.0, 0.5, 0.0));
     let frames = [frame(vec![]), frame(vec![pose(2, moved)])];
     let (g, out) = two_nodes(&frames);
     assert_eq!(out.report.groups, 2);
-    assert_untouched(&g, &out);
+    assert_eq!(out.report.pairs_split, 0, "nothing crosses within a group");
+    assert!(
+        out.report.pairs_split_across_groups >= 2,
+        "{:?}",
+        out.report
+    );
+    check(&g, &frames, &out, &EXACT);
+    let again = split_intersections(&out.geometry, &frames, &both_sides());
+    assert_eq!(again.report.pairs_split_across_groups, 0);
+    assert_eq!(again.report.triangles_added, 0);
+    let within_only = SplitOptions {
+        across_groups: false,
+        ..both_sides()
+    };
+    assert_untouched(&g, &split_intersections(&g, &frames, &within_only));
 }
 
 #[test]

@@ -19,6 +19,23 @@ use std::collections::{BTreeMap, HashSet};
 use glam::DVec3;
 use trisort_format::{world_transforms, Baked, FileKind, Recording};
 
+/// Whether an edge of triangle `t` passes through triangle `o` (f64, exact enough here).
+fn crosses(t: &[DVec3; 3], o: &[DVec3; 3]) -> bool {
+    let n = (o[1] - o[0]).cross(o[2] - o[0]);
+    (0..3).any(|k| {
+        let (p, q) = (t[k], t[(k + 1) % 3]);
+        let (dp, dq) = (n.dot(p - o[0]), n.dot(q - o[0]));
+        if dp * dq > 0.0 || dp == dq {
+            return false;
+        }
+        let x = p + (q - p) * (dp / (dp - dq));
+        (0..3).all(|j| {
+            let (a, b) = (o[j], o[(j + 1) % 3]);
+            n.dot((b - a).cross(x - a)) >= 0.0
+        })
+    })
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [baked, rec] = &args[..] else {
@@ -29,6 +46,8 @@ fn main() {
     let rec: Recording = trisort_format::read_file(FileKind::Recording, rec.as_ref()).unwrap();
     let g = &baked.geometry;
     let mut classes: BTreeMap<&str, (u32, u64, u32)> = BTreeMap::new();
+    let mut frames_of: BTreeMap<usize, u32> = BTreeMap::new();
+    let mut node_pairs: BTreeMap<(u32, u32), u32> = BTreeMap::new();
     for (f, removed) in baked.removed_edges.iter().enumerate() {
         if removed.is_empty() {
             continue;
@@ -81,9 +100,17 @@ fn main() {
                 }
             } else if shared > 0 {
                 "touching"
+            } else if crosses(&a, &b) || crosses(&b, &a) {
+                "intersecting"
             } else {
-                "straddling"
+                "skew"
             };
+            if class == "intersecting" || class == "skew" {
+                *frames_of.entry(f).or_default() += e.weight;
+                let na = g.vertices[g.triangles[e.from as usize][0] as usize].node;
+                let nb = g.vertices[g.triangles[e.to as usize][0] as usize].node;
+                *node_pairs.entry((na.min(nb), na.max(nb))).or_default() += e.weight;
+            }
             let two = edges.contains(&(
                 baked.scene_ids[e.to as usize],
                 baked.scene_ids[e.from as usize],
@@ -93,6 +120,22 @@ fn main() {
             c.1 += e.weight as u64;
             c.2 += two as u32;
         }
+    }
+    println!("intersecting or skew, samples per frame: {frames_of:?}");
+    let mut pairs: Vec<_> = node_pairs.into_iter().collect();
+    pairs.sort_by_key(|p| std::cmp::Reverse(p.1));
+    let names = |n: u32| {
+        g.nodes
+            .get(n as usize)
+            .map(|x| x.name.as_str())
+            .unwrap_or("?")
+    };
+    for ((a, b), w) in pairs.iter().take(8) {
+        println!(
+            "  nodes {a} {:?} / {b} {:?}: {w} samples",
+            names(*a),
+            names(*b)
+        );
     }
     println!("class: edges, unordered samples, of which two-cycles");
     for (k, (n, w, two)) in classes {

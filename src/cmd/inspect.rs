@@ -201,7 +201,8 @@ fn inspect_scene(a: &InspectArgs) -> Result<ExitCode> {
         "bounds": bounds,
         "notes": scene.notes,
         "variants": scene.variants,
-        "intersections_split": split.pairs_split,
+        "intersections_split": split.pairs_split + split.pairs_split_across_groups,
+        "intersections_split_across_groups": split.pairs_split_across_groups,
         "triangles_added": split.triangles_added,
         "intersections_left": split.pairs_skipped_sliver,
     });

@@ -144,9 +144,14 @@ pub fn recording_json(rec: &Recording, seconds: Option<f64>) -> serde_json::Valu
 }
 
 /// Adds `record --json`'s `intersections_split` (pairs of triangles split along their
-/// intersection before recording) and `triangles_added` (0 and 0 with `--keep-intersections`).
+/// intersection before recording), `intersections_split_across_groups` (those of them of parts
+/// that move apart) and `triangles_added` (0 and 0 with `--keep-intersections`).
 pub fn add_split_json(v: &mut serde_json::Value, split: Option<&trisort_intersect::SplitReport>) {
-    v["intersections_split"] = split.map_or(0, |r| r.pairs_split).into();
+    v["intersections_split"] = split
+        .map_or(0, |r| r.pairs_split + r.pairs_split_across_groups)
+        .into();
+    v["intersections_split_across_groups"] =
+        split.map_or(0, |r| r.pairs_split_across_groups).into();
     v["triangles_added"] = split.map_or(0, |r| r.triangles_added).into();
     v["intersections_left"] = split.map_or(0, |r| r.pairs_skipped_sliver).into();
 }
