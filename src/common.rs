@@ -255,12 +255,14 @@ pub fn working_scene(
     };
     let r = split.report;
     if r.pairs_split > 0 || r.pairs_skipped_sliver > 0 || r.pairs_split_across_groups > 0 {
+        let across = match r.pairs_split_across_groups {
+            0 => String::new(),
+            n => format!("{n} of them of parts that move apart, as the first frame poses them; "),
+        };
         eprintln!(
-            "trisort: split {} pairs of triangles that pass through each other ({} of them of \
-             parts that move apart, as the first frame poses them; +{} triangles; {} pairs \
-             left, their pieces would be slivers) in {:.2} s",
+            "trisort: split {} pairs of triangles that pass through each other ({across}+{} \
+             triangles; {} pairs left, their pieces would be slivers) in {:.2} s",
             r.pairs_split + r.pairs_split_across_groups,
-            r.pairs_split_across_groups,
             r.triangles_added,
             r.pairs_skipped_sliver,
             t0.elapsed().as_secs_f64()
