@@ -9,10 +9,12 @@
 //!   in front wherever both cover a point: the cycle is numerical (or the conservative
 //!   recording's), not geometric;
 //! - `touching`: they share a corner or an edge and are not separable;
-//! - `straddling`: each crosses the other's plane (they pass through each other, or are skew).
+//! - `intersecting`: an edge of one passes through the other;
+//! - `skew`: each crosses the other's plane, yet neither passes through the other.
 //!
 //! It prints per class the edges, their weight (unordered samples), and how many are one side
-//! of a two-cycle (the recording also holds the reverse edge at that frame).
+//! of a two-cycle (the recording also holds the reverse edge at that frame); for intersecting
+//! and skew pairs also the samples per frame and the node pairs with the most samples.
 
 use std::collections::{BTreeMap, HashSet};
 
