@@ -479,12 +479,16 @@ fn graph_frame(
         },
     } = parts;
     merge_grown_edges(&mut edges, grown_edges);
-    let covered: Vec<u32> = covered
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.load(Relaxed))
-        .map(|(k, _)| g[k])
-        .collect();
+    // The scene ids of the drawn triangles whose flag is set.
+    let flagged = |flags: Vec<AtomicBool>| -> Vec<u32> {
+        flags
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.load(Relaxed))
+            .map(|(k, _)| g[k])
+            .collect()
+    };
+    let covered = flagged(covered);
     let to_edges = |m: HashMap<(u32, u32), u32>| {
         let mut v: Vec<Edge> = m
             .into_iter()
@@ -493,12 +497,7 @@ fn graph_frame(
         v.sort_unstable();
         v
     };
-    let reached: Vec<u32> = reached
-        .iter()
-        .enumerate()
-        .filter(|(_, r)| r.load(Relaxed))
-        .map(|(k, _)| g[k])
-        .collect();
+    let reached = flagged(reached);
     Ok((
         covered,
         to_edges(edges),

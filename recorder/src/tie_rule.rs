@@ -159,15 +159,8 @@ impl TieRule {
     /// moves up at most [`MOVES`] places), with `id` reading a fragment's drawn position.
     pub fn order<T>(&self, list: &mut [T], id: impl Fn(&T) -> u32) {
         for i in 1..list.len() {
-            let mut j = i;
-            while j > 0 && i - j < MOVES {
-                let (p, q) = (&list[j - 1], &list[j]);
-                if !self.precedes(id(q), id(p)) {
-                    break;
-                }
-                list.swap(j - 1, j);
-                j -= 1;
-            }
+            let window = &mut list[i.saturating_sub(MOVES)..=i];
+            bubble_last(window, |q, p| self.precedes(id(q), id(p)));
         }
     }
 }
@@ -179,31 +172,29 @@ fn push_with<T: Copy + Default>(
     next: (u32, T),
 ) -> Option<(u32, T)> {
     let n = window.len as usize;
-    let mut items = window.items;
-    let mut out = None;
-    let mut j = n;
     let mut all = [(0u32, T::default()); MOVES + 1];
-    all[..n].copy_from_slice(&items[..n]);
+    all[..n].copy_from_slice(&window.items[..n]);
     all[n] = next;
-    while j > 0 {
-        let (p, q) = (all[j - 1], all[j]);
-        if !precedes(q.0, p.0) {
-            break;
-        }
-        all.swap(j - 1, j);
+    bubble_last(&mut all[..=n], |q, p| precedes(q.0, p.0));
+    if n == MOVES {
+        window.items.copy_from_slice(&all[1..]);
+        Some(all[0])
+    } else {
+        window.items[..=n].copy_from_slice(&all[..=n]);
+        window.len += 1;
+        None
+    }
+}
+
+/// Moves the last element of `s` up past every element before it that `precedes(last,
+/// earlier)` puts after it, stopping at the first that it does not: the one step of the
+/// rule's insertion sort that both [`TieRule::order`] and [`TieRule::push`] take.
+fn bubble_last<T>(s: &mut [T], precedes: impl Fn(&T, &T) -> bool) {
+    let mut j = s.len().saturating_sub(1);
+    while j > 0 && precedes(&s[j], &s[j - 1]) {
+        s.swap(j - 1, j);
         j -= 1;
     }
-    let len = if n == MOVES {
-        out = Some(all[0]);
-        items.copy_from_slice(&all[1..]);
-        MOVES
-    } else {
-        items[..=n].copy_from_slice(&all[..=n]);
-        n + 1
-    };
-    window.items = items;
-    window.len = len as u8;
-    out
 }
 
 /// How many places the rule moves a fragment up at most (see [`TieRule::push`]).
