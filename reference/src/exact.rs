@@ -229,8 +229,9 @@ pub struct ReferenceFrame {
     /// Number of samples whose consecutive fragments form one of the [`UnorderedEdges`], as
     /// the peel finds them.
     pub unordered_samples: u64,
-    /// Peel layers peeled (every mode peels to the end: the tie rule may put a later
-    /// fragment first).
+    /// Peel layers peeled (`blend` and `saturate` to the end; `depth` until every sample's
+    /// nearest fragment has come out of the tie rule's window, or to the end where the frame
+    /// has unordered edges to find).
     pub layers: u32,
     /// Whether the peel stopped at `max_layers` with fragments left.
     pub truncated: bool,
@@ -418,7 +419,7 @@ impl<'g> ExactReference<'g> {
         let mut unordered_samples = 0u64;
         let no_edges = HashSet::new();
         let edges = unordered.map(|r| r.per_frame.get(frame as usize).unwrap_or(&no_edges));
-        // Every mode peels every layer and takes each sample's fragments in the tie rule's
+        // Every mode takes each sample's fragments in the tie rule's
         // order, which the recorder followed (`trisort_recorder::tie_rule`): they go through a
         // window as they come, and the k-th to leave it goes to composited layer k (in `depth`,
         // the k-th that the depth test lets through).
@@ -443,6 +444,12 @@ impl<'g> ExactReference<'g> {
         // (`Less`, depth writes, cleared to 1): a fragment shows, *over* what came before, where
         // it is nearer than every fragment drawn before it. Per sample, the depth written so far.
         let mut written = vec![1.0f32; if depth_mode { slots } else { 0 }];
+        // `depth` needs a sample's fragments only until its nearest one (its first peel layer)
+        // has come out of the rule's window: nothing after it passes the depth test. Per
+        // sample, that nearest depth (NaN once it came out, or where the sample has none), and
+        // how many samples still wait for it; the peel stops when none does.
+        let gate =
+            std::cell::RefCell::new((vec![f32::NAN; if depth_mode { slots } else { 0 }], 0usize));
         let mut settle = |i: usize, (id, depth): (u32, f32), layer_ids: &mut Vec<Vec<u32>>| {
             if let (Some(r), Some(edges)) = (unordered, edges) {
                 if r.in_g.get((id - 1) as usize) == Some(&true) {
@@ -455,6 +462,11 @@ impl<'g> ExactReference<'g> {
                 }
             }
             if depth_mode {
+                let (nearest, waiting) = &mut *gate.borrow_mut();
+                if depth == nearest[i] {
+                    nearest[i] = f32::NAN;
+                    *waiting -= 1;
+                }
                 if depth.partial_cmp(&written[i]) != Some(std::cmp::Ordering::Less) {
                     return;
                 }
@@ -469,16 +481,35 @@ impl<'g> ExactReference<'g> {
         };
         let (layers, truncated) =
             self.peeler
-                .peel(frame, self.config.max_layers, |_, layer, _| {
+                .peel(frame, self.config.max_layers, |k, layer, _| {
+                    if depth_mode && k == 0 {
+                        let (nearest, waiting) = &mut *gate.borrow_mut();
+                        for (i, &id) in layer.ids.iter().enumerate() {
+                            if id != 0 {
+                                nearest[i] = layer.depth[i];
+                                *waiting += 1;
+                            }
+                        }
+                    }
                     for (i, &id) in layer.ids.iter().enumerate() {
                         if id == 0 {
+                            // The sample's list has ended: in depth mode its window can empty
+                            // now (the others empty after the peel).
+                            if depth_mode && !gate.borrow().0[i].is_nan() {
+                                for (p, d) in windows[i].drain() {
+                                    settle(i, (p + 1, d), &mut layer_ids);
+                                }
+                            }
                             continue;
                         }
                         if let Some((p, d)) = rule.push(&mut windows[i], (id - 1, layer.depth[i])) {
                             settle(i, (p + 1, d), &mut layer_ids);
                         }
                     }
-                    Ok(true)
+                    // Blend and saturate composite every layer; depth peels on only while a
+                    // sample waits for its nearest fragment, or to find unordered samples.
+                    let finding = edges.is_some_and(|e| !e.is_empty());
+                    Ok(!depth_mode || finding || gate.borrow().1 > 0)
                 })?;
         for (i, w) in windows.iter_mut().enumerate() {
             for (p, d) in w.drain() {
