@@ -274,6 +274,18 @@ impl Robust {
         self.tolerance + self.profile.snap_reach()
     }
 
+    /// The half-size in pixels of the box a sample's depth may be taken in, around the
+    /// recorded sample: [`Robust::sample_box`], and half a pixel more where the profile takes
+    /// depth anywhere in the pixel ([`DepthAt::Pixel`]).
+    pub fn depth_box(&self) -> f32 {
+        let pixel = if self.profile.depth_at == DepthAt::Pixel {
+            0.5
+        } else {
+            0.0
+        };
+        self.sample_box() + pixel
+    }
+
     /// Whether anything beyond the recorded pattern is gathered.
     pub fn is_on(&self) -> bool {
         self.patterns > 1 || self.conservative

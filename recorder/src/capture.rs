@@ -672,8 +672,13 @@ impl<'g> Capture<'g> {
         let total = heads_len + nodes_len;
         COUNTERS[3].fetch_add(total, Relaxed);
         let split = (heads_len / 4) as usize;
+        let first = (rows.start as u64 * row_slots) as usize;
         read_mapped(gpu, &pool.staging, total, |words| {
-            on_rows(&Band { words, split })
+            on_rows(&Band {
+                words,
+                split,
+                first,
+            })
         })?
     }
 }
@@ -725,6 +730,8 @@ pub(crate) struct Band<'a> {
     words: &'a [u32],
     /// Heads are `words[..split]`, nodes (4 words each) `words[split..]`.
     split: usize,
+    /// The image's slot of the band's first sample (`(y · width + x) · samples + s`).
+    first: usize,
 }
 
 impl Band<'_> {
@@ -733,7 +740,8 @@ impl Band<'_> {
         self.split
     }
 
-    /// Walks every sample's sorted fragment list ([`Band::sorted`]) with `walk`, in parallel
+    /// Walks every sample's sorted fragment list ([`Band::sorted`]) with `walk` (which also gets
+    /// the sample's slot in the image, `(y · width + x) · samples + s`), in parallel
     /// over runs of samples, each run into its own state made by `init`; returns the states
     /// (in run order) for the caller to merge. What the caller merges must not depend on how
     /// samples were split into runs (sums, unions, maxima), so recordings stay identical
@@ -741,7 +749,7 @@ impl Band<'_> {
     pub fn walk<S: Send>(
         &self,
         init: impl Fn() -> S + Sync,
-        walk: impl Fn(&mut S, &[Fragment]) + Sync,
+        walk: impl Fn(&mut S, usize, &[Fragment]) + Sync,
     ) -> Vec<S> {
         use rayon::prelude::*;
         let runs = (rayon::current_num_threads() * 4).max(1);
@@ -755,7 +763,7 @@ impl Band<'_> {
                 let mut list = Vec::new();
                 for slot in start..(start + per_run).min(self.slots()) {
                     self.sorted(slot, &mut list);
-                    walk(&mut state, &list);
+                    walk(&mut state, self.first + slot, &list);
                 }
                 state
             })

@@ -243,7 +243,7 @@ impl<'g> Envelope<'g> {
             .map(|_| AtomicBool::new(false))
             .collect();
         capture.frame(frame, |band| {
-            band.walk(Scratch::default, |scratch, list| {
+            band.walk(Scratch::default, |scratch, _, list| {
                 let bound = far_bound(list, neighbour, scratch);
                 for f in list {
                     // A little slack for rounding, as the conservative passes allow.

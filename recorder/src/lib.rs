@@ -34,7 +34,7 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
-use crate::tie_rule::TieRule;
+use crate::tie_rule::{GrownList, GrownOrder, TieRule};
 use trisort_format::{
     Edge, FrameRecord, FrameState, Geometry, Hash, Phase, RecordSettings, Recording, Robust,
 };
@@ -283,7 +283,7 @@ fn visibility_frame(
                 c.borrow_mut().frame(frame, |band| {
                     let runs = band.walk(
                         || (0u32, false),
-                        |(most, left), list| {
+                        |(most, left), _, list| {
                             let (mut transmittance, mut taken) = (1.0f32, 0u32);
                             for f in list {
                                 if taken == s.max_layers {
@@ -381,14 +381,8 @@ impl<'a> Pairs<'a> {
     }
 
     /// Fragment `id` (+ 1) follows fragment `prev` (+ 1) at a sample, at depths `depths`
-    /// (previous, this); `grown` edges go to `grown` and carry no ties.
-    fn pair(
-        &mut self,
-        prev: u32,
-        id: u32,
-        depths: (f32, f32),
-        grown: Option<&mut HashMap<(u32, u32), u32>>,
-    ) {
+    /// (previous, this).
+    fn pair(&mut self, prev: u32, id: u32, depths: (f32, f32)) {
         let key = (self.g[(prev - 1) as usize], self.g[(id - 1) as usize]);
         // Two fragments of one triangle at one sample (the near plane's clipper cuts a
         // triangle into a fan whose pieces can both cover a sample): no order between them.
@@ -396,15 +390,9 @@ impl<'a> Pairs<'a> {
         if key.0 == key.1 {
             return;
         }
-        match grown {
-            // Depths extended past a triangle's edges: order, never ties.
-            Some(grown) => *grown.entry(key).or_default() += 1,
-            None => {
-                *self.edges.entry(key).or_default() += 1;
-                if depths.0 == depths.1 {
-                    *self.ties.entry(key).or_default() += 1;
-                }
-            }
+        *self.edges.entry(key).or_default() += 1;
+        if depths.0 == depths.1 {
+            *self.ties.entry(key).or_default() += 1;
         }
     }
 }
@@ -435,7 +423,7 @@ impl<'a> GraphParts<'a> {
 /// conservative recording, the grown peel (`grown`, [`Peeler::grown`]): edge weights add up.
 fn graph_frame(
     source: &Layers,
-    grown: Option<&Layers>,
+    grown: Option<&(&Layers, GrownOrder)>,
     frame: u32,
     g: &[u32],
     s: &RecordSettings,
@@ -461,12 +449,11 @@ fn graph_frame(
     if offsets.len() > 1 {
         source.set_frame_subpixel_offset(frame, [0.0, 0.0]);
     }
-    if let Some(grown) = grown {
+    if let Some((grown, order)) = grown {
+        let to = Some((&mut grown_edges, order));
         let (l, t) = match grown {
-            Layers::Capture(c) => {
-                capture_graph(c, frame, s, rule, &mut parts, Some(&mut grown_edges))?
-            }
-            Layers::Peel(p) => peel_graph(p, frame, s, rule, &mut parts, Some(&mut grown_edges))?,
+            Layers::Capture(c) => capture_graph(c, frame, s, rule, &mut parts, to)?,
+            Layers::Peel(p) => peel_graph(p, frame, s, rule, &mut parts, to)?,
         };
         layers += l;
         truncated |= t;
@@ -508,11 +495,14 @@ fn graph_frame(
     ))
 }
 
+/// The grown layers' edges as they are gathered, and the order that makes them.
+type GrownTo<'a, 'r> = Option<(&'a mut HashMap<(u32, u32), u32>, &'a GrownOrder<'r>)>;
+
 /// Captures frame `frame` with `capture` into `parts` (into `grown` for the grown capture's
-/// edges): every sample's fragments in peel order, the first `max_layers` of them, walked in
-/// parallel runs of samples, each into its own pairs (covered flags are shared); returns the
-/// most fragments a sample took (the layers a peel would have needed) and whether any sample
-/// had more.
+/// edges, by [`GrownOrder`]): every sample's fragments in peel order, the first `max_layers`
+/// of them, walked in parallel runs of samples, each into its own pairs (covered flags are
+/// shared); returns the most fragments a sample took (the layers a peel would have needed) and
+/// whether any sample had more.
 ///
 /// The grown capture's lists are walked whole: a grown triangle covers every sample within
 /// the tolerance of it, so a small image of a dense scene stacks hundreds of them a sample
@@ -524,10 +514,10 @@ fn capture_graph(
     s: &RecordSettings,
     rule: &TieRule,
     parts: &mut GraphParts,
-    mut grown: Option<&mut HashMap<(u32, u32), u32>>,
+    mut grown: GrownTo,
 ) -> Result<(u32, bool), RecordError> {
-    let is_grown = grown.is_some();
-    let max = if is_grown {
+    let order = grown.as_ref().map(|(_, o)| *o);
+    let max = if order.is_some() {
         usize::MAX
     } else {
         s.max_layers as usize
@@ -539,38 +529,55 @@ fn capture_graph(
     let (mut most, mut left) = (0usize, false);
     capture.borrow_mut().frame(frame, |band| {
         let runs = band.walk(
-            || (Pairs::new(g), HashMap::new(), 0usize, false, Vec::new()),
-            |(run, run_grown, most, left, scratch), list| {
+            || {
+                let (pairs, grown) = (Pairs::new(g), HashMap::new());
+                (
+                    pairs,
+                    grown,
+                    0usize,
+                    false,
+                    Vec::new(),
+                    GrownList::default(),
+                )
+            },
+            |(run, run_grown, most, left, scratch, grown_list), slot, list| {
                 *left |= list.len() > max;
+                let list = &list[..list.len().min(max)];
+                *most = (*most).max(list.len());
+                for f in list {
+                    covered[(f.id - 1) as usize].store(true, Relaxed);
+                }
+                if let Some(order) = order {
+                    grown_list.clear();
+                    for f in list {
+                        order.push(grown_list, slot, (f.id - 1, f.depth), |a, b| {
+                            grown_edge(g, run_grown, a, b)
+                        });
+                    }
+                    return;
+                }
                 scratch.clear();
-                scratch.extend_from_slice(&list[..list.len().min(max)]);
+                scratch.extend_from_slice(list);
                 // The tie rule's order (the peel's layers go through the same window).
                 rule.order(scratch, |f| f.id - 1);
                 let taken = &scratch[..];
-                *most = (*most).max(taken.len());
-                if !is_grown {
-                    let mut transmittance = 1.0f32;
-                    for f in taken {
-                        if transmittance <= residual {
-                            break;
-                        }
-                        reached[(f.id - 1) as usize].store(true, Relaxed);
-                        transmittance *= 1.0 - f.alpha;
+                let mut transmittance = 1.0f32;
+                for f in taken {
+                    if transmittance <= residual {
+                        break;
                     }
+                    reached[(f.id - 1) as usize].store(true, Relaxed);
+                    transmittance *= 1.0 - f.alpha;
                 }
-                for (k, f) in taken.iter().enumerate() {
-                    covered[(f.id - 1) as usize].store(true, Relaxed);
-                    if k > 0 {
-                        let p = &taken[k - 1];
-                        let to = is_grown.then_some(&mut *run_grown);
-                        run.pair(p.id, f.id, (p.depth, f.depth), to);
-                    }
+                for k in 1..taken.len() {
+                    let (p, f) = (&taken[k - 1], &taken[k]);
+                    run.pair(p.id, f.id, (p.depth, f.depth));
                 }
             },
         );
-        for (run, run_grown, m, l, _) in runs {
+        for (run, run_grown, m, l, _, _) in runs {
             parts.pairs.absorb(run);
-            if let Some(grown) = grown.as_deref_mut() {
+            if let Some((grown, _)) = grown.as_mut() {
                 for (key, w) in run_grown {
                     *grown.entry(key).or_default() += w;
                 }
@@ -583,33 +590,56 @@ fn capture_graph(
     Ok((most as u32, left))
 }
 
+/// Adds one sample's grown edge `front` → `back` (drawn positions) to `to`, by scene ids.
+fn grown_edge(g: &[u32], to: &mut HashMap<(u32, u32), u32>, front: u32, back: u32) {
+    let key = (g[front as usize], g[back as usize]);
+    if key.0 != key.1 {
+        *to.entry(key).or_default() += 1;
+    }
+}
+
 /// Peels frame `frame` completely with `peeler` into `parts` (into `grown` for the grown
-/// peel's edges), each sample's fragments put in the tie rule's order as they come (a window
-/// of [`tie_rule::MOVES`] per sample); returns layers peeled and whether `max_layers`
-/// truncated the peel.
+/// peel's edges, by [`GrownOrder`]), each sample's fragments put in the tie rule's order as
+/// they come (a window of [`tie_rule::MOVES`] per sample); returns layers peeled and whether
+/// `max_layers` truncated the peel.
 fn peel_graph(
     peeler: &Peeler,
     frame: u32,
     s: &RecordSettings,
     rule: &TieRule,
     parts: &mut GraphParts,
-    mut grown: Option<&mut HashMap<(u32, u32), u32>>,
+    grown: GrownTo,
 ) -> Result<(u32, bool), RecordError> {
     let slots = peeler.slots();
-    let is_grown = grown.is_some();
+    if let Some((grown, order)) = grown {
+        // The grown peel: each layer's fragments ordered against the sample's earlier ones.
+        let g = parts.pairs.g;
+        let mut lists = vec![GrownList::default(); slots];
+        return peeler.peel(frame, s.max_layers, |_, layer, _| {
+            for (i, list) in lists.iter_mut().enumerate() {
+                let id = layer.ids[i];
+                if id == 0 {
+                    continue;
+                }
+                parts.covered[(id - 1) as usize].store(true, Relaxed);
+                order.push(list, i, (id - 1, layer.depth[i]), |a, b| {
+                    grown_edge(g, grown, a, b)
+                });
+            }
+            Ok(true)
+        });
+    }
     let residual = 1.0 - s.saturation;
     let mut last = vec![(0u32, 0f32); slots];
-    let mut transmittance = vec![1.0f32; if is_grown { 0 } else { slots }];
+    let mut transmittance = vec![1.0f32; slots];
     let mut windows = vec![tie_rule::Window::<(f32, f32)>::default(); slots];
     let mut settle = |i: usize, (id, (depth, alpha)): (u32, (f32, f32)), parts: &mut GraphParts| {
         let (prev, prev_depth) = last[i];
         if prev != 0 {
-            parts
-                .pairs
-                .pair(prev, id, (prev_depth, depth), grown.as_deref_mut());
+            parts.pairs.pair(prev, id, (prev_depth, depth));
         }
         last[i] = (id, depth);
-        if !is_grown && transmittance[i] > residual {
+        if transmittance[i] > residual {
             parts.reached[(id - 1) as usize].store(true, Relaxed);
             transmittance[i] *= 1.0 - alpha;
         }
@@ -621,7 +651,6 @@ fn peel_graph(
                 continue;
             }
             parts.covered[(id - 1) as usize].store(true, Relaxed);
-            // The grown peel reads no opacity (it reaches nothing).
             let alpha = layer.alpha.get(i).copied().unwrap_or(1.0);
             // Drawn positions go through the rule 0-based, as the capture's do.
             if let Some((p, d)) = rule.push(window, (id - 1, (layer.depth[i], alpha))) {
@@ -795,8 +824,13 @@ pub fn record(
                     }
                     // The rule may move any triangle of G: one it brings before saturation
                     // joins V_f (`reached`), and the reference moves those of V_f.
-                    let rule = TieRule::new(job.geometry, &g, &job.frames[f as usize]);
+                    let state = &job.frames[f as usize];
+                    let rule = TieRule::new(job.geometry, &g, state);
                     let source = peeler.as_ref().unwrap();
+                    let grown = grown.as_ref().map(|layers| {
+                        let order = GrownOrder::new(&rule, job.geometry, &g, state, &s);
+                        (layers, order)
+                    });
                     let r = graph_frame(source, grown.as_ref(), f, &g, &s, &rule)?;
                     if let Some(p) = partial {
                         p.store_graph(f, &r)?;
@@ -873,9 +907,9 @@ mod tests {
         // one clipped triangle, brought together) and A B.
         let g = [5u32, 7];
         let mut pairs = Pairs::new(&g);
-        pairs.pair(1, 1, (0.5, 0.5), None);
-        pairs.pair(1, 2, (0.5, 0.6), None);
-        pairs.pair(1, 1, (0.5, 0.5), None);
+        pairs.pair(1, 1, (0.5, 0.5));
+        pairs.pair(1, 2, (0.5, 0.6));
+        pairs.pair(1, 1, (0.5, 0.5));
         let edges: Vec<_> = pairs.edges.into_iter().collect();
         assert_eq!(edges, vec![((5, 7), 1)]);
         assert!(pairs.ties.is_empty());

@@ -234,9 +234,15 @@ fn vs_grown(@builtin(vertex_index) vi: u32) -> ConsVarying {
 // A grown fragment: x, the depth it is recorded at (its triangle's plane at the sample,
 // clamped to [0, 1]; the interpolated depth where the plane is not valid); y, 1 where it is
 // kept and 0 where it is dropped (a culled back face, or a sample the grown triangle does not
-// reach).
+// reach). A single-sided triangle whose facing snapping to the profile's coarsest grid may turn
+// is kept either facing, as the envelope capture keeps it: a sliver facing away by a few
+// thousandths of a pixel² draws front-facing on a rasterizer that snaps its corners (the demo
+// car at 64², 4×: moved by 1/512 px, a sliver culled here covered a sample, and no grown edge
+// ordered it).
 fn cons_grown_depth(in: ConsVarying, front_facing: bool) -> vec2<f32> {
-    if (culled(in.material, front_facing)) {
+    let p = array<vec2<f32>, 3>(in.p01.xy, in.p01.zw, in.p2);
+    let turns = in.plane.w > 0.5 && cons_moved_area2(p, cons.profile.y) <= 0.0;
+    if (!turns && culled(in.material, front_facing)) {
         return vec2<f32>(0.0, 0.0);
     }
     if (in.plane.w > 0.5) {
