@@ -256,8 +256,14 @@ impl<T: Copy + Default> Window<T> {
 
 /// How many earlier fragments of a sample's grown list [`GrownOrder::push`] orders a
 /// fragment against by geometry, where their depth ranges over the box overlap (ranges apart
-/// are ordered however far back).
+/// are ordered up to [`REACH_BACK`] back).
 pub const LOOK_BACK: usize = 8;
+
+/// How far back in a sample's grown list [`GrownOrder::push`] looks for fragments whose
+/// ranges lie apart from the new one's at most. The look stops earlier where everything before
+/// is ordered through what it found; wide boxes (the `browser` profile's whole pixel) over
+/// lists of hundreds (CarConcept at 128²) would otherwise look back over every fragment.
+pub const REACH_BACK: usize = 64;
 
 /// Window depths of two planes closer than this at a point are taken as equal there (they
 /// meet: f64 rounding; the rasterizer's f32 depth steps are 60 times coarser near 1).
@@ -281,7 +287,7 @@ const DEPTH_SLACK: f32 = 1e-6;
 /// of the box around the sample ([`Robust::depth_box`](trisort_format::Robust::depth_box)):
 /// - their planes' depth ranges over the box lie apart: the nearer first. These orders compose
 ///   (an interval order), so only the nearest of them become edges, and the rest follow
-///   through those, however far back in the list;
+///   through those, up to [`REACH_BACK`] fragments back;
 /// - the ranges overlap (one of the [`LOOK_BACK`] fragments before): the part of the box both
 ///   projected triangles cover is clipped out, and where one plane is nearer at every corner
 ///   of it, that one first; where they cover none of it together, no edge (a fan's
@@ -479,7 +485,7 @@ impl<'r> GrownOrder<'r> {
         let mut cover = f32::NEG_INFINITY;
         let mut at = None;
         for (back, t) in list.taken.iter().rev().enumerate() {
-            if t.far_so_far < cover {
+            if t.far_so_far < cover || back >= REACH_BACK {
                 break;
             }
             if t.id == id {
