@@ -364,6 +364,11 @@ fn malformed_recordings_are_named_not_merged() {
             |r| r.settings.samples = 3,
             "samples are impossible",
         ),
+        (
+            "bits",
+            |r| r.settings.robust.profile.subpixel_bits_max = 99,
+            "sub-pixel",
+        ),
     ];
     for (name, edit, problem) in cases {
         let mut r = good.clone();
@@ -438,6 +443,29 @@ fn malformed_baked_files_are_named_not_played() {
                 b.frame_states.pop();
             },
             "per-frame lists differ",
+        ),
+        // Settings a reader would size images, targets and loops by (issue 28: a width of 0
+        // made `play --out-dir` panic in the image library).
+        ("zero-width", |b| b.settings.width = 0, "settings 0x"),
+        (
+            "huge-height",
+            |b| b.settings.height = u32::MAX,
+            "x4294967295 is out of range",
+        ),
+        (
+            "no-layers",
+            |b| b.settings.max_layers = 0,
+            "max layers must be at least 1",
+        ),
+        (
+            "nan-tolerance",
+            |b| b.settings.robust.tolerance = f32::NAN,
+            "robust tolerance NaN px",
+        ),
+        (
+            "no-patterns",
+            |b| b.settings.robust.patterns = 0,
+            "the number of sample patterns must be",
         ),
     ];
     for (name, edit, problem) in cases {

@@ -177,12 +177,14 @@ impl Baked {
         &self.draws[w.first as usize..(w.first + w.count) as usize]
     }
 
-    /// Checks the structural consistency a reader must rely on before using the file: the
+    /// Checks the structural consistency a reader must rely on before using the file: settings
+    /// a recorder could have recorded with ([`crate::RecordSettings::check_stored`]), the
     /// geometry ([`Geometry::check_structure`]: indices in range, finite positions), scene ids
     /// ascending, draws inside the index buffer, windows inside the draw list, one frame state
     /// and one removed-edge list per frame, finite cameras and poses of existing nodes
     /// ([`crate::camera::check_frame_state`]). Returns the first problem found.
     pub fn check_structure(&self) -> Result<(), String> {
+        self.settings.check_stored()?;
         let g = &self.geometry;
         g.check_structure()?;
         if self.scene_ids.len() != g.triangles.len() {

@@ -349,6 +349,29 @@ impl RecordSettings {
         }
     }
 
+    /// [`RecordSettings::validate`] for the settings stored in a file (a recording's or a
+    /// baked file's `check_structure`), as a structural error: a reader that trusted an
+    /// impossible size, sample count, layer count or tolerance would divide by it, allocate by
+    /// it or hand it to an image library that asserts on it.
+    pub fn check_stored(&self) -> Result<(), String> {
+        let s = self;
+        if s.width == 0 || s.height == 0 || (s.samples != 1 && s.samples != 4) {
+            return Err(format!(
+                "settings {}x{} at {} samples are impossible",
+                s.width, s.height, s.samples
+            ));
+        }
+        let saturation_ok = s.saturation > 0.0 && s.saturation <= 1.0;
+        if !saturation_ok || !(0.0..=1.0).contains(&s.glass_opacity) {
+            return Err(format!(
+                "saturation {} or glass opacity {} is out of range",
+                s.saturation, s.glass_opacity
+            ));
+        }
+        self.validate()
+            .map_err(|e| format!("settings are impossible: {e}"))
+    }
+
     /// Checks that the settings can be recorded: size 1..=[`RecordSettings::MAX_SIDE`], 1 or
     /// 4 samples, saturation in (0, 1], glass opacity in [0, 1], at least one layer.
     pub fn validate(&self) -> Result<(), SettingsError> {
@@ -520,7 +543,9 @@ impl Recording {
 
     /// Checks the structural consistency a reader relies on before using the recording, and
     /// returns the first problem found:
-    /// - settings: size ≥ 1, 1 or 4 samples, saturation in (0, 1], glass opacity in [0, 1];
+    /// - settings a recorder could have recorded with ([`RecordSettings::check_stored`]: size,
+    ///   samples, saturation, glass opacity, layers, robust patterns, tolerance, sub-pixel
+    ///   bits);
     /// - `unique_visible` (G) strictly ascending, every id below `scene_triangles`;
     /// - frames ascending and contiguous, inside the path's `frame_states`;
     /// - per frame: visible and covered sets strictly ascending and inside G; edges and ties
@@ -533,20 +558,7 @@ impl Recording {
     ///
     /// O(size of the recording).
     pub fn check_structure(&self) -> Result<(), String> {
-        let s = &self.settings;
-        if s.width == 0 || s.height == 0 || (s.samples != 1 && s.samples != 4) {
-            return Err(format!(
-                "settings {}x{} at {} samples are impossible",
-                s.width, s.height, s.samples
-            ));
-        }
-        let saturation_ok = s.saturation > 0.0 && s.saturation <= 1.0;
-        if !saturation_ok || !(0.0..=1.0).contains(&s.glass_opacity) {
-            return Err(format!(
-                "saturation {} or glass opacity {} is out of range",
-                s.saturation, s.glass_opacity
-            ));
-        }
+        self.settings.check_stored()?;
         let g = &self.unique_visible;
         if g.windows(2).any(|w| w[0] >= w[1]) {
             return Err("the visible set G is not strictly ascending".into());
