@@ -312,3 +312,41 @@ fn forged_statistics_are_rejected() {
         h.rejected(name, &forged, &[], &[needle]);
     }
 }
+
+/// A file that names another recording device is checked, not measured (issue 28): with its
+/// device renamed and its index buffer reversed, `verify --scene` alone (no recording to take
+/// the device from) fails it (exit 3), saying it played on another device at the recorded
+/// pattern. The honest file with the renamed device still passes.
+#[test]
+fn a_renamed_device_does_not_wave_a_wrong_file_through() {
+    let Some(h) = honest() else { return };
+    let mut renamed = h.baked.clone();
+    renamed.device.adapter.push_str(" (renamed)");
+    let mut forged = renamed.clone();
+    forged.copies.reverse();
+    let d = h.dir.path();
+    for (name, file) in [("renamed", &renamed), ("reversed", &forged)] {
+        trisort_format::write_file_atomic(FileKind::Baked, &d.join(format!("{name}.baked")), file)
+            .unwrap();
+    }
+    let images = |name: &str, ok: bool| {
+        let file = format!("{name}.baked");
+        let out = run(
+            d,
+            &[
+                "verify", &file, "--scene", SCENE, "--mode", "depth", "--json",
+            ],
+            ok,
+        );
+        if !ok {
+            assert_eq!(out.status.code(), Some(3), "{name}");
+        }
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["at_recorded_pattern"], true, "{name}: {v}");
+        assert_eq!(v["played_on_recording_device"], false, "{name}: {v}");
+        v
+    };
+    images("renamed", true);
+    let v = images("reversed", false);
+    assert_eq!(v["images_ok"], false, "{v}");
+}

@@ -10,16 +10,19 @@
 //! device from it, not from the file.
 //!
 //! The rule ([`ImageCheck`]):
-//! - At the recorded pattern (the recorded size and sample count, on the recording device):
+//! - At the recorded pattern (the recorded size and sample count, no sub-pixel offset, on
+//!   whatever device: the device a file names is the file's word, and a renamed one once
+//!   turned a check into a measurement that passed a reversed buffer):
 //!   `depth` fails a frame that is not bit-exact on its ordered pixels (a transparent
 //!   fragment drawn after a farther one still blends over it); `blend` and `saturate` fail a
 //!   frame with an ordered pixel more than 1/255 off in a colour channel. A truncated
 //!   reference peel fails too. Frames captured elsewhere are held to the same rule at the
 //!   recorded size and sample count, whatever their device (that is what signing off a head
 //!   unit's frames means).
-//! - Off the pattern (another size, sample count or device): the error is measured, and a
-//!   frame fails only when `max_error` is given and its `max_channel_diff_ordered` (the largest
-//!   colour-channel difference on ordered pixels, in 1/255 units) exceeds it.
+//! - Off the pattern (another size or sample count, or a sub-pixel offset): the error is
+//!   measured, and a frame fails only when `max_error` is given and its
+//!   `max_channel_diff_ordered` (the largest colour-channel difference on ordered pixels, in
+//!   1/255 units) exceeds it.
 //!
 //! The 8-bit sRGB deployment error is measured alongside when asked and never gates.
 
@@ -168,6 +171,9 @@ impl<'a> Truth<'a> {
 pub struct ImageVerifier<'g> {
     check: ImageCheck,
     at_pattern: bool,
+    /// Frames are played here on a device other than the one the recording (or, without
+    /// one, the file) names.
+    other_device: bool,
     /// `None` for frames captured elsewhere.
     player: Option<HeadlessRenderer<'g>>,
     reference: ExactReference<'g>,
@@ -191,10 +197,14 @@ impl<'g> ImageVerifier<'g> {
     ) -> Result<ImageVerifier<'g>, ReferenceError> {
         let truth = Truth::new(baked, recordings, geometry.triangles.len())?;
         let s = &truth.settings;
+        // The device the file (or the recording) names does not decide: a file that named
+        // another device was once measured only, and passed, however wrong (issue 28). Frames
+        // played here on another device are held to the recorded pattern's rule, as frames
+        // captured elsewhere are; the report says so.
         let at_pattern = check.size == (s.width, s.height)
             && check.samples == s.samples.max(1)
-            && check.subpixel_offset == [0.0, 0.0]
-            && (check.captured || gpu.device_info() == *truth.device);
+            && check.subpixel_offset == [0.0, 0.0];
+        let other_device = !check.captured && gpu.device_info() != *truth.device;
         let player = if check.captured {
             None
         } else {
@@ -245,6 +255,7 @@ impl<'g> ImageVerifier<'g> {
         let verifier = ImageVerifier {
             check,
             at_pattern,
+            other_device,
             player,
             reference,
             srgb8,
@@ -268,10 +279,17 @@ impl<'g> ImageVerifier<'g> {
         self.reference.set_subpixel_offset(offset);
     }
 
-    /// Whether frames are checked at the recorded pattern (size, samples and, for frames
-    /// played here, device).
+    /// Whether frames are checked at the recorded pattern (size, sample count, no sub-pixel
+    /// offset), whatever device plays them.
     pub fn at_recorded_pattern(&self) -> bool {
         self.at_pattern
+    }
+
+    /// Whether frames are played here on a device other than the one the recording (or,
+    /// without one, the baked file) names: checked all the same, where at the recorded
+    /// pattern.
+    pub fn on_other_device(&self) -> bool {
+        self.other_device
     }
 
     /// Plays, references and compares frame `frame`. Errors for a verifier of captured

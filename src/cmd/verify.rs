@@ -103,6 +103,9 @@ pub struct ImageReport {
     pub ok: bool,
     /// Whether the check ran at the recorded pattern.
     pub at_recorded_pattern: bool,
+    /// Whether the frames were played here on a device other than the one the recording (or
+    /// the file) names (checked all the same at the recorded pattern).
+    pub on_other_device: bool,
     /// Per frame.
     pub frames: Vec<FrameImageReport>,
 }
@@ -141,6 +144,7 @@ pub fn verify_images(
     let mut report = ImageReport {
         ok: true,
         at_recorded_pattern: verifier.at_recorded_pattern(),
+        on_other_device: verifier.on_other_device(),
         frames: Vec::with_capacity(frames.len()),
     };
     for f in frames {
@@ -440,6 +444,7 @@ fn json_report(
         out["size"] = json!([check.size.0, check.size.1]);
         out["samples"] = json!(check.samples);
         out["at_recorded_pattern"] = json!(report.at_recorded_pattern);
+        out["played_on_recording_device"] = json!(!report.on_other_device);
         out["max_error"] = json!(check.max_error);
         out["captured"] = json!(check.captured);
         out["subpixel_offset"] = json!(check.subpixel_offset);
@@ -487,7 +492,10 @@ fn print_report(
             check.size.0,
             check.size.1,
             check.samples,
-            if report.at_recorded_pattern {
+            if report.at_recorded_pattern && report.on_other_device {
+                "recorded pattern, played on another device than recorded: checked all the same"
+                    .to_string()
+            } else if report.at_recorded_pattern {
                 "recorded pattern".to_string()
             } else {
                 match check.max_error {
