@@ -142,6 +142,45 @@ fn an_interrupted_bake_resumes_to_identical_bytes() {
     );
 }
 
+/// A bake killed while merging (issue 28) leaves its finished recording beside the output and
+/// no baked file (both are written to a temporary name, then renamed). Run again, it merges
+/// only: it says it resumes from the finished recording, reports `recording_reused`, leaves
+/// the recording untouched (not rewritten) and writes the bytes an uninterrupted bake writes.
+/// The same output with other settings records again.
+#[test]
+fn a_bake_killed_while_merging_merges_only_when_run_again() {
+    let Some(dir) = gpu_tempdir() else {
+        return;
+    };
+    let d = dir.path();
+    run_bake(d, "clean.baked", "2");
+    // The state a kill during the merge leaves: the recording, no baked file.
+    run_bake(d, "merged.baked", "2");
+    std::fs::remove_file(d.join("merged.baked")).unwrap();
+    let rec = d.join("merged.baked.rec");
+    let modified = |p: &Path| std::fs::metadata(p).unwrap().modified().unwrap();
+    let before = modified(&rec);
+    std::thread::sleep(Duration::from_millis(50));
+    let out = run_bake_json(d, bake("merged.baked"));
+    assert!(out.1.contains("merging only"), "{}", out.1);
+    assert_eq!(out.0["recording_reused"], true, "{}", out.0);
+    assert_eq!(modified(&rec), before, "the recording was written again");
+    assert!(read(d, "clean.baked") == read(d, "merged.baked"));
+    // Other settings (another size) for the same output: recorded again, and replaced.
+    let out = run_bake_json(d, bake_args(SCENE, PATH, "48x48", "4", "merged.baked"));
+    assert!(!out.1.contains("merging only"), "{}", out.1);
+    assert_eq!(out.0["recording_reused"], false, "{}", out.0);
+    assert_ne!(modified(&rec), before);
+}
+
+/// `bake ARGS --json` in `dir`, which must succeed: its JSON and its stderr.
+fn run_bake_json(dir: &Path, mut args: Vec<&str>) -> (serde_json::Value, String) {
+    args.push("--json");
+    let out = run(dir, &args, true);
+    let v = serde_json::from_slice(&out.stdout).unwrap();
+    (v, String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
 /// The same bake with 1 and 2 rayon threads, twice with 2: byte-identical recordings and
 /// baked files (the merger tries all strategies and layouts in parallel).
 #[test]

@@ -186,7 +186,7 @@ fn bake_for(
         samples
     ));
     let environment = merge.environment()?;
-    let (recording, baked, record_s, merge_s) =
+    let (recording, baked, record_s, merge_s, reused) =
         bake(gpu, scene, timeline, &record, &merge, environment, &path)?;
     let bytes = std::fs::metadata(&path)?.len();
     say(&format!(
@@ -200,7 +200,8 @@ fn bake_for(
         samples,
         source: source_baked(&baked, &recording)?,
         baked,
-        record_seconds: Some(record_s),
+        // A recording found finished beside the bake was not timed.
+        record_seconds: (!reused).then_some(record_s),
         merge_seconds: Some(merge_s),
         bytes,
         path,

@@ -80,7 +80,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     println!("device: {}", gpu.describe());
     let baked_path = a.out_dir.join("demo.baked");
     let environment = merge.environment()?;
-    let (rec, baked, record_s, merge_s) = bake(
+    let (rec, baked, record_s, merge_s, reused) = bake(
         &gpu,
         &scene,
         &path,
@@ -171,7 +171,8 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         worst(|f| f.comparison.max_channel_diff_ordered),
         images.frames.iter().map(|f| f.unordered_samples).sum::<u64>()
     );
-    println!("times:                  record {record_s:.1} s, merge {merge_s:.2} s, play {play_s:.1} s, verify images {images_s:.1} s, total {:.1} s", t0.elapsed().as_secs_f64());
+    let record = if reused { "record (reused)" } else { "record" };
+    println!("times:                  {record} {record_s:.1} s, merge {merge_s:.2} s, play {play_s:.1} s, verify images {images_s:.1} s, total {:.1} s", t0.elapsed().as_secs_f64());
     println!(
         "wrote {} and {} PNG frames in {}",
         baked_path.display(),
