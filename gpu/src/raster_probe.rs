@@ -31,17 +31,37 @@ use crate::{Gpu, GpuError};
 /// Steps of the sweep across a pixel (the target's width).
 const STEPS: u32 = 2048;
 
+/// Vulkan's and D3D's standard 4× sample locations within a pixel (x right, y down), sample
+/// k at `[k]`.
+pub const STANDARD_4X: [[f64; 2]; 4] = [
+    [0.375, 0.125],
+    [0.875, 0.375],
+    [0.125, 0.625],
+    [0.625, 0.875],
+];
+
+/// Sample `k`'s standard location within its pixel (x right, y down) at `samples` samples per
+/// pixel (1 or 4, what trisort records).
+pub fn standard_location(samples: u32, k: u32) -> [f64; 2] {
+    if samples == 4 {
+        STANDARD_4X[k as usize % 4]
+    } else {
+        [0.5, 0.5]
+    }
+}
+
 /// The standard sample positions' x and y (each as a set, sorted) for a sample count.
 pub fn standard_positions(samples: u32) -> (Vec<f64>, Vec<f64>) {
-    match samples {
-        1 => (vec![0.5], vec![0.5]),
-        // Vulkan's and D3D's standard 4× pattern: (0.375, 0.125), (0.875, 0.375),
-        // (0.125, 0.625), (0.625, 0.875).
-        _ => (
-            vec![0.125, 0.375, 0.625, 0.875],
-            vec![0.125, 0.375, 0.625, 0.875],
-        ),
-    }
+    let n = if samples == 4 { 4 } else { 1 };
+    let (mut xs, mut ys): (Vec<f64>, Vec<f64>) = (0..n)
+        .map(|k| {
+            let [x, y] = standard_location(samples, k);
+            (x, y)
+        })
+        .unzip();
+    xs.sort_by(f64::total_cmp);
+    ys.sort_by(f64::total_cmp);
+    (xs, ys)
 }
 
 /// What the raster probe measured.

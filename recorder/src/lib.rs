@@ -383,13 +383,9 @@ impl<'a> Pairs<'a> {
     /// Fragment `id` (+ 1) follows fragment `prev` (+ 1) at a sample, at depths `depths`
     /// (previous, this).
     fn pair(&mut self, prev: u32, id: u32, depths: (f32, f32)) {
-        let key = (self.g[(prev - 1) as usize], self.g[(id - 1) as usize]);
-        // Two fragments of one triangle at one sample (the near plane's clipper cuts a
-        // triangle into a fan whose pieces can both cover a sample): no order between them.
-        // The tie rule can bring them together (one moves up past what lay between).
-        if key.0 == key.1 {
+        let Some(key) = scene_pair(self.g, prev - 1, id - 1) else {
             return;
-        }
+        };
         *self.edges.entry(key).or_default() += 1;
         if depths.0 == depths.1 {
             *self.ties.entry(key).or_default() += 1;
@@ -590,10 +586,18 @@ fn capture_graph(
     Ok((most as u32, left))
 }
 
+/// The edge `front` → `back` (drawn positions, 0-based) by scene ids (`g`), or `None` for two
+/// fragments of one triangle: the near plane's clipper cuts a triangle into a fan whose pieces
+/// can both cover a sample (and the tie rule can bring them together), with no order between
+/// them.
+fn scene_pair(g: &[u32], front: u32, back: u32) -> Option<(u32, u32)> {
+    let key = (g[front as usize], g[back as usize]);
+    (key.0 != key.1).then_some(key)
+}
+
 /// Adds one sample's grown edge `front` → `back` (drawn positions) to `to`, by scene ids.
 fn grown_edge(g: &[u32], to: &mut HashMap<(u32, u32), u32>, front: u32, back: u32) {
-    let key = (g[front as usize], g[back as usize]);
-    if key.0 != key.1 {
+    if let Some(key) = scene_pair(g, front, back) {
         *to.entry(key).or_default() += 1;
     }
 }
@@ -827,10 +831,9 @@ pub fn record(
                     let state = &job.frames[f as usize];
                     let rule = TieRule::new(job.geometry, &g, state);
                     let source = peeler.as_ref().unwrap();
-                    let grown = grown.as_ref().map(|layers| {
-                        let order = GrownOrder::new(&rule, job.geometry, &g, state, &s);
-                        (layers, order)
-                    });
+                    let grown = grown
+                        .as_ref()
+                        .map(|layers| (layers, GrownOrder::new(&rule, state, &s)));
                     let r = graph_frame(source, grown.as_ref(), f, &g, &s, &rule)?;
                     if let Some(p) = partial {
                         p.store_graph(f, &r)?;

@@ -34,6 +34,7 @@
 
 use glam::{DMat4, DVec2, DVec3};
 use trisort_format::{world_transforms, FrameState, Geometry, RecordSettings};
+use trisort_gpu::raster_probe::standard_location;
 
 /// How two triangles lie in camera space ([`TieRule::relation`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -335,18 +336,12 @@ impl GrownList {
 }
 
 impl<'r> GrownOrder<'r> {
-    /// The order for `rule`'s drawn list (`triangles`, scene ids of `geometry`, in draw order)
-    /// at `frame`, recorded with `settings` (image size, samples, the robust settings' box).
-    pub fn new(
-        rule: &'r TieRule,
-        geometry: &Geometry,
-        triangles: &[u32],
-        frame: &FrameState,
-        settings: &RecordSettings,
-    ) -> GrownOrder<'r> {
+    /// The order for `rule`'s drawn list at `frame` (the rule's own frame), recorded with
+    /// `settings` (image size, samples, the robust settings' box).
+    pub fn new(rule: &'r TieRule, frame: &FrameState, settings: &RecordSettings) -> GrownOrder<'r> {
         let (w, h) = (settings.width.max(1) as f64, settings.height.max(1) as f64);
         let reach = settings.robust.depth_box() as f64;
-        let world: Vec<DMat4> = world_transforms(&geometry.nodes, &frame.poses);
+        // The rule's corners are world minus eye; the view's rotation makes them view space.
         let view = frame.camera.view_matrix();
         let proj = frame.camera.projection(w / h);
         // Window depth is affine in 1/w: z = a + b / w (w = −z in view space).
@@ -357,15 +352,19 @@ impl<'r> GrownOrder<'r> {
         // / d, with tx = 1 / proj[0][0] and ty = 1 / proj[1][1]; NDC x = 2 px / width − 1,
         // y = 1 − 2 py / height.
         let (tx, ty) = (1.0 / proj.x_axis.x, 1.0 / proj.y_axis.y);
-        let mut spread = Vec::with_capacity(triangles.len());
-        let mut depth_planes = Vec::with_capacity(triangles.len());
-        let mut corners = Vec::with_capacity(triangles.len());
-        for &t in triangles {
-            let c = geometry.triangles[t as usize].map(|v| {
-                let v = &geometry.vertices[v as usize];
-                let p = DVec3::from(v.position.map(f64::from));
-                (view * world[v.node as usize]).transform_point3(p)
-            });
+        let n = rule.planes.len();
+        let mut spread = Vec::with_capacity(n);
+        let mut depth_planes = Vec::with_capacity(n);
+        let mut corners = Vec::with_capacity(n);
+        for plane in &rule.planes {
+            let Some(triangle) = plane else {
+                // Degenerate in f64: no plane to order by, nothing it covers.
+                spread.push(f32::INFINITY);
+                depth_planes.push(None);
+                corners.push(None);
+                continue;
+            };
+            let c = triangle.corners.map(|p| view.transform_vector3(p));
             let n = (c[1] - c[0]).cross(c[2] - c[0]);
             let d = n.dot(c[0]);
             let plane = [
@@ -407,21 +406,11 @@ impl<'r> GrownOrder<'r> {
     /// The position in pixels of the sample in image slot `slot` (`(y · width + x) · samples
     /// + s`), at the standard sample locations.
     fn sample_position(&self, slot: usize) -> DVec2 {
-        const FOUR: [[f64; 2]; 4] = [
-            [0.375, 0.125],
-            [0.875, 0.375],
-            [0.125, 0.625],
-            [0.625, 0.875],
-        ];
         let samples = self.samples.max(1) as usize;
         let pixel = slot / samples;
         let (x, y) = (pixel % self.width as usize, pixel / self.width as usize);
-        let within = if samples == 4 {
-            FOUR[slot % 4]
-        } else {
-            [0.5, 0.5]
-        };
-        DVec2::new(x as f64 + within[0], y as f64 + within[1])
+        let [sx, sy] = standard_location(self.samples, (slot % samples) as u32);
+        DVec2::new(x as f64 + sx, y as f64 + sy)
     }
 
     /// Whether drawn triangle `p` lies in front of `q` wherever both cover a point of the box
