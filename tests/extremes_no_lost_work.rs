@@ -38,6 +38,14 @@ fn run_bake(dir: &Path, out: &str, threads: &str) -> std::process::Output {
     out
 }
 
+/// A GPU test directory holding an uninterrupted bake, `clean.baked` (2 threads), to compare
+/// resumed bakes with; `None` to skip.
+fn with_clean_bake() -> Option<tempfile::TempDir> {
+    let dir = gpu_tempdir()?;
+    run_bake(dir.path(), "clean.baked", "2");
+    Some(dir)
+}
+
 /// Finished frame files in a partial folder (everything but its `key`).
 fn finished(partial: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(partial)
@@ -63,11 +71,10 @@ fn read(dir: &Path, name: &str) -> Vec<u8> {
 /// is set by the folder, not by timing, so the test holds on a device of any speed.
 #[test]
 fn an_interrupted_bake_resumes_to_identical_bytes() {
-    let Some(dir) = gpu_tempdir() else {
+    let Some(dir) = with_clean_bake() else {
         return;
     };
     let d = dir.path();
-    run_bake(d, "clean.baked", "2");
     let mut child = trisort(d)
         .args(bake("resumed.baked"))
         .stderr(std::process::Stdio::null())
@@ -149,11 +156,10 @@ fn an_interrupted_bake_resumes_to_identical_bytes() {
 /// The same output with other settings records again.
 #[test]
 fn a_bake_killed_while_merging_merges_only_when_run_again() {
-    let Some(dir) = gpu_tempdir() else {
+    let Some(dir) = with_clean_bake() else {
         return;
     };
     let d = dir.path();
-    run_bake(d, "clean.baked", "2");
     // The state a kill during the merge leaves: the recording, no baked file.
     run_bake(d, "merged.baked", "2");
     std::fs::remove_file(d.join("merged.baked")).unwrap();
