@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use trisort_format::container::{encode, FileKind};
-use trisort_format::{Baked, DeviceInfo, Phase, RecordSettings, Recording};
+use trisort_format::{
+    Baked, DeviceInfo, DrawIndexedIndirectArgs, FrameWindow, Phase, RecordSettings, Recording,
+};
 use trisort_merger::synth::{split_frames, turntable, Turntable};
 use trisort_merger::{merge, MergeOptions};
 
@@ -431,6 +433,38 @@ fn malformed_baked_files_are_named_not_played() {
             "window-outside",
             |b| b.frames[2].first = u32::MAX,
             "outside the draw list",
+        ),
+        // Per-frame work beyond what a merge produces (issue 28: 200,000 draws of the whole
+        // buffer in one frame held play and verify past 60 s).
+        (
+            "200k-draws",
+            |b| {
+                let whole = DrawIndexedIndirectArgs {
+                    index_count: 3 * b.copies.len() as u32,
+                    ..b.draws[0]
+                };
+                let first = b.draws.len() as u32;
+                b.draws.extend(std::iter::repeat_n(whole, 200_000));
+                b.frames[1] = FrameWindow {
+                    first,
+                    count: 200_000,
+                };
+            },
+            "frame 1 has 200000 draws, more than a merge gives",
+        ),
+        (
+            "buffer-twice",
+            |b| {
+                let whole = DrawIndexedIndirectArgs {
+                    index_count: 3 * b.copies.len() as u32,
+                    first_index: 0,
+                    ..b.draws[0]
+                };
+                let first = b.draws.len() as u32;
+                b.draws.extend([whole, whole]);
+                b.frames[0] = FrameWindow { first, count: 2 };
+            },
+            "more than the",
         ),
         (
             "copy-beyond",
