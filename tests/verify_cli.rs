@@ -1,6 +1,6 @@
 //! `trisort verify --scene` through the real binary: the JSON keys of DESIGN's CLI contract,
 //! graph and image checks together, difference images, a scene that is not the baked one,
-//! the off-pattern measure with `--max-error`, the mutation check (a file whose order was
+//! off the pattern only with `--max-error` or `--measure-only`, the mutation check (a file whose order was
 //! corrupted on purpose fails with exit code 3), and frames captured elsewhere
 //! (`--frames-dir`).
 
@@ -82,12 +82,15 @@ fn another_scene_is_refused_with_a_clear_error() {
     );
 }
 
+/// Off the recorded pattern nothing passes unchecked (issue 28): without `--max-error` the run
+/// is refused before anything is drawn; `--measure-only` measures, says nothing was verified
+/// and exits 4 unless `--allow-unverified`; `--max-error` below the measured error fails.
 #[test]
-fn off_pattern_is_measured_and_gated_only_by_max_error() {
+fn off_pattern_is_checked_only_with_max_error_or_measured_only_on_request() {
     let Some(dir) = baked_car() else {
         return;
     };
-    // Twice the recorded size: measured, not failed.
+    // Twice the recorded size.
     let off_pattern = [
         "verify",
         "car.baked",
@@ -98,12 +101,38 @@ fn off_pattern_is_measured_and_gated_only_by_max_error() {
         "--frames",
         "0..1",
     ];
-    let v = run_json(dir.path(), &off_pattern);
+    let out = run(dir.path(), &off_pattern, false);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("off the recorded pattern") && err.contains("--max-error N"),
+        "{err}"
+    );
+    let measured = [&off_pattern[..], &["--measure-only", "--json"]].concat();
+    let out = run(dir.path(), &measured, false);
+    assert_eq!(out.status.code(), Some(4));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["at_recorded_pattern"], false);
-    assert_eq!(v["ok"], true);
+    assert_eq!(v["ok"], false);
+    assert_eq!(v["verified"], false);
+    assert_eq!(v["image_check"], "measured_only");
+    assert!(v["frames"][0]["ok"].is_null(), "{v}");
     let max = v["frames"][0]["max_channel_diff_ordered"].as_u64().unwrap();
     assert!(max > 0, "holes show at twice the size: {v}");
-    // The same with a bound below the measured error fails (exit 3).
+    let text = run(
+        dir.path(),
+        &[&off_pattern[..], &["--measure-only"]].concat(),
+        false,
+    );
+    assert!(String::from_utf8_lossy(&text.stdout).contains("NOTHING VERIFIED"));
+    // Allowed: exit 0, and still not verified.
+    let allowed = [&off_pattern[..], &["--measure-only", "--allow-unverified"]].concat();
+    let v = run_json(dir.path(), &allowed);
+    assert_eq!(
+        (v["ok"].as_bool(), v["verified"].as_bool()),
+        (Some(true), Some(false))
+    );
+    // A bound below the measured error fails (exit 3); at it, passes and says so.
     let bound = (max - 1).to_string();
     let out = run(
         dir.path(),
@@ -111,6 +140,12 @@ fn off_pattern_is_measured_and_gated_only_by_max_error() {
         false,
     );
     assert_eq!(out.status.code(), Some(3));
+    let v = run_json(
+        dir.path(),
+        &[&off_pattern[..], &["--max-error", &max.to_string()]].concat(),
+    );
+    assert_eq!(v["image_check"], "max_error");
+    assert_eq!(v["verified"], true);
 }
 
 /// The mutation check: swapping the positions of two triangles drawn in frame 0 that the

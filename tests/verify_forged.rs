@@ -165,15 +165,7 @@ fn every_edge_removed_and_the_cells_reversed_is_rejected() {
         .flatten()
         .map(|e| e.weight as u64)
         .sum();
-    let n = forged.copies.len() as u32;
-    forged.copies.reverse();
-    for d in &mut forged.draws {
-        d.first_index = 3 * n - d.first_index - d.index_count;
-    }
-    let per_frame: Vec<Vec<_>> = (0..forged.frames.len())
-        .map(|f| forged.frame_draws(f).iter().rev().copied().collect())
-        .collect();
-    set_draws(&mut forged, per_frame);
+    let forged = cells_reversed(&forged);
     let out = h.rejected(
         "every-edge",
         &forged,
@@ -349,4 +341,89 @@ fn a_renamed_device_does_not_wave_a_wrong_file_through() {
     images("renamed", true);
     let v = images("reversed", false);
     assert_eq!(v["images_ok"], false, "{v}");
+}
+
+/// The same cells reversed (every copy's position mirrored, every frame's draws in reverse
+/// order), nothing else changed.
+fn cells_reversed(b: &Baked) -> Baked {
+    let mut forged = b.clone();
+    let n = forged.copies.len() as u32;
+    forged.copies.reverse();
+    for d in &mut forged.draws {
+        d.first_index = 3 * n - d.first_index - d.index_count;
+    }
+    let per_frame: Vec<Vec<_>> = (0..forged.frames.len())
+        .map(|f| forged.frame_draws(f).iter().rev().copied().collect())
+        .collect();
+    set_draws(&mut forged, per_frame);
+    forged
+}
+
+/// Issue 28: a depth-only file is checked for the mode it plays in. A legitimate
+/// `merge --depth-only` passes graph and images in depth mode (the demo car's glass is
+/// translucent: what lies behind it must be drawn after it even with the depth test), fails
+/// as a blend file, and the file that claims depth-only with every cell reversed fails both.
+#[test]
+fn a_depth_only_file_is_checked_for_the_mode_it_plays_in() {
+    let Some(h) = honest() else { return };
+    let d = h.dir.path();
+    run(
+        d,
+        &args("merge car.baked.rec --depth-only -o depth.baked"),
+        true,
+    );
+    let depth = run_json(
+        d,
+        &args(&format!(
+            "verify depth.baked --recording car.baked.rec --scene {SCENE} --mode depth"
+        )),
+    );
+    assert_eq!(depth["ok"], true, "{depth}");
+    assert_eq!(depth["graph_check"], "depth", "{depth}");
+    assert_eq!(depth["depth_only"], true, "{depth}");
+    assert_eq!(depth["image_check"], "recorded_pattern", "{depth}");
+    for f in depth["frames"].as_array().unwrap() {
+        assert_eq!(
+            f["pixels_differing"], 0,
+            "depth mode, a legitimate depth-only bake: {f}"
+        );
+    }
+    // As a blend file its order is checked against every edge of E_f, and fails.
+    let depth_only: Baked =
+        trisort_format::read_file(FileKind::Baked, &d.join("depth.baked")).unwrap();
+    let out = h.rejected("depth-only-as-blend", &depth_only, &[], &["is violated"]);
+    assert!(out.contains("a depth-only file checked for blend"), "{out}");
+    // The honest file's cells reversed, claiming depth-only: fails in blend and depth mode.
+    let mut forged = cells_reversed(&h.baked);
+    forged.merge.depth_only = true;
+    h.rejected("depth-only-reversed", &forged, &[], &["is violated"]);
+    h.rejected(
+        "depth-only-reversed",
+        &forged,
+        &["--mode", "depth"],
+        &["is violated"],
+    );
+}
+
+/// Issue 28: what the file says of its merge and path and the recording decides is checked:
+/// the matrix cells against the frames that draw each copy, the frame rate against the
+/// recording's.
+#[test]
+fn forged_cells_and_frame_rate_are_rejected() {
+    let Some(h) = honest() else { return };
+    let mut cells = h.baked.clone();
+    let c = cells
+        .merge
+        .cells
+        .iter()
+        .position(|c| c.first_frame < c.last_frame)
+        .expect("a cell spans frames");
+    cells.merge.cells[c].last_frame -= 1;
+    h.rejected("cells", &cells, &[], &[&format!("its merge cell {c} says")]);
+    let mut gap = h.baked.clone();
+    gap.merge.cells.pop();
+    h.rejected("cells-short", &gap, &[], &["the merge cells cover copies"]);
+    let mut fps = h.baked.clone();
+    fps.fps = Some(fps.fps.unwrap_or(30.0) * 2.0);
+    h.rejected("fps", &fps, &[], &["the frame rate"]);
 }

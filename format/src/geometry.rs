@@ -188,6 +188,17 @@ impl Material {
             }
         }
     }
+
+    /// Whether every fragment of the material has alpha 1 when recorded and played with
+    /// `glass_opacity`: glass only at opacity 1, otherwise `Opaque` and `Mask` (whose cut
+    /// fragments are discarded, the rest alpha 1), never `Blend` (its texture may lower alpha).
+    pub fn every_fragment_opaque(&self, glass_opacity: f32) -> bool {
+        if self.transmission > 0.0 {
+            glass_opacity >= 1.0
+        } else {
+            self.alpha_mode != AlphaMode::Blend
+        }
+    }
 }
 
 /// A decoded texture: tightly packed RGBA8, rows top to bottom, with its mip chain.

@@ -535,6 +535,64 @@ pub struct Recording {
 }
 
 impl Recording {
+    /// The edges of frame `fr` that a frame played in depth mode (front to back, depth test
+    /// `Less` with depth writes, *over*) must hold, and so all that a depth-only bake
+    /// (`merge --depth-only`) keeps: every tie (equal depths: the first drawn wins the depth
+    /// test), and every edge x → y whose x is a triangle that may have a fragment with alpha
+    /// below 1 (a `Blend` material, or glass recorded below opacity 1) or lies behind one in
+    /// E_f. A translucent a drawn after something behind it blends over it where the exact
+    /// reference shows a alone; so everything behind a, opaque triangles between included
+    /// (a → b → c: c drawn before a shows through it), must come after a. Behind opaque
+    /// triangles only, the order does not matter: the nearest opaque fragment is what remains
+    /// whichever is drawn first. Sorted; a tie that is also a kept edge is listed once, with
+    /// the edge's weight. A triangle outside G counts as translucent.
+    pub fn depth_mode_edges(&self, fr: &FrameRecord) -> Vec<Edge> {
+        let g = &self.geometry;
+        let opaque = |t: u32| {
+            self.unique_visible
+                .binary_search(&t)
+                .ok()
+                .and_then(|k| g.triangles.get(k))
+                .and_then(|tri| g.vertices.get(tri[0] as usize))
+                .and_then(|v| g.materials.get(v.material as usize))
+                .is_some_and(|m| m.every_fragment_opaque(self.settings.glass_opacity))
+        };
+        let mut edges = fr.edges.clone();
+        edges.sort_unstable();
+        // Triangles translucent or behind a translucent one (reachable in E_f).
+        let mut behind = std::collections::HashSet::new();
+        let mut stack: Vec<u32> = Vec::new();
+        for e in &edges {
+            if !opaque(e.from) && behind.insert(e.from) {
+                stack.push(e.from);
+            }
+        }
+        while let Some(t) = stack.pop() {
+            let first = edges.partition_point(|e| e.from < t);
+            for e in edges[first..].iter().take_while(|e| e.from == t) {
+                if behind.insert(e.to) {
+                    stack.push(e.to);
+                }
+            }
+        }
+        let mut out: Vec<Edge> = edges
+            .into_iter()
+            .filter(|e| behind.contains(&e.from))
+            .collect();
+        let kept = out.len();
+        for t in &fr.ties {
+            let i = out[..kept].partition_point(|e| (e.from, e.to) < (t.from, t.to));
+            let listed = out[..kept]
+                .get(i)
+                .is_some_and(|e| (e.from, e.to) == (t.from, t.to));
+            if !listed {
+                out.push(*t);
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
     /// The recording's identity: BLAKE3 of its postcard encoding (what a [`crate::Baked`]
     /// stores in `recording_hashes`; independent of the container's compression).
     pub fn content_hash(&self) -> Hash {

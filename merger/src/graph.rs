@@ -92,7 +92,8 @@ pub(crate) fn check_recordings(
 }
 
 /// Builds frame `f`'s graph of recording `k` (frame record `fr`): maps scene ids to G-local
-/// ids, keeps only tie edges for a depth-only bake, and breaks intra-frame cycles.
+/// ids, keeps for a depth-only bake only the edges depth mode needs
+/// ([`Recording::depth_mode_edges`]: ties and edges in front of which a fragment may be translucent), and breaks intra-frame cycles.
 pub(crate) fn frame_graph(
     k: usize,
     rec: &Recording,
@@ -135,7 +136,13 @@ pub(crate) fn frame_graph(
     covered.extend_from_slice(&visible);
     covered.sort_unstable();
     covered.dedup();
-    let source = if depth_only { &fr.ties } else { &fr.edges };
+    let depth_edges;
+    let source = if depth_only {
+        depth_edges = rec.depth_mode_edges(fr);
+        &depth_edges
+    } else {
+        &fr.edges
+    };
     let mut edges: Vec<Edge> = source
         .iter()
         .map(|e| {

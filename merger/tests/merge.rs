@@ -6,7 +6,7 @@ use proptest::strategy::Strategy as _;
 use trisort_format::{Baked, Recording};
 use trisort_merger::synth::{recording_from_frames, split_frames, turntable, FrameSpec, Turntable};
 use trisort_merger::{merge, Bridge, Choice, Layout, MergeOptions, Seeding, Strategy};
-use trisort_verify::check_graph;
+use trisort_verify::{check_graph, check_graph_for, PlayedIn};
 
 fn opts(strategy: Strategy, layout: Layout, bridge: Bridge, seeding: Seeding) -> MergeOptions {
     MergeOptions {
@@ -20,7 +20,13 @@ fn opts(strategy: Strategy, layout: Layout, bridge: Bridge, seeding: Seeding) ->
 
 /// Fails with the validator's findings unless the file passes.
 fn assert_valid(recs: &[Recording], baked: &Baked, what: &str) {
-    let report = check_graph(recs, baked);
+    // A depth-only file is made for depth mode (and checked for it).
+    let played = if baked.merge.depth_only {
+        PlayedIn::Depth
+    } else {
+        PlayedIn::Blend
+    };
+    let report = check_graph_for(recs, baked, played);
     assert!(
         report.ok,
         "{what}: {:?}\nframes: {:?}",

@@ -160,7 +160,7 @@ pub fn playback_warnings(baked: &Baked, config: &PlayerConfig) -> Vec<String> {
     }
     if baked.merge.depth_only && config.mode != Mode::Depth {
         out.push(format!(
-            "a depth-only bake is ordered only where depths tie; played in {} mode without the depth test it is not sorted",
+            "a depth-only bake is ordered only where depth mode needs it (ties, and behind translucent fragments); played in {} mode it is not sorted",
             config.mode
         ));
     }

@@ -108,8 +108,8 @@ pub struct UnorderedEdges {
 
 impl UnorderedEdges {
     /// Per frame of `recordings` (frame ranges of one path, any order), the edges of E_f on a
-    /// cycle of E_f; of its tie edges for a depth-only bake (`depth_only`), which keeps only
-    /// those. Errors when a recording names scene ids beyond the scene's `scene_triangles`.
+    /// cycle of E_f; of the edges depth mode needs for a depth-only bake
+    /// (`depth_only`: [`Recording::depth_mode_edges`]), which keeps only those. Errors when a recording names scene ids beyond the scene's `scene_triangles`.
     pub fn of_recordings(
         recordings: &[Recording],
         depth_only: bool,
@@ -119,7 +119,13 @@ impl UnorderedEdges {
         for r in recordings {
             edges.add_g(&r.unique_visible, "a recording")?;
             for fr in &r.frames {
-                let source = if depth_only { &fr.ties } else { &fr.edges };
+                let depth_edges;
+                let source = if depth_only {
+                    depth_edges = r.depth_mode_edges(fr);
+                    &depth_edges
+                } else {
+                    &fr.edges
+                };
                 edges.set_drawn(fr.frame as usize, fr.visible.clone());
                 edges.set_frame(
                     fr.frame as usize,

@@ -132,6 +132,7 @@ impl<'a> Truth<'a> {
         baked: &'a Baked,
         recordings: &'a [Recording],
         scene_triangles: usize,
+        mode: Mode,
     ) -> Result<Truth<'a>, ReferenceError> {
         let Some(first) = recordings.first() else {
             return Ok(Truth {
@@ -156,8 +157,9 @@ impl<'a> Truth<'a> {
                 baked.frames.len()
             )));
         }
-        let unordered =
-            UnorderedEdges::of_recordings(recordings, baked.merge.depth_only, scene_triangles)?;
+        // A depth-only file's ties are its order only where the depth test is on.
+        let ties = baked.merge.depth_only && mode == Mode::Depth;
+        let unordered = UnorderedEdges::of_recordings(recordings, ties, scene_triangles)?;
         Ok(Truth {
             settings: first.settings,
             device: &first.device,
@@ -195,7 +197,7 @@ impl<'g> ImageVerifier<'g> {
         check: ImageCheck,
         recordings: &[Recording],
     ) -> Result<ImageVerifier<'g>, ReferenceError> {
-        let truth = Truth::new(baked, recordings, geometry.triangles.len())?;
+        let truth = Truth::new(baked, recordings, geometry.triangles.len(), check.mode)?;
         let s = &truth.settings;
         // The device the file (or the recording) names does not decide: a file that named
         // another device was once measured only, and passed, however wrong (issue 28). Frames

@@ -7,10 +7,12 @@
 //! on the recording device; for captured frames, whatever the device) a frame fails when
 //! `depth` mode is not bit-exact, or when `blend`/`saturate` differ by more than 1/255 in a
 //! colour channel at an ordered pixel. Which pixels are unordered (excused) comes from the
-//! recordings' cycles only: with `--scene` alone no pixel is excused. Off the pattern the error
-//! is measured and a frame fails only above `--max-error N`: the largest colour-channel
-//! difference on ordered pixels, in 1/255 units (no `--max-error`: measure only). The error of
-//! an 8-bit sRGB deployment target is reported separately (`srgb8`) and never gated on.
+//! recordings' cycles only: with `--scene` alone no pixel is excused. Off the pattern a frame
+//! fails above `--max-error N`: the largest colour-channel difference on ordered pixels, in
+//! 1/255 units. Nothing passes unchecked (issue 28): off the pattern without `--max-error` is
+//! an error, and measuring without verifying needs `--measure-only`, which says that nothing
+//! was verified and exits 4 unless `--allow-unverified` is given. The error of an 8-bit sRGB
+//! deployment target is reported separately (`srgb8`) and never gated on.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -32,6 +34,10 @@ use crate::common::{load_scene, parse_range, parse_size, print_json, working_sce
 
 /// Exit code of a verification that ran and found the baked file wrong.
 pub const VERIFY_FAILED: u8 = 3;
+
+/// Exit code of `verify --measure-only` without `--allow-unverified`: the images were measured,
+/// nothing was verified.
+pub const UNVERIFIED: u8 = 4;
 
 /// Arguments of `verify`.
 #[derive(Args, Debug)]
@@ -58,9 +64,18 @@ pub struct VerifyArgs {
     #[arg(long, value_parser = parse_range)]
     frames: Option<FrameRange>,
     /// Off the recorded pattern: fail a frame whose largest colour-channel difference on
-    /// ordered pixels exceeds N/255 (default: measure only).
-    #[arg(long, value_name = "N")]
+    /// ordered pixels exceeds N/255. Off the pattern, a check needs this (or `--measure-only`).
+    #[arg(long, value_name = "N", conflicts_with = "measure_only")]
     max_error: Option<u8>,
+    /// Measure the images without verifying them: no frame fails, the report says that
+    /// nothing was verified, and the exit code is 4 unless `--allow-unverified` is given. The
+    /// graph rules (`--recording`) are checked all the same.
+    #[arg(long, requires = "scene")]
+    measure_only: bool,
+    /// With `--measure-only`: exit 0 after measuring (the report still says that the images
+    /// were not verified).
+    #[arg(long, requires = "measure_only")]
+    allow_unverified: bool,
     /// Write, for each failing frame, the player's frame, the reference, a difference image
     /// and the unordered mask as PNGs.
     #[arg(long)]
@@ -269,7 +284,11 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         bail!("nothing to verify against: give --recording REC (graph rules) and/or --scene SCENE (images)");
     }
     let recs = read_recordings(&a.recording)?;
-    let graph = (!recs.is_empty()).then(|| trisort_verify::check_graph(&recs, &baked));
+    let played = match a.mode {
+        Mode::Depth => trisort_verify::PlayedIn::Depth,
+        Mode::Blend | Mode::Saturate => trisort_verify::PlayedIn::Blend,
+    };
+    let graph = (!recs.is_empty()).then(|| trisort_verify::check_graph_for(&recs, &baked, played));
     let images = match &a.scene {
         None => None,
         Some(spec) => match image_check(&a, spec, &baked, &recs) {
@@ -282,26 +301,68 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             Err(e) => return Err(e),
         },
     };
-    let ok = graph.as_ref().is_none_or(|g| g.ok) && images.as_ref().is_none_or(|i| i.0.ok);
+    let graph_ok = graph.as_ref().is_none_or(|g| g.ok);
+    // Measured only: the images cannot fail, and they did not pass either.
+    let images_ok = images.as_ref().is_none_or(|i| a.measure_only || i.0.ok);
+    let unverified = a.measure_only && images.is_some();
+    let code = if !(graph_ok && images_ok) {
+        VERIFY_FAILED
+    } else if unverified && !a.allow_unverified {
+        UNVERIFIED
+    } else {
+        0
+    };
+    let ok = code == 0;
+    let check = images.as_ref().map(|(report, _)| {
+        if a.measure_only {
+            "measured_only"
+        } else if report.at_recorded_pattern {
+            "recorded_pattern"
+        } else {
+            "max_error"
+        }
+    });
     if a.json {
         let mut v = json_report(ok, graph.as_ref(), images.as_ref());
         if let Some(dir) = &a.frames_dir {
             v["frames_dir"] = json!(dir.display().to_string());
         }
+        v["image_check"] = json!(check);
+        v["graph_check"] = json!(graph.as_ref().map(|g| g.checked));
+        v["verified"] = json!(!unverified && (graph.is_some() || images.is_some()));
+        if unverified {
+            // Measured, not judged: no frame passed or failed.
+            v["images_ok"] = Value::Null;
+            for f in v["frames"].as_array_mut().into_iter().flatten() {
+                f["ok"] = Value::Null;
+            }
+        }
         print_json(&v);
     } else {
-        print_report(&a.baked, graph.as_ref(), images.as_ref());
+        print_report(&a.baked, graph.as_ref(), images.as_ref(), a.measure_only);
         println!(
             "{}: {}",
             a.baked.display(),
-            if ok { "OK" } else { "FAILED" }
+            match code {
+                0 if unverified => "images NOT VERIFIED (--measure-only --allow-unverified)",
+                0 => "OK",
+                UNVERIFIED =>
+                    "images NOT VERIFIED (--measure-only; exit 4 unless --allow-unverified)",
+                _ => "FAILED",
+            }
         );
     }
-    Ok(if ok {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(VERIFY_FAILED)
-    })
+    Ok(ExitCode::from(code))
+}
+
+/// Whether a check at `size`, `samples` and `offset` is at the recorded pattern of
+/// `settings` (the recording's, or the file's without one): the same rule as
+/// [`ImageVerifier::at_recorded_pattern`], decided before anything is rendered so that an
+/// unchecked run is refused up front.
+fn at_pattern(settings: &RecordSettings, size: (u32, u32), samples: u32, offset: [f64; 2]) -> bool {
+    size == (settings.width, settings.height)
+        && samples == settings.samples.max(1)
+        && offset == [0.0, 0.0]
 }
 
 /// The image check of `verify --scene SPEC`: the scene as recorded (split where the
@@ -371,6 +432,28 @@ fn image_check(
     if check.samples != 1 && check.samples != 4 {
         bail!("--samples {}: only 1 and 4 are supported", check.samples);
     }
+    if !a.measure_only
+        && check.max_error.is_none()
+        && !at_pattern(&settings, check.size, check.samples, check.subpixel_offset)
+    {
+        bail!(
+            "{}x{} with {}x MSAA{} is off the recorded pattern ({}x{}, {}x): nothing would be verified there unless you give --max-error N (fail a frame whose ordered pixels differ by more than N/255), or --measure-only to measure without verifying (exit 4 unless --allow-unverified)",
+            check.size.0,
+            check.size.1,
+            check.samples,
+            if check.subpixel_offset == [0.0, 0.0] {
+                String::new()
+            } else {
+                format!(
+                    " moved by {},{} px",
+                    check.subpixel_offset[0], check.subpixel_offset[1]
+                )
+            },
+            settings.width,
+            settings.height,
+            settings.samples.max(1)
+        );
+    }
     let gpu = crate::common::open_gpu()?;
     if !a.json {
         println!("device: {}", gpu.describe());
@@ -435,6 +518,8 @@ fn json_report(
         out["graph_ok"] = json!(g.ok);
         out["problems"] = json!(g.problems);
         out["bad_copies"] = json!(g.bad_copies);
+        out["depth_only"] = json!(g.depth_only);
+        out["bridge"] = json!({ "claimed": g.bridge_claimed, "derived": g.bridge_derived });
     }
     if let Some((report, check)) = images {
         out["images_ok"] = json!(report.ok);
@@ -457,6 +542,7 @@ fn print_report(
     baked: &Path,
     graph: Option<&trisort_verify::GraphReport>,
     images: Option<&(ImageReport, ImageCheck)>,
+    measure_only: bool,
 ) {
     if let Some(report) = graph {
         let bad: Vec<_> = report.frames.iter().filter(|f| !f.ok()).collect();
@@ -470,6 +556,18 @@ fn print_report(
                 .iter()
                 .map(|f| f.unordered_samples)
                 .sum::<u64>()
+        );
+        println!(
+            "  order checked against: {}",
+            match (report.checked, report.depth_only) {
+                ("depth", _) => "the edges depth mode needs (a depth-only file, checked for --mode depth: ties, and edges behind translucent fragments)",
+                (_, true) => "every edge of E_f (a depth-only file checked for blend: it plays right only in depth mode; --mode depth checks it for that)",
+                _ => "every edge of E_f",
+            }
+        );
+        println!(
+            "  bridge: the file claims {}, its draws need {}",
+            report.bridge_claimed, report.bridge_derived
         );
         for p in &report.problems {
             println!("  {p}");
@@ -492,20 +590,28 @@ fn print_report(
             check.size.0,
             check.size.1,
             check.samples,
-            if report.at_recorded_pattern && report.on_other_device {
+            if measure_only {
+                "measured only: NOTHING VERIFIED, no frame can fail".to_string()
+            } else if report.at_recorded_pattern && report.on_other_device {
                 "recorded pattern, played on another device than recorded: checked all the same"
                     .to_string()
             } else if report.at_recorded_pattern {
                 "recorded pattern".to_string()
             } else {
-                match check.max_error {
-                    Some(m) => format!("off the recorded pattern, max error {m}/255"),
-                    None => "off the recorded pattern, measured only".to_string(),
-                }
+                format!(
+                    "off the recorded pattern, max error {}/255",
+                    check.max_error.unwrap_or(0)
+                )
             },
-            if report.ok { "OK" } else { "FAILED" },
+            if measure_only {
+                "measured"
+            } else if report.ok {
+                "OK"
+            } else {
+                "FAILED"
+            },
             report.frames.len(),
-            bad
+            if measure_only { 0 } else { bad }
         );
         println!(
             "  unordered (excused) pixels: {}",
@@ -523,7 +629,11 @@ fn print_report(
             println!(
                 "  {:5}  {:3} {:9}  {:7}  {:3}  {:7}  {:5.1}  {:.5}  {:9}  {}",
                 f.frame,
-                if f.ok { "yes" } else { "NO" },
+                match (measure_only, f.ok) {
+                    (true, _) => "-",
+                    (false, true) => "yes",
+                    (false, false) => "NO",
+                },
                 c.pixels_differing,
                 c.pixels_differing_ordered,
                 c.max_channel_diff,

@@ -91,8 +91,8 @@ fn same_identity(recordings: &[Recording], baked: &Baked, report: &mut GraphRepo
     same
 }
 
-/// What the file copies from recording `k`: the device, the geometry of G and the path (its
-/// frame count, every frame's camera and poses).
+/// What the file copies from recording `k`: the device, the frame rate, the geometry of G and
+/// the path (its frame count, every frame's camera and poses).
 fn same_content(k: usize, r: &Recording, baked: &Baked, report: &mut GraphReport) {
     if r.device != baked.device {
         report.problem(format!(
@@ -103,6 +103,12 @@ fn same_content(k: usize, r: &Recording, baked: &Baked, report: &mut GraphReport
     if let Some(what) = geometry_difference(&r.geometry, &baked.geometry) {
         report.problem(format!(
             "the baked geometry differs from recording {k}'s: {what}"
+        ));
+    }
+    if r.fps.map(f64::to_bits) != baked.fps.map(f64::to_bits) {
+        report.problem(format!(
+            "recording {k}: the frame rate ({:?} fps) differs from the baked file's ({:?})",
+            r.fps, baked.fps
         ));
     }
     let path = r.frame_states.len();

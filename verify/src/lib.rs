@@ -9,7 +9,8 @@
 //! 2. a drawn triangle that is not visible is allowed by the file's bridge policy: `hidden`
 //!    allows any such frame, `ignored` only frames where the triangle has no fragment
 //!    (t ∉ C_f), `visible` none;
-//! 3. with E_f* = E_f (or the tie edges of a depth-only bake) minus the file's removed edges of
+//! 3. with E_f* = E_f (or, for a depth-only bake checked for depth mode, the edges depth mode
+//!    needs: [`Recording::depth_mode_edges`]) minus the file's removed edges of
 //!    f: every removed edge is an edge of E_f with its weight, lies on a cycle of E_f (both
 //!    ends in one strongly connected component) and is *needed* (its head still reaches its
 //!    tail in E_f*, so keeping it alone would close a cycle); E_f* is acyclic; and for drawn
@@ -26,6 +27,14 @@
 //! determine (`index_triangles`, `source_triangles`, `unique_visible`, draws per frame,
 //! `drawn_not_visible_mean`, `unordered_samples`).
 //!
+//! The file's claims about its own merge are checked where the recordings and its draws
+//! decide them (issue 28): a depth-only file (`merge.depth_only`) is checked against the edges
+//! depth mode needs only when it is checked for depth mode ([`PlayedIn::Depth`]); for blend and saturate
+//! its order must hold every edge of E_f, as any other file's. The matrix cells
+//! (`merge.cells`) must tile the index buffer, each copy drawn in exactly its cell's frames;
+//! the frame rate must be the recording's; and the report names the strictest bridge policy
+//! the draws obey beside the one the file claims.
+//!
 //! [`cycle_edges`] is the same cycle test for others (the image check's unordered mask).
 #![deny(missing_docs)]
 
@@ -35,6 +44,19 @@ mod rule3;
 
 use serde::Serialize;
 use trisort_format::{Baked, Bridge, FrameRecord, Recording};
+
+/// The compositing a file is checked for: which of the recording's edges its order must hold.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlayedIn {
+    /// Blend or saturate (no depth test): every edge of E_f.
+    #[default]
+    Blend,
+    /// Depth mode (depth test on): a depth-only file only the edges depth mode needs
+    /// ([`Recording::depth_mode_edges`]: ties, where the depth test keeps the first drawn, and
+    /// edges behind translucent fragments); any other file still every edge of E_f.
+    Depth,
+}
 
 pub use graph::cycle_edges;
 
@@ -91,6 +113,16 @@ pub struct GraphReport {
     /// Everything found that is not a per-frame count (structure, hashes, statistics) and the
     /// first examples of each per-frame violation, naming the frame and the edge.
     pub problems: Vec<String>,
+    /// Which edges the order was checked against: `"edges"` (E_f) or `"depth"` (a depth-only
+    /// file checked for depth mode: [`Recording::depth_mode_edges`], ties and the edges
+    /// behind translucent fragments).
+    pub checked: &'static str,
+    /// The bridge policy the file claims (`merge.bridge`).
+    pub bridge_claimed: Bridge,
+    /// The strictest bridge policy the file's draws obey (`visible` ⊂ `ignored` ⊂ `hidden`).
+    pub bridge_derived: Bridge,
+    /// Whether the file is depth-only (`merge.depth_only`): it plays right only in depth mode.
+    pub depth_only: bool,
 }
 
 const MAX_PROBLEMS: usize = 40;
@@ -121,13 +153,42 @@ struct Tally {
     visible: u64,
     /// Σ_f of the removed edges' weight.
     removed_weight: u64,
+    /// The strictest bridge policy the frames so far obey.
+    bridge: Bridge,
+}
+
+/// The laxer of two bridge policies (`visible` ⊂ `ignored` ⊂ `hidden`).
+fn wider(a: Bridge, b: Bridge) -> Bridge {
+    let rank = |x: Bridge| match x {
+        Bridge::Visible => 0,
+        Bridge::Ignored => 1,
+        Bridge::Hidden => 2,
+    };
+    if rank(a) >= rank(b) {
+        a
+    } else {
+        b
+    }
+}
+
+/// [`check_graph_for`] for blend and saturate ([`PlayedIn::Blend`]): every edge of E_f.
+pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
+    check_graph_for(recordings, baked, PlayedIn::Blend)
 }
 
 /// Checks rules 1–3 of every frame of `baked` against `recordings` (its frame ranges, any
-/// order), and what the file repeats from them. O(Σ_f (|E_f| + draws of f) + |G|) time plus
-/// one search inside its component per removed edge; never panics on malformed input.
-pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
-    let mut report = GraphReport::default();
+/// order), played as `played`, and what the file repeats from them. O(Σ_f (|E_f| + draws of
+/// f) + |G|) time plus one search inside its component per removed edge; never panics on
+/// malformed input.
+pub fn check_graph_for(recordings: &[Recording], baked: &Baked, played: PlayedIn) -> GraphReport {
+    let ties = baked.merge.depth_only && played == PlayedIn::Depth;
+    let mut report = GraphReport {
+        checked: if ties { "depth" } else { "edges" },
+        bridge_claimed: baked.merge.bridge,
+        bridge_derived: Bridge::Visible,
+        depth_only: baked.merge.depth_only,
+        ..GraphReport::default()
+    };
     if let Err(e) = baked.check_structure() {
         report.problems.push(format!("baked file structure: {e}"));
         return report;
@@ -139,6 +200,7 @@ pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
     let mut copies = Copies::new(baked.copies.len());
     let mut frame = FrameCheck {
         baked,
+        depth: ties.then(|| &recordings[0]),
         pos: vec![0; baked.scene_ids.len()],
         stamp: vec![u32::MAX; baked.scene_ids.len()],
     };
@@ -149,6 +211,8 @@ pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
     }
     files::check_stats(recordings, baked, &tally, &mut report);
     copies.check(baked, &mut report);
+    copies.check_cells(baked, &mut report);
+    report.bridge_derived = tally.bridge;
     report.ok = report.problems.is_empty()
         && report.bad_copies == 0
         && report.frames.iter().all(FrameReport::ok);
@@ -196,9 +260,67 @@ impl Copies {
     }
 }
 
+impl Copies {
+    /// The file's matrix cells (`merge.cells`, what `inspect --matrix` draws), where it lists
+    /// any: they tile the index buffer in order, and every copy of cell (i, j) is drawn in
+    /// exactly frames i..=j.
+    fn check_cells(&self, baked: &Baked, report: &mut GraphReport) {
+        let cells = &baked.merge.cells;
+        if cells.is_empty() {
+            return;
+        }
+        let mut next = 0u64;
+        let mut wrong = 0u64;
+        for (c, cell) in cells.iter().enumerate() {
+            let (a, n) = (cell.first_copy as u64, cell.triangles as u64);
+            if a != next || n == 0 || cell.first_frame > cell.last_frame {
+                report.problem(format!(
+                    "merge cell {c} (frames {}..={}, copies {a}..{}) does not follow cell {} in the index buffer, or is empty",
+                    cell.first_frame,
+                    cell.last_frame,
+                    a + n,
+                    c.wrapping_sub(1) as i64
+                ));
+                return;
+            }
+            next = a + n;
+            if next > self.first.len() as u64 {
+                break;
+            }
+            for k in a as usize..next as usize {
+                if self.frames[k] > 0
+                    && (self.first[k] != cell.first_frame || self.last[k] != cell.last_frame)
+                {
+                    wrong += 1;
+                    if wrong <= 3 {
+                        report.problem(format!(
+                            "copy {k} is drawn in frames {}..={}, its merge cell {c} says {}..={}",
+                            self.first[k], self.last[k], cell.first_frame, cell.last_frame
+                        ));
+                    }
+                }
+            }
+        }
+        if next != self.first.len() as u64 {
+            report.problem(format!(
+                "the merge cells cover copies 0..{next}, the index buffer holds {}",
+                self.first.len()
+            ));
+        }
+        if wrong > 3 {
+            report.problem(format!(
+                "{wrong} copies in all are drawn in other frames than their merge cell says"
+            ));
+        }
+    }
+}
+
 /// Rules 1–3 frame by frame, reusing per-triangle scratch.
 struct FrameCheck<'a> {
     baked: &'a Baked,
+    /// A recording (all have the same G and geometry) whose depth-mode edges rule 3 takes,
+    /// for a depth-only file checked for depth mode; `None`: every edge of E_f.
+    depth: Option<&'a Recording>,
     /// Per G-local triangle: its draw position + 1 in the frame of `stamp`.
     pos: Vec<u64>,
     /// Per G-local triangle: the frame that last drew it.
@@ -249,9 +371,23 @@ impl FrameCheck<'_> {
         let distinct = drawn_count - fm.drawn_twice;
         fm.drawn_not_visible =
             distinct.saturating_sub((visible.len() as u64).saturating_sub(fm.visible_missing));
-        self.bridge(&covered, &visible, &mut fm);
+        self.bridge(&covered, &visible, &mut fm, tally);
         let rule3 = rule3::Rule3 { f, ids };
-        rule3.check(baked, fr, &|t| drawn(t).then(|| pos[t]), &mut fm, report);
+        let depth_edges;
+        let source = match self.depth {
+            Some(rec) => {
+                depth_edges = rec.depth_mode_edges(fr);
+                &depth_edges
+            }
+            None => &fr.edges,
+        };
+        rule3.check(
+            baked,
+            source,
+            &|t| drawn(t).then(|| pos[t]),
+            &mut fm,
+            report,
+        );
         tally.removed_weight += fm.unordered_samples;
         fm
     }
@@ -290,21 +426,34 @@ impl FrameCheck<'_> {
         p
     }
 
-    /// Rule 2: counts the drawn-not-visible triangles the file's bridge policy forbids.
-    fn bridge(&self, covered: &[usize], visible: &[usize], fm: &mut FrameReport) {
+    /// Rule 2: counts the drawn-not-visible triangles the file's bridge policy forbids, and
+    /// widens the tally's derived policy to what the frame's draws need.
+    fn bridge(
+        &self,
+        covered: &[usize],
+        visible: &[usize],
+        fm: &mut FrameReport,
+        tally: &mut Tally,
+    ) {
         let f32_ = fm.frame;
+        // Drawn, not visible and covered (it has a fragment here): only `hidden` allows it.
+        let hidden = covered
+            .iter()
+            .filter(|&&t| self.stamp[t] == f32_ && visible.binary_search(&t).is_err())
+            .count() as u64;
+        let needs = if hidden > 0 {
+            Bridge::Hidden
+        } else if fm.drawn_not_visible > 0 {
+            Bridge::Ignored
+        } else {
+            Bridge::Visible
+        };
+        tally.bridge = wider(tally.bridge, needs);
         match self.baked.merge.bridge {
             Bridge::Hidden => {}
             // No triangle may be drawn where it is not visible.
             Bridge::Visible => fm.bridge_violations += fm.drawn_not_visible,
-            // Drawn, not visible and covered: not allowed.
-            Bridge::Ignored => {
-                for &t in covered {
-                    if self.stamp[t] == f32_ && visible.binary_search(&t).is_err() {
-                        fm.bridge_violations += 1;
-                    }
-                }
-            }
+            Bridge::Ignored => fm.bridge_violations += hidden,
         }
     }
 }

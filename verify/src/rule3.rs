@@ -1,7 +1,7 @@
 //! Rule 3 for one frame: the removed edges are edges of E_f that lie on a cycle and are
 //! needed, E_f* (E_f minus them) is acyclic, and the draw order respects E_f*.
 
-use trisort_format::{Baked, Edge, FrameRecord};
+use trisort_format::{Baked, Edge};
 
 use crate::graph::{Csr, Search};
 use crate::{FrameReport, GraphReport};
@@ -39,12 +39,13 @@ impl Rule3<'_> {
         format!("{}→{}", self.name(a), self.name(b))
     }
 
-    /// Checks rule 3 of the frame `fr` against the file's removed edges of the frame and its
-    /// draw positions (`draw(t)`: t's position if drawn), adding to `fm` and `report`.
+    /// Checks rule 3 of the frame against `source` (its E_f, or its tie edges), the file's
+    /// removed edges of the frame and its draw positions (`draw(t)`: t's position if drawn),
+    /// adding to `fm` and `report`.
     pub fn check(
         &self,
         baked: &Baked,
-        fr: &FrameRecord,
+        source: &[Edge],
         draw: &dyn Fn(usize) -> Option<u64>,
         fm: &mut FrameReport,
         report: &mut GraphReport,
@@ -55,11 +56,6 @@ impl Rule3<'_> {
             .map(Vec::as_slice)
             .unwrap_or(&[]);
         fm.unordered_samples = removed.iter().map(|e| e.weight as u64).sum();
-        let source = if baked.merge.depth_only {
-            &fr.ties
-        } else {
-            &fr.edges
-        };
         let fe = self.frame_edges(baked, source, removed, fm, report);
         let pairs: Vec<(usize, usize)> = fe.edges.iter().map(|e| (e.0, e.1)).collect();
         let graph = Csr::new(&pairs);
