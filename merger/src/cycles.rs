@@ -3,9 +3,10 @@
 //!
 //! Components are found without recursion (`scc.rs`; petgraph's `tarjan_scc`
 //! recurses once per vertex and overflows a rayon worker's stack on long chains). Each
-//! component that the exact reductions shrink to at most 16 vertices is solved exactly
-//! (`exact.rs`: every component of up to 24 edges or 16 vertices; real frames' cycles are
-//! tiny), the others by the weighted Eades–Lin–Smyth heuristic (`els.rs`). Afterwards every
+//! component that the exact reductions shrink to at most 20 vertices is solved exactly by a
+//! subset programme, and one of 21 to 32 by branch and bound where it proves its order
+//! optimal within its budget (`exact.rs`: every component of up to 30 edges or 20 vertices is
+//! exact; real frames' cycles are tiny), the others by the weighted Eades–Lin–Smyth heuristic (`els.rs`). Afterwards every
 //! removed edge whose re-insertion closes no cycle is put back (heaviest first), so the set is
 //! minimal on both paths: each removed edge lies on a cycle of the frame's graph and is
 //! needed, which the independent validator checks. Where the heuristic's set already has the
@@ -42,7 +43,8 @@ pub struct ArcSet {
 /// their order.
 ///
 /// Complexity: O(V + E) for the components; per component of E_c edges, O(E_c) for the exact
-/// reductions, then either at most 2¹⁶ · 16 steps for the exact programme or O(E_c log V)
+/// reductions, then either at most 2²⁰ · 20 steps for the exact programme, at most 10⁶ · 32
+/// for branch and bound, or O(E_c log V)
 /// for the heuristic; and O(E_c) per removed edge for the minimality pass (skipped for
 /// heuristic components where that would exceed ~5·10⁷ steps).
 ///

@@ -13,32 +13,48 @@
 //!    vertex is left (a cycle of 50,000 vertices shrinks to one vertex).
 //!
 //! After them every vertex has at least three edges, so a component of n vertices and m edges
-//! shrinks to n′ ≤ min(n, 2m/3, 2(m − n)) vertices (the reductions never raise m − n). A
-//! dynamic programme over vertex subsets then finds the best order of what is left: with
-//! cost(S) the least backward weight of an order of S placed first,
+//! shrinks to n′ ≤ min(n, 2m/3, 2(m − n)) vertices (the reductions never raise m − n). Up to
+//! [`MAX_PROGRAMME`] vertices a dynamic programme over vertex subsets finds the best order of
+//! what is left: with cost(S) the least backward weight of an order of S placed first,
 //! cost(S) = min over v ∈ S of cost(S \ v) + w(v → S \ v) (v last among S), O(2ⁿ′ · n′) with
-//! per-vertex tables of subset sums. Components that keep more than [`MAX_VERTICES`]
-//! vertices are left to the heuristic.
+//! per-vertex tables of subset sums. From there up to [`MAX_VERTICES`] vertices a branch and
+//! bound builds the order from the front (issue 28): each placed prefix S costs the weight
+//! of its backward edges, the rest R at least its edges into S plus Σ over pairs
+//! {u, v} ⊂ R of min(w(u → v), w(v → u)) (one edge of every pair points backwards in any
+//! order; the bound never falls as the prefix grows), a prefix
+//! reached again at no lower cost is not expanded twice, and the cheapest next vertex is
+//! tried first, so the first leaf is the greedy order. It proves its order optimal unless it
+//! expands more than [`BRANCH_BUDGET`] prefixes; then, as for bigger components, the
+//! heuristic decides.
 //!
 //! Ties: for every subset S the smallest vertex (in the component's ascending vertex order)
 //! that reaches cost(S) is put last, and a chain is cut at its incoming edge when both weigh
-//! the same, so the result depends only on the component's edges, in their order.
+//! the same; branch and bound keeps the first optimum it meets in its fixed search order. So
+//! the result depends only on the component's edges, in their order.
 
 use std::collections::HashMap;
 
-/// The most vertices a reduced component may keep to be solved exactly: the programme then
-/// takes at most 2¹⁶ · 16 ≈ 10⁶ steps and 0.6 MB (`merger/BENCHMARKS.md` § Cycle breaking
-/// measures it). This covers every component of up to 16 vertices, up to 24 edges (n′ ≤
-/// 2m/3), or with at most 8 more edges than vertices (n′ ≤ 2(m − n)).
-pub(crate) const MAX_VERTICES: usize = 16;
+/// The most vertices the subset programme takes: at most 2²⁰ · 20 ≈ 2·10⁷ steps and 9 MB
+/// (`BENCHMARKS.md` § Exact cycle cuts measures it). This covers every component of up to
+/// 20 vertices, up to 30 edges (n′ ≤ 2m/3), or with at most 10 more edges than vertices.
+pub(crate) const MAX_PROGRAMME: usize = 20;
+
+/// The most vertices a reduced component may keep to be solved exactly: above
+/// [`MAX_PROGRAMME`] by branch and bound, within [`BRANCH_BUDGET`].
+pub(crate) const MAX_VERTICES: usize = 32;
+
+/// The prefixes branch and bound may expand before it gives the component to the heuristic
+/// (each costs O(n′) and one map entry: at most about 40 MB).
+pub(crate) const BRANCH_BUDGET: u64 = 1_000_000;
 
 /// The edges `(from, to, weight)` of one component over local vertices.
 type Edges = [(u32, u32, u64)];
 
 /// The ids (positions in `le`) of a minimum-weight set of edges whose removal leaves the
 /// component acyclic, ascending; `None` if after the reductions more than `max_vertices`
-/// vertices are left. `n` vertices, `le` without self-loops. Linear time for the reductions,
-/// then O(2ⁿ′ · n′) with n′ ≤ `max_vertices`.
+/// vertices are left, or branch and bound runs out of its budget. `n` vertices, `le` without
+/// self-loops. Linear time for the reductions, then O(2ⁿ′ · n′) with n′ ≤ [`MAX_PROGRAMME`],
+/// or at most [`BRANCH_BUDGET`] · n′ steps above.
 pub(crate) fn solve(n: usize, le: &Edges, max_vertices: usize) -> Option<Vec<usize>> {
     let mut r = Reduced::new(n, le);
     r.contract_chains();
@@ -52,7 +68,11 @@ pub(crate) fn solve(n: usize, le: &Edges, max_vertices: usize) -> Option<Vec<usi
         .iter()
         .map(|b| (local(b.from), local(b.to), b.weight))
         .collect();
-    let order = best_order(verts.len(), &edges);
+    let order = if verts.len() <= MAX_PROGRAMME {
+        best_order(verts.len(), &edges)
+    } else {
+        branch_and_bound(verts.len(), &edges, BRANCH_BUDGET)?
+    };
     let mut pos = vec![0u32; verts.len()];
     for (p, &v) in order.iter().enumerate() {
         pos[v as usize] = p as u32;
@@ -113,6 +133,106 @@ pub(crate) fn best_order(n: usize, edges: &Edges) -> Vec<u32> {
         s &= !(1 << last[s]);
     }
     order
+}
+
+/// A vertex order of least backward weight of a graph of `n` vertices (at most 64) by branch
+/// and bound (module documentation), or `None` when that takes more than `budget` prefixes.
+pub(crate) fn branch_and_bound(n: usize, edges: &Edges, budget: u64) -> Option<Vec<u32>> {
+    assert!(n <= 64, "{n} vertices are too many for a 64-bit vertex set");
+    let mut w = vec![0u64; n * n];
+    for &(a, b, x) in edges {
+        w[a as usize * n + b as usize] += x;
+    }
+    let pair = |u: usize, v: usize| w[u * n + v].min(w[v * n + u]);
+    let full: u64 = if n == 64 { u64::MAX } else { (1u64 << n) - 1 };
+    let bound: u64 = (0..n)
+        .flat_map(|u| (u + 1..n).map(move |v| (u, v)))
+        .map(|(u, v)| pair(u, v))
+        .sum();
+    let mut search = Branch {
+        n,
+        w: &w,
+        full,
+        best: u64::MAX,
+        best_order: Vec::new(),
+        seen: HashMap::new(),
+        order: Vec::with_capacity(n),
+        left: budget,
+    };
+    search.place(0, 0, bound).then_some(search.best_order)
+}
+
+/// Branch and bound's state: the graph as a weight matrix, the best order found so far, the
+/// least cost each prefix set was reached at, and the budget left.
+struct Branch<'a> {
+    n: usize,
+    w: &'a [u64],
+    full: u64,
+    best: u64,
+    best_order: Vec<u32>,
+    seen: HashMap<u64, u64>,
+    order: Vec<u32>,
+    left: u64,
+}
+
+impl Branch<'_> {
+    /// Extends the prefix `placed` (cost `cost`, what is still to come bounded below by
+    /// `bound`: the rest's pairs, and the rest's edges into the prefix); false when the budget
+    /// ran out.
+    fn place(&mut self, placed: u64, cost: u64, bound: u64) -> bool {
+        if placed == self.full {
+            if cost < self.best {
+                self.best = cost;
+                self.best_order = self.order.clone();
+            }
+            return true;
+        }
+        if cost + bound >= self.best {
+            return true;
+        }
+        match self.seen.get(&placed) {
+            Some(&c) if c <= cost => return true,
+            _ => {}
+        }
+        if self.left == 0 {
+            return false;
+        }
+        self.left -= 1;
+        self.seen.insert(placed, cost);
+        let n = self.n;
+        let rest = self.full & !placed;
+        // Each candidate with the weight of its edges back into the prefix, and the bound's
+        // share of its pairs with the rest; cheapest first, then by vertex.
+        let mut next: Vec<(u64, u32, u64)> = Vec::with_capacity(rest.count_ones() as usize);
+        let mut r = rest;
+        while r != 0 {
+            let v = r.trailing_zeros() as usize;
+            r &= r - 1;
+            let (mut back, mut share, mut behind) = (0u64, 0u64, 0u64);
+            for u in 0..n {
+                let bit = 1u64 << u;
+                if placed & bit != 0 {
+                    back += self.w[v * n + u];
+                } else if u != v {
+                    share += self.w[v * n + u].min(self.w[u * n + v]);
+                    behind += self.w[u * n + v];
+                }
+            }
+            // The rest's bound loses v's pairs and its edges into the prefix (now cost), and
+            // gains the rest's edges into v (backward whatever comes next).
+            next.push((back, v as u32, bound - share - back + behind));
+        }
+        next.sort_unstable();
+        for (back, v, rest_bound) in next {
+            self.order.push(v);
+            let done = self.place(placed | 1u64 << v, cost + back, rest_bound);
+            self.order.pop();
+            if !done {
+                return false;
+            }
+        }
+        true
+    }
 }
 
 /// The sums of every subset of `w`: entry S is Σ w[k] over the bits k of S.
@@ -318,6 +438,41 @@ mod tests {
             let cut = solve(n, &edges, MAX_VERTICES).expect("n ≤ 16");
             prop_assert_eq!(cut.iter().map(|&e| edges[e].2).sum::<u64>(), best);
         }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+        /// Branch and bound finds an order as good as the subset programme's, on graphs dense
+        /// and sparse, with a ring through every vertex or without.
+        #[test]
+        fn branch_and_bound_matches_the_programme(
+            n in 2usize..15,
+            raw in proptest::collection::vec((0u32..15, 0u32..15, 0u64..20), 0..60),
+            ring in any::<bool>(),
+        ) {
+            let mut edges = graph(n, raw);
+            if ring {
+                edges.extend((0..n as u32).map(|v| (v, (v + 1) % n as u32, 1 + v as u64 % 3)));
+            }
+            let best = backward(&edges, &best_order(n, &edges));
+            let order = branch_and_bound(n, &edges, u64::MAX).expect("no budget");
+            let mut sorted = order.clone();
+            sorted.sort_unstable();
+            prop_assert_eq!(sorted, (0..n as u32).collect::<Vec<_>>());
+            prop_assert_eq!(backward(&edges, &order), best);
+        }
+    }
+
+    #[test]
+    fn branch_and_bound_gives_up_past_its_budget() {
+        // The complete digraph on 12 vertices, every weight 1: every order costs 66, which
+        // the bound proves once the first leaf is reached, after 12 prefixes.
+        let edges: Vec<(u32, u32, u64)> = (0..12u32)
+            .flat_map(|a| (0..12u32).filter(move |&b| b != a).map(move |b| (a, b, 1)))
+            .collect();
+        assert_eq!(branch_and_bound(12, &edges, 11), None);
+        let order = branch_and_bound(12, &edges, 12).expect("within the budget");
+        assert_eq!(backward(&edges, &order), 66);
     }
 
     #[test]
