@@ -143,7 +143,16 @@ pub enum FormatError {
 pub fn encode<T: Serialize>(kind: FileKind, value: &T) -> Vec<u8> {
     let raw =
         postcard::to_stdvec(value).expect("postcard serialization of trisort types cannot fail");
-    let packed = zstd::encode_all(&raw[..], 3).expect("zstd compression into memory cannot fail");
+    encode_payload(kind, &raw)
+}
+
+/// Wraps a postcard payload `raw` (whatever it holds) in a correct container: compressed,
+/// with the right lengths and checksum. What [`encode`] writes; the fuzz targets and the
+/// mutation fuzz (`scripts/mutation-fuzz.sh`) use it to reach the payload's decoding and the
+/// structure checks past the checksum.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn encode_payload(kind: FileKind, raw: &[u8]) -> Vec<u8> {
+    let packed = zstd::encode_all(raw, 3).expect("zstd compression into memory cannot fail");
     let mut out = Vec::with_capacity(HEADER_LEN + packed.len());
     out.extend_from_slice(kind.magic());
     out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());

@@ -12,13 +12,5 @@ pub fn file_bytes(kind: FileKind, data: &[u8]) -> Option<Vec<u8>> {
     if mode & 1 == 0 {
         return Some(body.to_vec());
     }
-    let packed = zstd::encode_all(body, 1).ok()?;
-    let mut out = Vec::with_capacity(60 + packed.len());
-    out.extend_from_slice(kind.magic());
-    out.extend_from_slice(&trisort_format::FORMAT_VERSION.to_le_bytes());
-    out.extend_from_slice(&(packed.len() as u64).to_le_bytes());
-    out.extend_from_slice(&(body.len() as u64).to_le_bytes());
-    out.extend_from_slice(blake3::hash(&packed).as_bytes());
-    out.extend_from_slice(&packed);
-    Some(out)
+    Some(trisort_format::container::encode_payload(kind, body))
 }
