@@ -17,7 +17,9 @@
 //!    a, b with b reachable from a in E_f* through any triangles (drawn or not), a is drawn
 //!    before b. The order is checked in linear time: in a topological order of E_f*, each
 //!    vertex carries the latest draw position of any drawn ancestor, and every drawn vertex
-//!    must come after it. The removed weight is the frame's `unordered_samples`.
+//!    must come after it. The removed weight is the frame's `unordered_samples`. In every
+//!    cyclic component of at most 20 triangles the removed weight is also the least possible
+//!    (an exact subset programme of the validator's own), as the merger's exact cut makes it.
 //!
 //! It also runs [`Baked::check_structure`] and every recording's
 //! [`Recording::check_structure`] first, and compares what the file repeats from the
@@ -67,7 +69,8 @@ pub struct FrameReport {
     pub frame: u32,
     /// Rule 3: drawn triangles drawn before some drawn ancestor in E_f* (reachable through
     /// any triangles), plus one if E_f* has a cycle, plus removed edges that are not edges of
-    /// E_f, lie on no cycle or are not needed.
+    /// E_f, lie on no cycle or are not needed, plus one per component whose cut is heavier
+    /// than the least (`cut_excess`).
     pub graph_violations: u64,
     /// Total weight of the removed intra-frame cycle edges of this frame.
     pub unordered_samples: u64,
@@ -77,6 +80,12 @@ pub struct FrameReport {
     /// Rule 3: removed edges on a cycle whose head does not reach their tail in E_f minus the
     /// removed edges (keeping them would close no cycle).
     pub removed_not_needed: u64,
+    /// Rule 3: samples the file's cut removes beyond the least cut, over the cyclic
+    /// components of at most 20 triangles (solved exactly here, as the merger solves them).
+    pub cut_excess: u64,
+    /// Cyclic components of more than 20 triangles: their cut is checked to be needed, not
+    /// to be least.
+    pub cut_components_unbounded: u64,
     /// Rule 1: visible triangles not drawn.
     pub visible_missing: u64,
     /// Rule 1: triangles drawn more than once.

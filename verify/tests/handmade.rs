@@ -481,3 +481,43 @@ fn a_cycle_through_forty_thousand_triangles() {
     assert!(r.ok, "{:?}", r.problems);
     assert_eq!(r.frames[0].unordered_samples, 1);
 }
+
+/// Issue 28: a cut that is on a cycle and needed, but heavier than the least, fails. In frame
+/// 1 of [`cyclic_recording`] (A → H 2, H → B 2, B → A 1) removing H → B (2 samples) and drawing
+/// B, A, H keeps every other edge, yet B → A alone (1 sample) suffices.
+#[test]
+fn a_heavier_cut_than_the_least_is_rejected() {
+    let rec = cyclic_recording();
+    let recs = std::slice::from_ref(&rec);
+    // Buffer [A, B, B, A, H]: frame 0 draws A, B; frame 1 draws B, A, H.
+    let mut b = baked(
+        &rec,
+        Bridge::Ignored,
+        vec![0, 2, 2, 0, 1],
+        &[(0, 2)],
+        &[(2, 3)],
+    );
+    b.removed_edges = vec![
+        vec![],
+        vec![Edge {
+            from: 1,
+            to: 2,
+            weight: 2,
+        }],
+    ];
+    restat(&mut b, &rec);
+    let r = check_graph(recs, &b);
+    assert!(!r.ok);
+    assert_eq!(r.frames[1].cut_excess, 1, "{:?}", r.frames[1]);
+    assert_eq!(
+        r.frames[1].removed_not_needed + r.frames[1].removed_not_on_cycle,
+        0
+    );
+    assert!(
+        r.problems
+            .iter()
+            .any(|p| p.contains("removes 2 samples where 1 suffice")),
+        "{:?}",
+        r.problems
+    );
+}
