@@ -49,6 +49,21 @@ fn bake_and_merge_store_the_environment_they_are_given() {
     // 128×64 + 64×32 + … + 4×2 texels of 8 bytes.
     assert_eq!(e["bytes"], 10_920 * 8);
     assert!(e["sun"].is_null(), "an .hdr file has no sun: {e}");
+    // `verify --environment` makes the light anew and compares (issue 28): the .hdr file it
+    // was baked with passes, the studio does not.
+    let v = run_json(d, &["verify", "sky.baked", "--environment", "sky.hdr"]);
+    assert_eq!(
+        (v["ok"].as_bool(), &v["environment"]["difference"]),
+        (Some(true), &serde_json::Value::Null),
+        "{v}"
+    );
+    let out = run(
+        d,
+        &["verify", "sky.baked", "--environment", "studio"],
+        false,
+    );
+    assert_eq!(out.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("is not studio: named \"sky.hdr\""));
 
     // Merging the recording again: the studio by default and by name.
     for extra in [&[][..], &["--environment", "studio"][..]] {

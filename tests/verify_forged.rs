@@ -427,3 +427,31 @@ fn forged_cells_and_frame_rate_are_rejected() {
     fps.fps = Some(fps.fps.unwrap_or(30.0) * 2.0);
     h.rejected("fps", &fps, &[], &["the frame rate"]);
 }
+
+/// Issue 28: the stored light is a claim too. The built-in studio is made anew and compared
+/// by `verify --recording` and by `verify --environment studio`; a moved sun fails both.
+#[test]
+fn a_forged_sun_is_rejected() {
+    let Some(h) = honest() else { return };
+    let d = h.dir.path();
+    let v = run_json(d, &args("verify car.baked --environment studio"));
+    assert_eq!(v["ok"], true, "{v}");
+    assert_eq!(v["environment"]["checked"], "given", "{v}");
+    let mut forged = h.baked.clone();
+    let sun = forged
+        .environment
+        .sun
+        .as_mut()
+        .expect("the studio has a sun");
+    sun.direction = [0.0, -1.0, 0.0];
+    h.rejected(
+        "sun",
+        &forged,
+        &[],
+        &["claims to be the built-in studio but differs: sun"],
+    );
+    let out = run(d, &args("verify sun.baked --environment studio"), false);
+    assert_eq!(out.status.code(), Some(3));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("environment: FAILED"), "{text}");
+}

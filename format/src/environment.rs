@@ -242,6 +242,53 @@ impl Environment {
         self.levels.iter().map(|l| l.len() as u64 * 2).sum()
     }
 
+    /// What differs between this environment and `expected` (made anew from the same source),
+    /// or `None`: name, sizes, exposure and sun exactly (bit for bit), the spherical harmonics
+    /// and every texel within 1 % relative (plus 10⁻³ absolute) — the prefilter's float
+    /// arithmetic may round differently on another machine, a forged light differs by far
+    /// more. What a validator checks a file's claimed light by (issue 28).
+    pub fn difference(&self, expected: &Environment) -> Option<String> {
+        let close = |a: f32, b: f32| (a - b).abs() <= 1e-3 + 0.01 * a.abs().max(b.abs());
+        if self.name != expected.name {
+            return Some(format!("named {:?}, not {:?}", self.name, expected.name));
+        }
+        if (self.width, self.height, self.levels.len())
+            != (expected.width, expected.height, expected.levels.len())
+        {
+            return Some(format!(
+                "{}x{} with {} levels, not {}x{} with {}",
+                self.width,
+                self.height,
+                self.levels.len(),
+                expected.width,
+                expected.height,
+                expected.levels.len()
+            ));
+        }
+        let bits =
+            |s: Option<Sun>| s.map(|s| (s.direction.map(f32::to_bits), s.color.map(f32::to_bits)));
+        if bits(self.sun) != bits(expected.sun) {
+            return Some(format!("sun {:?}, not {:?}", self.sun, expected.sun));
+        }
+        if self.exposure.to_bits() != expected.exposure.to_bits() {
+            return Some(format!(
+                "exposure {}, not {}",
+                self.exposure, expected.exposure
+            ));
+        }
+        let sh = self.sh.iter().flatten().zip(expected.sh.iter().flatten());
+        if sh.clone().any(|(&a, &b)| !close(a, b)) {
+            return Some("irradiance (spherical harmonics) differs".into());
+        }
+        for (k, (a, b)) in self.levels.iter().zip(&expected.levels).enumerate() {
+            let f = |x: &u16| half::f16::from_bits(*x).to_f32();
+            if a.len() != b.len() || a.iter().zip(b).any(|(x, y)| !close(f(x), f(y))) {
+                return Some(format!("radiance level {k} differs"));
+            }
+        }
+        None
+    }
+
     /// The RGB radiance stored at texel (x, y) of level `k` (panics outside the level).
     pub fn texel(&self, k: usize, x: u32, y: u32) -> [f32; 3] {
         let (w, _) = self.level_size(k);

@@ -52,6 +52,15 @@ pub struct MergeOpts {
 /// `--environment`'s name of the built-in studio.
 const STUDIO: &str = "studio";
 
+/// An `--environment` light: `studio`, the built-in studio, or an .hdr file loaded and
+/// prefiltered (an error naming the file when it cannot be).
+pub fn load_environment(spec: &str) -> Result<Environment> {
+    if spec == STUDIO {
+        return Ok(Environment::studio());
+    }
+    Ok(trisort_scene::load_hdr(std::path::Path::new(spec))?)
+}
+
 impl MergeOpts {
     /// The command line's defaults: [`MergeOptions::default`].
     pub fn defaults() -> MergeOpts {
@@ -70,12 +79,7 @@ impl MergeOpts {
     /// The `--environment` light: the built-in studio, or the .hdr file loaded and prefiltered
     /// (an error naming the file when it cannot be).
     pub fn environment(&self) -> Result<Environment> {
-        if self.environment == STUDIO {
-            return Ok(Environment::studio());
-        }
-        Ok(trisort_scene::load_hdr(std::path::Path::new(
-            &self.environment,
-        ))?)
+        load_environment(&self.environment)
     }
 
     /// The merger's options (`--segment 0`: no segments).

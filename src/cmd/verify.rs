@@ -97,6 +97,12 @@ pub struct VerifyArgs {
     /// vertex snapping. Off the recorded pattern: measured, failing only above --max-error.
     #[arg(long, value_name = "X,Y", value_parser = crate::cmd::play::parse_subpixel_offset, allow_hyphen_values = true)]
     subpixel_offset: Option<[f64; 2]>,
+    /// The light the file was baked with (`studio`, or the .hdr file given to
+    /// `bake`/`merge --environment`): made anew and compared with the file's stored
+    /// environment, which fails the file when it differs. Without it `--recording` checks a
+    /// file that names the built-in studio, and a file light is reported as not checked.
+    #[arg(long, value_name = "studio|FILE.hdr")]
+    environment: Option<String>,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -280,9 +286,17 @@ fn write_diff(dir: &Path, v: &VerifiedFrame, size: (u32, u32)) -> Result<()> {
 
 pub fn run(a: VerifyArgs) -> Result<ExitCode> {
     let baked: Baked = trisort_player::open_baked(&a.baked)?;
-    if a.recording.is_empty() && a.scene.is_none() {
-        bail!("nothing to verify against: give --recording REC (graph rules) and/or --scene SCENE (images)");
+    if a.recording.is_empty() && a.scene.is_none() && a.environment.is_none() {
+        bail!("nothing to verify against: give --recording REC (graph rules) and/or --scene SCENE (images), or --environment studio|FILE.hdr (the stored light)");
     }
+    // The stored light against the one named (None: not asked).
+    let environment = match &a.environment {
+        None => None,
+        Some(spec) => {
+            let expected = crate::cmd::merge::load_environment(spec)?;
+            Some(baked.environment.difference(&expected))
+        }
+    };
     let recs = read_recordings(&a.recording)?;
     let played = match a.mode {
         Mode::Depth => trisort_verify::PlayedIn::Depth,
@@ -301,7 +315,8 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             Err(e) => return Err(e),
         },
     };
-    let graph_ok = graph.as_ref().is_none_or(|g| g.ok);
+    let graph_ok =
+        graph.as_ref().is_none_or(|g| g.ok) && environment.as_ref().is_none_or(|d| d.is_none());
     // Measured only: the images cannot fail, and they did not pass either.
     let images_ok = images.as_ref().is_none_or(|i| a.measure_only || i.0.ok);
     let unverified = a.measure_only && images.is_some();
@@ -329,7 +344,16 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         }
         v["image_check"] = json!(check);
         v["graph_check"] = json!(graph.as_ref().map(|g| g.checked));
-        v["verified"] = json!(!unverified && (graph.is_some() || images.is_some()));
+        v["verified"] = json!(!unverified);
+        v["environment"] = json!({
+            "name": baked.environment.name,
+            "checked": match (&a.environment, graph.is_some()) {
+                (Some(_), _) => "given",
+                (None, true) if baked.environment.name == "studio" => "studio",
+                _ => "no",
+            },
+            "difference": environment.clone().flatten(),
+        });
         if unverified {
             // Measured, not judged: no frame passed or failed.
             v["images_ok"] = Value::Null;
@@ -340,6 +364,19 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         print_json(&v);
     } else {
         print_report(&a.baked, graph.as_ref(), images.as_ref(), a.measure_only);
+        let name = &baked.environment.name;
+        match (&environment, &a.environment) {
+            (Some(Some(what)), Some(spec)) => {
+                println!("environment: FAILED: the stored light ({name:?}) is not {spec}: {what}")
+            }
+            (Some(None), Some(spec)) => println!("environment: OK (the stored light is {spec})"),
+            _ if graph.is_some() && name == "studio" => {
+                println!("environment: checked with the graph rules (the built-in studio)")
+            }
+            _ => println!(
+                "environment: {name:?}, not checked (give --environment FILE.hdr, the light it was baked with)"
+            ),
+        }
         println!(
             "{}: {}",
             a.baked.display(),

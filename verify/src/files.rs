@@ -30,6 +30,18 @@ pub(crate) fn collect_frames<'a>(
     for (k, r) in recordings.iter().enumerate() {
         same_content(k, r, baked, report);
     }
+    // The light the file claims: the built-in studio is made anew and compared (a file
+    // light from an .hdr file is checked by `trisort verify --environment FILE.hdr`).
+    if baked.environment.name == "studio" {
+        if let Some(what) = baked
+            .environment
+            .difference(&trisort_format::Environment::studio())
+        {
+            report.problem(format!(
+                "the file's environment claims to be the built-in studio but differs: {what}"
+            ));
+        }
+    }
     let mut hashes: Vec<_> = recordings.iter().map(Recording::content_hash).collect();
     let mut expected = baked.recording_hashes.clone();
     hashes.sort_unstable();
