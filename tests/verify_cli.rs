@@ -119,6 +119,12 @@ fn off_pattern_is_checked_only_with_max_error_or_measured_only_on_request() {
     assert!(v["frames"][0]["ok"].is_null(), "{v}");
     let max = v["frames"][0]["max_channel_diff_ordered"].as_u64().unwrap();
     assert!(max > 0, "holes show at twice the size: {v}");
+    // And they are told apart from order errors: samples the file does not draw.
+    let f = &v["frames"][0];
+    assert!(
+        f["hole_pixels"].as_u64().unwrap() > f["order_error_pixels"].as_u64().unwrap(),
+        "{f}"
+    );
     let text = run(
         dir.path(),
         &[&off_pattern[..], &["--measure-only"]].concat(),

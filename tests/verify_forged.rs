@@ -180,6 +180,9 @@ fn every_edge_removed_and_the_cells_reversed_is_rejected() {
     let f = &v["frames"][0];
     assert_eq!(f["ok"], false, "{f}");
     assert!(f["pixels_differing_ordered"].as_u64().unwrap() > 0, "{f}");
+    // Every triangle is drawn, in the wrong order: order errors, no hole.
+    assert_eq!(f["hole_pixels"], 0, "{f}");
+    assert!(f["order_error_pixels"].as_u64().unwrap() > 0, "{f}");
     eprintln!(
         "every-edge images: frame 0 {} pixels differ on ordered pixels, by up to {}/255; {} unordered samples",
         f["pixels_differing_ordered"], f["max_channel_diff_ordered"], f["unordered_samples"]

@@ -241,6 +241,11 @@ pub struct ReferenceFrame {
     pub layers: u32,
     /// Whether the peel stopped at `max_layers` with fragments left.
     pub truncated: bool,
+    /// Per sample (`pixel · samples + s`): the scene id + 1 of the first fragment composited
+    /// (the nearest in the tie rule's order; in `depth`, the first the depth test passes)
+    /// that is not of a triangle whose every fragment has alpha 0; 0 where the sample has
+    /// none. What a verifier tells holes by.
+    pub front: Vec<u32>,
 }
 
 /// Composite-pass resources of one layer.
@@ -260,6 +265,10 @@ pub struct ExactReference<'g> {
     /// planes ([`TieRule`]).
     shape: Geometry,
     frames: Vec<FrameState>,
+    /// Per scene triangle: whether every fragment of it has alpha 0 (glass at opacity 0, a
+    /// blend material of alpha 0): it is composited but shows nothing, so it is no sample's
+    /// front ([`ReferenceFrame::front`]).
+    clear: Vec<bool>,
     peeler: Peeler<'g>,
     scene: SceneGpu,
     pipeline: wgpu::RenderPipeline,
@@ -385,6 +394,14 @@ impl<'g> ExactReference<'g> {
                 ..Geometry::default()
             },
             frames: frames.to_vec(),
+            clear: (0..geometry.triangles.len() as u32)
+                .map(|t| {
+                    geometry
+                        .materials
+                        .get(geometry.triangle_material(t) as usize)
+                        .is_some_and(|m| m.factor_opacity(config.glass_opacity) <= 0.0)
+                })
+                .collect(),
             peeler,
             scene,
             pipeline,
@@ -456,6 +473,8 @@ impl<'g> ExactReference<'g> {
         // how many samples still wait for it; the peel stops when none does.
         let gate =
             std::cell::RefCell::new((vec![f32::NAN; if depth_mode { slots } else { 0 }], 0usize));
+        let mut front = vec![0u32; slots];
+        let clear = &self.clear;
         let mut settle = |i: usize, (id, depth): (u32, f32), layer_ids: &mut Vec<Vec<u32>>| {
             if let (Some(r), Some(edges)) = (unordered, edges) {
                 if r.in_g.get((id - 1) as usize) == Some(&true) {
@@ -477,6 +496,9 @@ impl<'g> ExactReference<'g> {
                     return;
                 }
                 written[i] = depth;
+            }
+            if front[i] == 0 && !clear.get((id - 1) as usize).copied().unwrap_or(false) {
+                front[i] = id;
             }
             let k = placed[i] as usize;
             placed[i] += 1;
@@ -547,6 +569,7 @@ impl<'g> ExactReference<'g> {
             unordered_samples,
             layers,
             truncated,
+            front,
         })
     }
 

@@ -100,6 +100,15 @@ pub struct FrameImageReport {
     /// The player's (or the captured) frame against the reference.
     #[serde(flatten)]
     pub comparison: Comparison,
+    /// Samples whose nearest fragment in the reference (in the tie rule's order; in `depth`,
+    /// the first the depth test passes) is of a triangle the file does not draw in the frame.
+    pub hole_samples: u64,
+    /// Pixels that differ (depth: at all; blend, saturate: by more than 1/255) and have a
+    /// hole sample: something the file should draw is missing.
+    pub hole_pixels: u64,
+    /// Ordered pixels that differ as much without a hole sample: what is drawn is drawn in
+    /// the wrong order (or wrongly otherwise).
+    pub order_error_pixels: u64,
     /// Peel layers of the reference.
     pub layers: u32,
     /// Whether the reference peel was cut at its layer bound.
@@ -181,6 +190,56 @@ pub struct ImageVerifier<'g> {
     reference: ExactReference<'g>,
     srgb8: Option<Srgb8Player<'g>>,
     unordered: Option<UnorderedEdges>,
+    /// What the file draws, for telling holes: the scene id of every copy, and per frame its
+    /// draws' copy ranges.
+    drawn: Drawn,
+}
+
+/// The triangles each frame of a baked file draws, by scene id.
+struct Drawn {
+    /// Scene id of each copy (`u32::MAX` for a G-local id outside `scene_ids`).
+    copies: Vec<u32>,
+    /// Per frame: half-open copy ranges.
+    frames: Vec<Vec<(u32, u32)>>,
+    /// Triangles of the scene.
+    scene_triangles: usize,
+}
+
+impl Drawn {
+    fn new(baked: &Baked, scene_triangles: usize) -> Drawn {
+        let scene = |t: u32| baked.scene_ids.get(t as usize).copied().unwrap_or(u32::MAX);
+        Drawn {
+            copies: baked.copies.iter().map(|&t| scene(t)).collect(),
+            frames: (0..baked.frames.len())
+                .map(|f| {
+                    baked
+                        .frame_draws(f)
+                        .iter()
+                        .map(|d| (d.first_index / 3, (d.first_index + d.index_count) / 3))
+                        .collect()
+                })
+                .collect(),
+            scene_triangles,
+        }
+    }
+
+    /// Per scene triangle: whether frame `f` draws it.
+    fn of_frame(&self, f: u32) -> Vec<bool> {
+        let mut out = vec![false; self.scene_triangles];
+        for &(a, b) in self
+            .frames
+            .get(f as usize)
+            .map(Vec::as_slice)
+            .unwrap_or(&[])
+        {
+            for &t in self.copies.get(a as usize..b as usize).unwrap_or(&[]) {
+                if let Some(x) = out.get_mut(t as usize) {
+                    *x = true;
+                }
+            }
+        }
+        out
+    }
 }
 
 impl<'g> ImageVerifier<'g> {
@@ -262,6 +321,7 @@ impl<'g> ImageVerifier<'g> {
             reference,
             srgb8,
             unordered: truth.unordered,
+            drawn: Drawn::new(baked, geometry.triangles.len()),
         };
         if check.subpixel_offset != [0.0, 0.0] {
             verifier.shift(check.subpixel_offset);
@@ -336,6 +396,38 @@ impl<'g> ImageVerifier<'g> {
         let (w, h) = self.check.size;
         let reference = self.reference.render(frame, self.unordered.as_ref())?;
         let comparison = compare(&test, &reference.rgba8, w, h, &reference.unordered);
+        // Holes: samples whose nearest fragment is of a triangle the file does not draw in
+        // this frame. A differing pixel with one is a hole pixel, any other differing ordered
+        // pixel an order error (depth: any difference; blend, saturate: over 1/255).
+        let drawn = self.drawn.of_frame(frame);
+        let samples = (reference.front.len() / (w as usize * h as usize).max(1)).max(1);
+        let mut hole_pixel = vec![false; w as usize * h as usize];
+        let mut hole_samples = 0u64;
+        for (i, &id) in reference.front.iter().enumerate() {
+            if id != 0 && !drawn.get(id as usize - 1).copied().unwrap_or(false) {
+                hole_samples += 1;
+                if let Some(p) = hole_pixel.get_mut(i / samples) {
+                    *p = true;
+                }
+            }
+        }
+        let tolerance = if self.check.mode == Mode::Depth { 0 } else { 1 };
+        let (mut hole_pixels, mut order_error_pixels) = (0u64, 0u64);
+        for p in 0..hole_pixel.len() {
+            let d = test[p * 4..p * 4 + 3]
+                .iter()
+                .zip(&reference.rgba8[p * 4..p * 4 + 3])
+                .map(|(a, b)| a.abs_diff(*b))
+                .max()
+                .unwrap_or(0);
+            if d > tolerance {
+                if hole_pixel[p] {
+                    hole_pixels += 1;
+                } else if !reference.unordered.get(p).copied().unwrap_or(false) {
+                    order_error_pixels += 1;
+                }
+            }
+        }
         let srgb8 = srgb8.map(|img| compare(&img, &reference.rgba8, w, h, &reference.unordered));
         let ok = if self.at_pattern {
             !reference.truncated
@@ -358,6 +450,9 @@ impl<'g> ImageVerifier<'g> {
                 .map_or(0, |u| u.recorded_weight(frame)),
             unordered_pixels: reference.unordered.iter().filter(|&&u| u).count() as u64,
             comparison,
+            hole_samples,
+            hole_pixels,
+            order_error_pixels,
             layers: reference.layers,
             truncated: reference.truncated,
             srgb8,

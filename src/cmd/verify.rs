@@ -651,6 +651,9 @@ fn print_report(
             if measure_only { 0 } else { bad }
         );
         println!(
+            "  holes: differing pixels where the reference's nearest fragment is of a triangle the file does not draw; order: other differing ordered pixels"
+        );
+        println!(
             "  unordered (excused) pixels: {}",
             if graph.is_some() {
                 "those with a sample on a cycle of the recording's E_f"
@@ -659,12 +662,12 @@ fn print_report(
             }
         );
         println!(
-            "  frame  ok  differing  ordered  max  max_ord  psnr   flip     unordered  srgb8_max"
+            "  frame  ok  differing  ordered  max  max_ord  psnr   flip     unordered  holes  order  srgb8_max"
         );
         for f in &report.frames {
             let c = &f.comparison;
             println!(
-                "  {:5}  {:3} {:9}  {:7}  {:3}  {:7}  {:5.1}  {:.5}  {:9}  {}",
+                "  {:5}  {:3} {:9}  {:7}  {:3}  {:7}  {:5.1}  {:.5}  {:9}  {:5}  {:5}  {}",
                 f.frame,
                 match (measure_only, f.ok) {
                     (true, _) => "-",
@@ -678,6 +681,8 @@ fn print_report(
                 c.psnr,
                 c.flip_mean,
                 f.unordered_samples,
+                f.hole_pixels,
+                f.order_error_pixels,
                 f.srgb8
                     .map(|s| s.max_channel_diff.to_string())
                     .unwrap_or_else(|| "-".into())
