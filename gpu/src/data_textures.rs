@@ -1,4 +1,4 @@
-//! Group 0 on the data-texture tier ([`crate::Bindings::Textures`], `wgsl/textures.wgsl`): node
+//! Group 0 on the data-texture tier ([`crate::Bindings::Textures`], `shaders/common/textures.wgsl`): node
 //! matrices of every frame and the materials as Rgba32Float texels, [`DATA_WIDTH`] a row, and a
 //! per-frame uniform with the frame's first node, bound by dynamic offset where the storage
 //! tier binds the frame's matrices. GLES 3.0 / WebGL2 read these in the vertex stage, where

@@ -33,10 +33,10 @@ pub mod scene_gpu;
 pub use scene_gpu::{Bindings, Lighting, Shading, ToneMap};
 
 /// The shared bindings, vertex layout, vertex transform and surface functions.
-pub const COMMON: &str = include_str!("wgsl/common.wgsl");
+pub const COMMON: &str = include_str!("../../shaders/common/common.wgsl");
 
 /// The GPU smoke test's fragment entry point (`fs_smoke`); compose with [`smoke_shader`].
-pub const SMOKE: &str = include_str!("wgsl/smoke.wgsl");
+pub const SMOKE: &str = include_str!("../../shaders/common/smoke.wgsl");
 
 /// The complete smoke-test shader: [`COMMON`], the plain pass's vertex stage (`vs_plain`) and
 /// [`SMOKE`]'s `fs_smoke`, which colours each triangle by its material.
@@ -45,11 +45,11 @@ pub fn smoke_shader() -> String {
 }
 
 /// Entry points of the player (`vs_player`, `fs_player_straight`, `fs_player_premultiplied`).
-pub const PLAYER: &str = include_str!("wgsl/player.wgsl");
+pub const PLAYER: &str = include_str!("../../shaders/play/player.wgsl");
 
 /// The exact reference's compositing entry points (`fs_reference_straight`,
 /// `fs_reference_premultiplied`); compose with [`reference_shader`].
-pub const REFERENCE: &str = include_str!("wgsl/reference.wgsl");
+pub const REFERENCE: &str = include_str!("../../shaders/reference/reference.wgsl");
 
 /// The complete shader of the exact reference's compositing passes: [`COMMON`], the player's
 /// [`PLAYER`] entry points and the reference's own (needs `Features::PRIMITIVE_INDEX`). The
@@ -60,15 +60,15 @@ pub fn reference_shader() -> String {
 
 /// The recorder's vertex stage (`vs_record`, `RecordVarying`), shared by [`PEEL`] and
 /// [`CAPTURE`] so both rasterize the same positions.
-pub const RECORD_VERTEX: &str = include_str!("wgsl/record_vertex.wgsl");
+pub const RECORD_VERTEX: &str = include_str!("../../shaders/record/record_vertex.wgsl");
 
 /// Depth peeling's fragment stage (`fs_peel`, after [`RECORD_VERTEX`]); compose with
 /// [`peel_shader`].
-pub const PEEL: &str = include_str!("wgsl/peel.wgsl");
+pub const PEEL: &str = include_str!("../../shaders/record/peel.wgsl");
 
 /// The recorder's fragment capture (`fs_capture`, after [`RECORD_VERTEX`]): every fragment of every
 /// sample in one pass, pushed on per-sample lists; compose with [`capture_shader`].
-pub const CAPTURE: &str = include_str!("wgsl/capture.wgsl");
+pub const CAPTURE: &str = include_str!("../../shaders/record/capture.wgsl");
 
 /// The complete fragment-capture shader (needs `Features::PRIMITIVE_INDEX` and writable
 /// storage in fragment shaders); with `early_depth_test`, its fragment stage forces the depth
@@ -89,7 +89,7 @@ pub fn capture_shader(early_depth_test: bool) -> String {
 
 /// The grown capture's fragment stage (`fs_capture_grown`, after [`GROW`]'s `vs_grown`); compose with
 /// [`capture_grown_shader`].
-pub const CAPTURE_GROWN: &str = include_str!("wgsl/capture_grown.wgsl");
+pub const CAPTURE_GROWN: &str = include_str!("../../shaders/record/capture_grown.wgsl");
 
 /// The complete grown-capture shader: [`COMMON`], the capture's bindings and functions
 /// ([`CAPTURE`], group 1), [`GROW`] in group 2 and [`CAPTURE_GROWN`]: the one-pass form of
@@ -111,7 +111,7 @@ pub fn capture_grown_shader() -> String {
 pub const ENVELOPE_ID_BITS: u32 = 24;
 
 /// The compute pass that gathers a peel layer per sample; compose with [`gather_shader`].
-pub const GATHER: &str = include_str!("wgsl/gather.wgsl");
+pub const GATHER: &str = include_str!("../../shaders/record/gather.wgsl");
 
 /// The id texture type, the depth texture type and the sample argument of a `textureLoad` at
 /// sample `sample`, for a sample count: multisampled textures for `samples > 1`, plain ones
@@ -172,7 +172,7 @@ pub fn gather_shader(samples: u32) -> String {
 }
 
 /// The plain benchmark pass (`vs_plain`, `fs_plain`); compose with [`plain_shader`].
-pub const PLAIN: &str = include_str!("wgsl/plain.wgsl");
+pub const PLAIN: &str = include_str!("../../shaders/reference/plain.wgsl");
 
 /// The complete plain benchmark shader.
 pub fn plain_shader() -> String {
@@ -181,7 +181,7 @@ pub fn plain_shader() -> String {
 
 /// The per-sample linked-list OIT renderer's entry points (`fs_oit_list`,
 /// `vs_oit_fullscreen`, `fs_oit_resolve`); compose with [`oit_shader`].
-pub const OIT: &str = include_str!("wgsl/oit.wgsl");
+pub const OIT: &str = include_str!("../../shaders/reference/oit.wgsl");
 
 /// The complete OIT shader: [`COMMON`], the player's [`PLAYER`] entry points (`vs_player`,
 /// `player_colour`) and [`OIT`] with a per-sample sort array of `max_sorted` entries (needs
@@ -199,7 +199,7 @@ pub fn oit_shader(max_sorted: u32) -> String {
 /// The GPU-only depth peeling renderer's entry points (`fs_peeling`, which finds the next
 /// layer by the recorder's (depth, id) key, and `fs_peeling_composite`, which shades a layer's
 /// samples through the player's `player_colour`); compose with [`peeling_shader`].
-pub const PEELING: &str = include_str!("wgsl/peeling.wgsl");
+pub const PEELING: &str = include_str!("../../shaders/reference/peeling.wgsl");
 
 /// The complete depth peeling shader for a sample count: [`COMMON`], the player's [`PLAYER`]
 /// entry points (`vs_player`, `player_colour`) and [`PEELING`] with its texture types and
@@ -229,11 +229,11 @@ pub fn peeling_shader(samples: u32) -> String {
 
 /// Triangles grown or shrunk by a tolerance box, pulled from storage (bindings in group
 /// `CONS_GROUP`); the base of [`conservative_shader`] and [`peel_grown_shader`].
-pub const GROW: &str = include_str!("wgsl/grow.wgsl");
+pub const GROW: &str = include_str!("../../shaders/record/grow.wgsl");
 
 /// The recorder's conservative visibility passes (`vs_erode`/`fs_erode`,
 /// `vs_dilate`/`fs_mark`); compose with [`conservative_shader`].
-pub const CONSERVATIVE: &str = include_str!("wgsl/conservative.wgsl");
+pub const CONSERVATIVE: &str = include_str!("../../shaders/record/conservative.wgsl");
 
 /// The complete conservative visibility shader for a sample count: [`COMMON`], [`GROW`] in
 /// group 1 and [`CONSERVATIVE`] with its texture types, per-sample loads and sample count
@@ -263,7 +263,7 @@ pub fn conservative_shader(samples: u32) -> String {
 
 /// The grown peel's fragment stage (`fs_peel_grown`, after [`GROW`]'s `vs_grown`); compose with
 /// [`peel_grown_shader`].
-pub const PEEL_GROWN: &str = include_str!("wgsl/peel_grown.wgsl");
+pub const PEEL_GROWN: &str = include_str!("../../shaders/record/peel_grown.wgsl");
 
 /// The complete grown-peel shader for a sample count: [`COMMON`], the peel's bindings and
 /// entry points ([`PEEL`], group 1), [`GROW`] in group 2 and [`PEEL_GROWN`] (needs
@@ -282,7 +282,7 @@ pub fn peel_grown_shader(samples: u32) -> String {
 }
 
 /// The coverage test's entry point (`fs_coverage`); compose with [`coverage_shader`].
-pub const COVERAGE: &str = include_str!("wgsl/coverage.wgsl");
+pub const COVERAGE: &str = include_str!("../../shaders/common/coverage.wgsl");
 
 /// The complete shader of the recorder's coverage test: [`COMMON`], the player's [`PLAYER`]
 /// entry points (`vs_player`) and [`COVERAGE`] (needs `Features::PRIMITIVE_INDEX`).
@@ -292,7 +292,7 @@ pub fn coverage_shader() -> String {
 
 /// The window viewer's copy of a frame to its surface (`vs_blit`, `fs_blit`); stand-alone (no
 /// shared bindings): see [`blit_shader`].
-pub const BLIT: &str = include_str!("wgsl/blit.wgsl");
+pub const BLIT: &str = include_str!("../../shaders/play/blit.wgsl");
 
 /// The complete blit shader: `under` puts `background` (linear RGB) under the frame's
 /// premultiplied colour (`saturate` mode), `encode_srgb` applies the sRGB transfer function in
@@ -366,9 +366,9 @@ pub fn compose_with(bindings: Bindings, enables: &[&str], body: &str) -> String 
 }
 
 /// Binding prelude of [`Bindings::Storage`]: node matrices and materials in storage buffers.
-pub const STORAGE_BINDINGS: &str = include_str!("wgsl/storage.wgsl");
+pub const STORAGE_BINDINGS: &str = include_str!("../../shaders/common/storage.wgsl");
 /// Binding prelude of [`Bindings::Textures`]: node matrices and materials in data textures.
-pub const TEXTURE_BINDINGS: &str = include_str!("wgsl/textures.wgsl");
+pub const TEXTURE_BINDINGS: &str = include_str!("../../shaders/common/textures.wgsl");
 
 /// Size in bytes of the `Frame` uniform of [`COMMON`].
 pub const FRAME_UNIFORM_SIZE: u64 = 64 + 16 + 16 + 48;

@@ -1,6 +1,6 @@
 //! Presenting frames in a window: the surface configuration the window viewer uses and the
 //! blit from the player's linear `Rgba16Float` frame to the surface ([`Blit`], shader
-//! `wgsl/blit.wgsl`). The window shows the pixels of the PNG frames (within rounding of the
+//! `shaders/play/blit.wgsl`). The window shows the pixels of the PNG frames (within rounding of the
 //! GPU's `pow`): the blit encodes sRGB itself and writes through a non-sRGB view where the
 //! surface allows one.
 

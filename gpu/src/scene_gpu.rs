@@ -67,7 +67,7 @@ pub struct LightingUniform {
 }
 
 /// The pipeline-overridable constants that specialise a pipeline's surface function to
-/// `shading` (`SHADING_MODEL` in `wgsl/common.wgsl`), so it compiles only this model's code; for
+/// `shading` (`SHADING_MODEL` in `shaders/common/common.wgsl`), so it compiles only this model's code; for
 /// the fragment stage of pipelines whose module includes the common WGSL. Without them the
 /// model is chosen at run time from the lighting uniform.
 pub fn shading_constants(shading: Shading) -> &'static [(&'static str, f64)] {
@@ -214,11 +214,11 @@ fn align(x: u64, a: u64) -> u64 {
 /// a shader is composed with ([`crate::compose_with`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Bindings {
-    /// Storage buffers read in the vertex stage (`wgsl/storage.wgsl`).
+    /// Storage buffers read in the vertex stage (`shaders/common/storage.wgsl`).
     #[default]
     Storage,
     /// Rgba32Float data textures read with `textureLoad`, and a per-frame uniform naming the
-    /// frame's first node (`wgsl/textures.wgsl`): GLES 3.0 / WebGL2, which have no storage
+    /// frame's first node (`shaders/common/textures.wgsl`): GLES 3.0 / WebGL2, which have no storage
     /// buffers in the vertex stage.
     Textures,
 }

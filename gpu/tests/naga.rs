@@ -22,19 +22,25 @@ fn a_broken_shader_is_caught() {
     assert!(naga::front::wgsl::parse_str(&source).is_err());
 }
 
-/// Every WGSL file of the crate's shader folder reaches the validation above: each file's text
-/// is part of at least one composed shader of `trisort_gpu::all()` (a new file that no
+/// Every WGSL file of the repository lies in the top-level `shaders/` (grouped by stage:
+/// `common/`, `record/`, `play/`, `reference/`), and each reaches the validation above: its
+/// text is part of at least one composed shader of `trisort_gpu::all()` (a new file that no
 /// composition uses fails here).
 #[test]
 fn every_wgsl_file_is_validated() {
     let all = trisort_gpu::all();
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/wgsl");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the workspace root")
+        .to_path_buf();
+    let shaders = root.join("shaders");
     let mut files = 0;
-    for entry in std::fs::read_dir(&dir).expect("gpu/src/wgsl") {
-        let path = entry.expect("directory entry").path();
-        if path.extension().is_none_or(|e| e != "wgsl") {
-            continue;
-        }
+    for path in wgsl_files(&root) {
+        assert!(
+            path.starts_with(&shaders),
+            "{} lies outside shaders/: every WGSL file lives there",
+            path.display()
+        );
         files += 1;
         let text = std::fs::read_to_string(&path).expect("readable WGSL");
         // Placeholders (runs of capitals such as PREV_IDS_TYPE or UNDER) are filled in before
@@ -54,8 +60,29 @@ fn every_wgsl_file_is_validated() {
         );
     }
     assert!(
-        files >= 11,
+        files >= 19,
         "found only {files} WGSL files in {}",
-        dir.display()
+        shaders.display()
     );
+}
+
+/// The `.wgsl` files under `dir`, skipping build output, dependencies and hidden folders.
+fn wgsl_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for entry in std::fs::read_dir(&d).expect("a readable folder") {
+            let path = entry.expect("directory entry").path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            if path.is_dir() {
+                if !(name.starts_with('.') || name == "target" || name == "node_modules") {
+                    todo.push(path);
+                }
+            } else if path.extension().is_some_and(|e| e == "wgsl") {
+                out.push(path);
+            }
+        }
+    }
+    out.sort();
+    out
 }

@@ -1,4 +1,4 @@
-//! Fragment capture: every fragment of a frame in one render pass (`gpu/src/wgsl/capture.wgsl`)
+//! Fragment capture: every fragment of a frame in one render pass (`shaders/record/capture.wgsl`)
 //! instead of one depth-peeling pass per layer.
 //!
 //! A peel layer is, per sample, the next fragment in (depth, id) order among the fragments

@@ -2,7 +2,7 @@
 //! capture, or inside [`crate::with_conservative_passes`]; where a device captures, phase 1
 //! takes the envelope bound of `envelope.rs` instead, which has no sample-spacing blind spot):
 //! the triangles that can win a sample when the sample pattern moves by up to the tolerance,
-//! found in three render passes per frame (see `gpu/src/wgsl/conservative.wgsl`):
+//! found in three render passes per frame (see `shaders/record/conservative.wgsl`):
 //! 1. the opaque triangles as rasterized at the recorded pattern write their plane's farthest
 //!    depth over a box of ±(tolerance + 0.55) px: the nearest opaque surface, raised by its
 //!    slope;

@@ -2,7 +2,7 @@
 //! where the device can capture): the triangles that can be nearest at some point of a
 //! sample's tolerance box, with no sample-spacing assumption.
 //!
-//! One grown capture a frame (`fs_capture_envelope` in `gpu/src/wgsl/capture_grown.wgsl`)
+//! One grown capture a frame (`fs_capture_envelope` in `shaders/record/capture_grown.wgsl`)
 //! lists, per sample, every triangle that meets the sample's box of ±tolerance pixels, with its
 //! plane's nearest and farthest depth over the box. For an opaque triangle it also says which of
 //! its edges cross the box, and which of those are *closable*: the triangle across the edge

@@ -12,11 +12,11 @@
 //! primitive ids and writable storage in fragment shaders (`capture::supported`; lavapipe and
 //! most desktop Vulkan drivers have both, neither is required by Vulkan), one render pass
 //! captures every fragment of the frame on per-sample lists and the host sorts each list
-//! (`capture.rs`, `gpu/src/wgsl/capture.wgsl`; conservative recording's grown peel likewise,
+//! (`capture.rs`, `shaders/record/capture.wgsl`; conservative recording's grown peel likewise,
 //! `capture_grown.wgsl`). Elsewhere each layer is one depth-peeling render pass: triangles in
 //! ascending id order, depth test `Less`, the depth written explicitly, and fragments whose
 //! (depth, id) key is not greater than the previous layer's at that sample discarded (see
-//! `gpu/src/wgsl/peel.wgsl`); samples that are finished are masked so later layers do no work
+//! `shaders/record/peel.wgsl`); samples that are finished are masked so later layers do no work
 //! there. Both give the same layers, so the same recordings (test `capture_matches_peeling`).
 #![deny(missing_docs)]
 

@@ -6,7 +6,7 @@
 //! front; `saturate`: front to back, under) through the player's vertex shader, its
 //! `player_colour`, its blend state and its `Rgba16Float` target, one render pass with one draw
 //! per layer: each triangle of a layer writes only the samples where the peel found it in that
-//! layer (`@builtin(sample_mask)`, see `gpu/src/wgsl/reference.wgsl`); shading stays per
+//! layer (`@builtin(sample_mask)`, see `shaders/reference/reference.wgsl`); shading stays per
 //! pixel as in the player. The pass resolves MSAA like the headless player and the result is
 //! quantized once with [`quantize_rgba16f`].
 //!

@@ -4,7 +4,7 @@
 //! Every frame draws the *whole scene* (every triangle, ascending ids, one draw, no depth test)
 //! once into per-sample linked lists, then resolves them with one full-screen pass:
 //!
-//! 1. **List pass** (`fs_oit_list` in `gpu/src/wgsl/oit.wgsl`): the player's `vs_player`
+//! 1. **List pass** (`fs_oit_list` in `shaders/reference/oit.wgsl`): the player's `vs_player`
 //!    and `player_colour`, shaded once per covered sample (`@builtin(sample_index)`). Each
 //!    fragment with alpha > 0 takes a node of a fixed pool with an atomic counter
 //!    (straight-alpha colour as f32, depth, scene triangle id from
