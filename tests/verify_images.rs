@@ -48,6 +48,7 @@ fn bake(
         range: None,
         phase: Phase::Graphs,
         known_visible: None,
+        internals: Default::default(),
     };
     let rec = record(gpu, &job, None, |_| {}).expect("recording succeeds");
     let baked = trisort_merger::merge(std::slice::from_ref(&rec), &Default::default())

@@ -413,6 +413,7 @@ fn run_real(
         range: None,
         phase: Phase::Graphs,
         known_visible: None,
+        internals: Default::default(),
     };
     progress(&format!(
         "{axis}: recording {triangles} triangles, {n} frames ({spec}) at {}x{} {}x",

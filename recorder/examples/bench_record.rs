@@ -8,7 +8,7 @@
 //! frames only), and prints seconds per frame of each phase, peel passes per frame, bytes
 //! read back per frame, peak memory, and a peel pass's cost relative to a plain pass over the
 //! same triangles, measured in the same run. With `compare`, first the same by depth peeling
-//! (`with_peeling`: one pass per layer, the recorder until 2026-12-02), then as shipped (one
+//! (`Internals::peel`: one pass per layer, the recorder until 2026-12-02), then as shipped (one
 //! capture pass a frame where the device can), in one process, and checks that both
 //! recordings are identical. With `costs`, only the pass costs (no recording); with `record`
 //! or `peel`, one recording as shipped or by peeling and its peak memory (no pass costs).
@@ -20,7 +20,7 @@ use trisort_format::{Phase, RecordSettings};
 use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
 use trisort_recorder::{
-    bench::pass_cost, capture_counters, readback_counters, record, with_peeling, RecordJob,
+    bench::pass_cost, capture_counters, readback_counters, record, Internals, RecordJob,
 };
 
 fn peak_rss_mib() -> f64 {
@@ -87,6 +87,7 @@ fn main() {
         range: None,
         phase: Phase::Graphs,
         known_visible: None,
+        internals: Default::default(),
     };
     println!("device: {}", gpu.describe());
     println!("scene: {} ({} triangles), path {} ({} frames, every {stride}th: {} recorded), {size}x{size} at {samples}x", scene.name, scene.geometry.triangles.len(), args[2], timeline.frames.len(), frames.len());
@@ -96,7 +97,15 @@ fn main() {
         samples,
         glass_opacity: 0.0,
     };
-    let run = || {
+    let peel = Internals {
+        peel: true,
+        ..Internals::default()
+    };
+    let run = |internals: Internals| {
+        let job = RecordJob {
+            internals,
+            ..job.clone()
+        };
         let mut last = (Instant::now(), counters(), cpu_seconds());
         // Per frame of each phase: wall seconds, layers peeled (including the last, empty,
         // one), bytes read back, CPU seconds.
@@ -128,17 +137,17 @@ fn main() {
         // One recording (as shipped, or by peeling), no pass costs: the peak memory is the
         // recording's.
         if mode == "peel" {
-            with_peeling(run);
+            run(peel);
         } else {
-            run();
+            run(Internals::default());
         }
         println!("peak RSS {:.0} MiB", peak_rss_mib());
         return;
     } else if compare {
         println!("\nbefore: depth peeling, one pass a layer");
-        let before = with_peeling(run);
+        let before = run(peel);
         println!("\nafter: one capture pass a frame");
-        let after = run();
+        let after = run(Internals::default());
         let bytes = |r: &Recording| postcard::to_stdvec(r).expect("serialises");
         let same = bytes(&before) == bytes(&after);
         println!("\nrecordings identical: {same}");
@@ -146,7 +155,7 @@ fn main() {
             std::process::exit(1);
         }
     } else {
-        run();
+        run(Internals::default());
     }
     println!("\npass costs (medians of 5 interleaved repeats):");
     for f in [0u32, (frames.len() / 2) as u32] {

@@ -47,7 +47,15 @@ pub fn pass_cost(
     let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
     let peeler = Peeler::new(gpu, geometry, &all, frames, view)?.with_readback(true, false);
     let mut capture = if crate::capture::supported(gpu) {
-        Some(Capture::new(gpu, geometry, &all, frames, view, true)?)
+        Some(Capture::new(
+            gpu,
+            geometry,
+            &all,
+            frames,
+            view,
+            true,
+            &Default::default(),
+        )?)
     } else {
         None
     };

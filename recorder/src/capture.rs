@@ -79,6 +79,8 @@ pub(crate) struct Capture<'g> {
     /// Phase 1's depth pass of the always-opaque triangles, drawn before the capture.
     prepass: Option<Prepass>,
     view: View,
+    /// First pool and most fragments a pass ([`crate::Internals::pool_limits`]).
+    pool_limits: Option<(u64, u64)>,
 }
 
 /// The triangles among those drawn whose every fragment is opaque (alpha mode OPAQUE, not glass
@@ -128,8 +130,18 @@ impl<'g> Capture<'g> {
         frames: &[FrameState],
         view: View,
         until_opaque: bool,
+        internals: &crate::Internals,
     ) -> Result<Self, RecordError> {
-        Capture::build(gpu, geometry, triangles, frames, view, until_opaque, None)
+        Capture::build(
+            gpu,
+            geometry,
+            triangles,
+            frames,
+            view,
+            until_opaque,
+            None,
+            internals,
+        )
     }
 
     /// [`Capture::new`] over the triangles grown by a tolerance box (`capture_grown.wgsl`):
@@ -146,10 +158,21 @@ impl<'g> Capture<'g> {
         frames: &[FrameState],
         view: View,
         grow: Grow,
+        internals: &crate::Internals,
     ) -> Result<Self, RecordError> {
-        Capture::build(gpu, geometry, triangles, frames, view, false, Some(grow))
+        Capture::build(
+            gpu,
+            geometry,
+            triangles,
+            frames,
+            view,
+            false,
+            Some(grow),
+            internals,
+        )
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn build(
         gpu: &'g Gpu,
         geometry: &Geometry,
@@ -158,6 +181,7 @@ impl<'g> Capture<'g> {
         view: View,
         until_opaque: bool,
         grow: Option<Grow>,
+        internals: &crate::Internals,
     ) -> Result<Self, RecordError> {
         let device = &gpu.device;
         // Before anything is allocated: the list heads must fit one binding.
@@ -172,7 +196,7 @@ impl<'g> Capture<'g> {
                 slots * 4
             )));
         }
-        let scene = crate::peeler::visibility_scene(gpu, geometry, frames, view);
+        let scene = crate::peeler::visibility_scene(gpu, geometry, frames, view, internals);
         let until_opaque = until_opaque
             && device
                 .features()
@@ -453,12 +477,13 @@ impl<'g> Capture<'g> {
             pool: None,
             prepass,
             view,
+            pool_limits: internals.pool_limits,
         };
         // A fragment a sample to begin with, at most 4 Mi (64 MiB): a frame's pass that asks
         // for more is drawn again with room for what it asked plus an eighth, kept for later
         // frames.
-        let first = POOL_LIMITS
-            .with(|c| c.get())
+        let first = internals
+            .pool_limits
             .map_or(slots.min(1 << 22), |(first, _)| first);
         capture.grow(first.min(capture.pool_limit()));
         Ok(capture)
@@ -806,33 +831,16 @@ pub fn capture_counters() -> [u64; 4] {
     std::array::from_fn(|k| COUNTERS[k].load(Relaxed))
 }
 
-thread_local! {
-    /// See [`with_pool_limits`].
-    static POOL_LIMITS: std::cell::Cell<Option<(u64, u64)>> =
-        const { std::cell::Cell::new(None) };
-}
-
-/// Runs `f` with captures set up inside it starting with a pool of `first` nodes (instead of
-/// one a sample) and holding at most `most` fragments a pass (instead of what one storage
-/// binding holds), so that tests can make a frame grow its pool and split into bands on any
-/// device.
-#[doc(hidden)]
-pub fn with_pool_limits<R>(first: u64, most: u64, f: impl FnOnce() -> R) -> R {
-    crate::peeler::with_switch(&POOL_LIMITS, Some((first, most)), f)
-}
-
 impl Capture<'_> {
     /// Most nodes one pool holds: one storage binding, a readback buffer of the pool and the
-    /// heads within the device's largest buffer, node indices + 1 in a u32 ([`with_pool_limits`]
-    /// may lower it).
+    /// heads within the device's largest buffer, node indices + 1 in a u32
+    /// ([`crate::Internals::pool_limits`] may lower it).
     fn pool_limit(&self) -> u64 {
         let limits = self.gpu.device.limits();
         let nodes = (binding_limit(&self.gpu.device) / NODE_BYTES)
             .min(limits.max_buffer_size.saturating_sub(self.heads.size()) / NODE_BYTES)
             .min(u32::MAX as u64 - 1);
-        POOL_LIMITS
-            .with(|c| c.get())
-            .map_or(nodes, |(_, most)| most.min(nodes))
+        self.pool_limits.map_or(nodes, |(_, most)| most.min(nodes))
     }
 }
 

@@ -1,5 +1,5 @@
 //! Conservative visibility by three passes (`record --conservative` on devices that cannot
-//! capture, or inside [`crate::with_conservative_passes`]; where a device captures, phase 1
+//! capture, or with [`crate::Internals::conservative_passes`]; where a device captures, phase 1
 //! takes the envelope bound of `envelope.rs` instead, which has no sample-spacing blind spot):
 //! the triangles that can win a sample when the sample pattern moves by up to the tolerance,
 //! found in three render passes per frame (see `shaders/record/conservative.wgsl`):
@@ -259,9 +259,10 @@ impl<'g> Conservative<'g> {
         frames: &[FrameState],
         view: View,
         robust: &Robust,
+        internals: &crate::Internals,
     ) -> Result<Conservative<'g>, RecordError> {
         let device = &gpu.device;
-        let scene = crate::peeler::visibility_scene(gpu, geometry, frames, view);
+        let scene = crate::peeler::visibility_scene(gpu, geometry, frames, view, internals);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("conservative"),
             source: wgpu::ShaderSource::Wgsl(trisort_gpu::conservative_shader(view.samples).into()),

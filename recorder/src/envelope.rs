@@ -210,6 +210,7 @@ impl<'g> Envelope<'g> {
         frames: &[FrameState],
         view: View,
         robust: &Robust,
+        internals: &crate::Internals,
     ) -> Result<Envelope<'g>, RecordError> {
         if !Envelope::fits(geometry) {
             return Err(RecordError::Unsupported(format!(
@@ -221,7 +222,7 @@ impl<'g> Envelope<'g> {
         let all: Vec<u32> = (0..geometry.triangles.len() as u32).collect();
         let adjacency = Adjacency::new(geometry, &all);
         let grow = Grow::Envelope(robust, &adjacency.opposite);
-        let capture = Capture::grown(gpu, geometry, &all, frames, view, grow)?;
+        let capture = Capture::grown(gpu, geometry, &all, frames, view, grow, internals)?;
         Ok(Envelope {
             capture: RefCell::new(capture),
             neighbour: adjacency.neighbour,

@@ -42,12 +42,37 @@ use trisort_gpu::scene_gpu::View;
 use trisort_gpu::Gpu;
 
 #[doc(hidden)]
-pub use capture::{capture_counters, with_pool_limits};
+pub use capture::capture_counters;
 pub use conservative::Conservative;
 use partial::{Graph, Visibility};
 #[doc(hidden)]
-pub use peeler::{readback_counters, with_full_texture_upload, with_interleaved_readback};
+pub use peeler::readback_counters;
 pub use peeler::{Layer, Peeler};
+
+/// How the recorder works inside. The default is how recordings are made; every other value
+/// makes the same recordings by another route (the recorder's tests check that each does),
+/// for tests that compare the routes and benchmarks that measure what one saves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Internals {
+    /// Peel one render pass per layer even where the device can capture every fragment of a
+    /// frame in one pass (what devices without primitive ids and fragment storage do).
+    pub peel: bool,
+    /// `--conservative`: take phase 1's extra triangles from the three conservative passes
+    /// ([`Conservative`]) even where the device can capture the envelope bound (what devices
+    /// without capture do).
+    pub conservative_passes: bool,
+    /// Peelers gather every layer interleaved (16 bytes a sample, unpacked sample by
+    /// sample), and phase 1 lists visible triangles sample by sample when it peels: the
+    /// former readback.
+    pub interleaved_readback: bool,
+    /// Upload every texture as a player does instead of only what visibility reads (the
+    /// linear maps are left out).
+    pub full_texture_upload: bool,
+    /// Captures start with a pool of this many nodes (instead of one a sample) and hold at
+    /// most this many fragments a pass (instead of what one storage binding holds), so that
+    /// a frame grows its pool and splits into bands on any device.
+    pub pool_limits: Option<(u64, u64)>,
+}
 
 /// Errors while recording.
 #[derive(Debug, thiserror::Error)]
@@ -86,6 +111,8 @@ pub struct RecordJob<'a> {
     /// For phase 2 of a range: G from the union of phase-1 recordings of the whole path; `None`
     /// to run phase 1 over every frame of the path first.
     pub known_visible: Option<Vec<u32>>,
+    /// How the recorder works inside (the default: as recordings are made).
+    pub internals: Internals,
 }
 
 /// Progress reports while recording.
@@ -130,30 +157,6 @@ fn view_of(s: &RecordSettings) -> View {
     }
 }
 
-thread_local! {
-    /// See [`with_peeling`].
-    static PEELING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-    static CONSERVATIVE_PASSES: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Runs `f` with `--conservative` recordings made inside it taking phase 1's extra triangles
-/// from the three conservative passes ([`Conservative`]: the nearest opaque surface as samples
-/// see it, spread over their neighbours) even where the device can capture the envelope bound
-/// (`envelope.rs`). The passes are what devices without capture use; kept callable so tests
-/// can record with them on any device.
-#[doc(hidden)]
-pub fn with_conservative_passes<R>(f: impl FnOnce() -> R) -> R {
-    peeler::with_switch(&CONSERVATIVE_PASSES, true, f)
-}
-
-/// Runs `f` with recordings made inside it by depth peeling, one pass per layer, even where the
-/// device can capture every fragment in one pass. Kept so that tests and the benchmark can show
-/// that both give the same recordings, and what capturing saves.
-#[doc(hidden)]
-pub fn with_peeling<R>(f: impl FnOnce() -> R) -> R {
-    peeler::with_switch(&PEELING, true, f)
-}
-
 /// Whether `gpu` can capture fragments (and so bound `--conservative`'s envelope) rather than
 /// only peel: for tests that check what capturing alone does.
 #[doc(hidden)]
@@ -163,9 +166,9 @@ pub fn can_capture(gpu: &Gpu) -> bool {
 
 /// Whether recordings on `gpu` capture (one pass a frame) rather than peel: the device can
 /// ([`capture::supported`]: primitive ids and writable storage in fragment shaders), and
-/// [`with_peeling`] does not ask for peeling.
-fn captures(gpu: &Gpu) -> bool {
-    capture::supported(gpu) && !PEELING.with(|c| c.get())
+/// `internals` do not ask for peeling.
+fn captures(gpu: &Gpu, internals: &Internals) -> bool {
+    capture::supported(gpu) && !internals.peel
 }
 
 /// Where a phase's layers come from: one capture pass a frame, or one peel pass a layer.
@@ -188,8 +191,8 @@ enum Purpose {
 }
 
 impl<'g> Layers<'g> {
-    /// Capture where the device can (and [`with_peeling`] does not say otherwise), else peel,
-    /// as `purpose` needs.
+    /// Capture where the device can (and `internals` do not say otherwise), else peel, as
+    /// `purpose` needs.
     fn new(
         gpu: &'g Gpu,
         geometry: &Geometry,
@@ -197,24 +200,30 @@ impl<'g> Layers<'g> {
         frames: &[FrameState],
         view: View,
         purpose: Purpose,
+        internals: &Internals,
     ) -> Result<Self, RecordError> {
-        let (g, t, f) = (geometry, triangles, frames);
-        if captures(gpu) {
+        let (g, t, f, i) = (geometry, triangles, frames, internals);
+        if captures(gpu, internals) {
             let c = match purpose {
-                Purpose::Visibility => capture::Capture::new(gpu, g, t, f, view, true)?,
-                Purpose::Graphs => capture::Capture::new(gpu, g, t, f, view, false)?,
+                Purpose::Visibility => capture::Capture::new(gpu, g, t, f, view, true, i)?,
+                Purpose::Graphs => capture::Capture::new(gpu, g, t, f, view, false, i)?,
                 Purpose::Grown(robust) => {
-                    capture::Capture::grown(gpu, g, t, f, view, capture::Grow::Peel(&robust))?
+                    let grow = capture::Grow::Peel(&robust);
+                    capture::Capture::grown(gpu, g, t, f, view, grow, i)?
                 }
             };
             return Ok(Layers::Capture(std::cell::RefCell::new(c)));
         }
         Ok(Layers::Peel(match purpose {
-            Purpose::Visibility => Peeler::new(gpu, g, t, f, view)?.with_readback(true, false),
+            Purpose::Visibility => {
+                Peeler::build(gpu, g, t, f, view, None, i)?.with_readback(true, false)
+            }
             // Opacity too: the tie rule's order may reach a triangle before saturation.
-            Purpose::Graphs => Peeler::new(gpu, g, t, f, view)?.with_readback(true, true),
+            Purpose::Graphs => {
+                Peeler::build(gpu, g, t, f, view, None, i)?.with_readback(true, true)
+            }
             Purpose::Grown(robust) => {
-                Peeler::grown(gpu, g, t, f, view, &robust)?.with_readback(false, true)
+                Peeler::build(gpu, g, t, f, view, Some(&robust), i)?.with_readback(false, true)
             }
         }))
     }
@@ -237,8 +246,8 @@ impl<'g> Layers<'g> {
 /// Phase 1's conservative set: the envelope bound where the device can capture
 /// ([`envelope`]), else the three conservative passes ([`Conservative`]).
 enum PhaseOneConservative<'g> {
-    Envelope(envelope::Envelope<'g>),
-    Passes(Conservative<'g>),
+    Envelope(Box<envelope::Envelope<'g>>),
+    Passes(Box<Conservative<'g>>),
 }
 
 impl PhaseOneConservative<'_> {
@@ -258,11 +267,11 @@ fn visibility_frame(
     conservative: Option<&PhaseOneConservative>,
     frame: u32,
     s: &RecordSettings,
+    interleaved: bool,
 ) -> Result<Visibility, RecordError> {
     let mut visible = vec![];
     // Per drawn triangle (phase 1 draws every scene triangle, in id order): reached before
     // saturation. One flag a triangle instead of one entry a sample and layer to sort.
-    let interleaved = peeler::interleaved();
     let reached: Vec<AtomicBool> = (0..source.triangles())
         .map(|_| AtomicBool::new(false))
         .collect();
@@ -744,24 +753,30 @@ pub fn record(
                 job.frames,
                 view,
                 Purpose::Visibility,
+                &job.internals,
             )?;
             let conservative = if s.robust.conservative {
                 let (g, f, t) = (job.geometry, job.frames, &s.robust);
-                // The envelope needs a capture, but not the layers' switch: recordings peeled
-                // by `with_peeling` take the same conservative set as captured ones.
-                let passes = CONSERVATIVE_PASSES.with(|c| c.get());
+                // The envelope needs a capture, but not the layers' way: recordings peeled
+                // (`Internals::peel`) take the same conservative set as captured ones.
+                let (passes, i) = (job.internals.conservative_passes, &job.internals);
                 // Scenes of 2^24 triangles or more take the passes too.
                 let envelope = capture::supported(gpu) && !passes && envelope::Envelope::fits(g);
                 Some(if envelope {
-                    PhaseOneConservative::Envelope(envelope::Envelope::new(gpu, g, f, view, t)?)
+                    PhaseOneConservative::Envelope(Box::new(envelope::Envelope::new(
+                        gpu, g, f, view, t, i,
+                    )?))
                 } else {
-                    PhaseOneConservative::Passes(Conservative::new(gpu, g, f, view, t)?)
+                    PhaseOneConservative::Passes(Box::new(Conservative::new(
+                        gpu, g, f, view, t, i,
+                    )?))
                 })
             } else {
                 None
             };
             for f in todo {
-                let v = visibility_frame(&source, conservative.as_ref(), f, &s)?;
+                let interleaved = job.internals.interleaved_readback;
+                let v = visibility_frame(&source, conservative.as_ref(), f, &s, interleaved)?;
                 if let Some(p) = partial {
                     p.store_visibility(f, &v)?;
                 }
@@ -818,8 +833,8 @@ pub fn record(
             let result = match partial.and_then(|p| p.load_graph(f)) {
                 Some(r) => r,
                 None => {
-                    let layers =
-                        |purpose| Layers::new(gpu, job.geometry, &g, job.frames, view, purpose);
+                    let (geometry, frames, i) = (job.geometry, job.frames, &job.internals);
+                    let layers = |purpose| Layers::new(gpu, geometry, &g, frames, view, purpose, i);
                     if peeler.is_none() {
                         peeler = Some(layers(Purpose::Graphs)?);
                     }

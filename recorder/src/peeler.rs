@@ -27,47 +27,22 @@ pub struct Layer {
     pub depth: Vec<f32>,
 }
 
-thread_local! {
-    /// See [`with_interleaved_readback`].
-    static INTERLEAVED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-    /// See [`with_full_texture_upload`].
-    static FULL_UPLOAD: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Runs `f` with peelers and conservative passes built inside uploading every texture as a
-/// player does ([`SceneGpu::new`]) instead of only what visibility reads
-/// ([`SceneGpu::for_visibility`], which leaves out the linear maps). Kept only so that tests
-/// can show both upload the same recordings.
-#[doc(hidden)]
-pub fn with_full_texture_upload<R>(f: impl FnOnce() -> R) -> R {
-    with_switch(&FULL_UPLOAD, true, f)
-}
-
 /// The scene as the recorder's shaders read it, which is only what decides visibility:
-/// [`SceneGpu::for_visibility`] (or [`SceneGpu::new`] inside [`with_full_texture_upload`]).
+/// [`SceneGpu::for_visibility`] (or [`SceneGpu::new`], every texture as a player uploads
+/// it, with [`crate::Internals::full_texture_upload`]).
 pub(crate) fn visibility_scene(
     gpu: &Gpu,
     geometry: &Geometry,
     frames: &[FrameState],
     view: View,
+    internals: &crate::Internals,
 ) -> SceneGpu {
     let (device, queue) = (&gpu.device, &gpu.queue);
-    if FULL_UPLOAD.with(|c| c.get()) {
+    if internals.full_texture_upload {
         SceneGpu::new(device, queue, geometry, frames, view)
     } else {
         SceneGpu::for_visibility(device, queue, geometry, frames, view)
     }
-}
-
-/// Runs `f` with the recorder's former readback on this thread: peelers built inside gather
-/// every layer interleaved (16 bytes a sample, all fields read back and unpacked sample by
-/// sample), and phase 1 lists visible triangles sample by sample when it peels. Kept only so
-/// that tests can compare the compact readback against it in one process (inside
-/// [`crate::with_peeling`]: a recording that captures reads back no layers): both give the same
-/// recordings.
-#[doc(hidden)]
-pub fn with_interleaved_readback<R>(f: impl FnOnce() -> R) -> R {
-    with_switch(&INTERLEAVED, true, f)
 }
 
 /// Layers peeled and bytes read back by every peeler of the process (benchmarks).
@@ -82,11 +57,6 @@ static COUNTERS: [std::sync::atomic::AtomicU64; 2] = [
 pub fn readback_counters() -> (u64, u64) {
     let get = |k: usize| COUNTERS[k].load(std::sync::atomic::Ordering::Relaxed);
     (get(0), get(1))
-}
-
-/// Whether this thread records the former way ([`with_interleaved_readback`]).
-pub(crate) fn interleaved() -> bool {
-    INTERLEAVED.with(|c| c.get())
 }
 
 /// A texture of `view`'s size and samples that passes both render into and read from.
@@ -132,30 +102,6 @@ pub(crate) fn read_mapped<R>(
     Ok(r)
 }
 
-/// Runs `f` with the thread-local switch `key` set to `value`, and restores its former value
-/// afterwards, also when `f` panics (a test that fails inside must not leave the switch on for
-/// the next test on its thread).
-pub(crate) fn with_switch<T: Copy + 'static, R>(
-    key: &'static std::thread::LocalKey<std::cell::Cell<T>>,
-    value: T,
-    f: impl FnOnce() -> R,
-) -> R {
-    struct Restore<T: Copy + 'static> {
-        key: &'static std::thread::LocalKey<std::cell::Cell<T>>,
-        before: T,
-    }
-    impl<T: Copy + 'static> Drop for Restore<T> {
-        fn drop(&mut self) {
-            self.key.with(|c| c.set(self.before));
-        }
-    }
-    let _restore = Restore {
-        key,
-        before: key.with(|c| c.replace(value)),
-    };
-    f()
-}
-
 /// The peeling pipeline for one scene at one view.
 pub struct Peeler<'g> {
     gpu: &'g Gpu,
@@ -181,7 +127,7 @@ pub struct Peeler<'g> {
     /// Read back the alpha and depth arrays ([`Peeler::with_readback`]).
     read_alpha: bool,
     read_depth: bool,
-    /// The former interleaved gather ([`with_interleaved_readback`]).
+    /// The former interleaved gather ([`crate::Internals::interleaved_readback`]).
     interleaved: bool,
 }
 
@@ -314,7 +260,15 @@ impl<'g> Peeler<'g> {
         frames: &[FrameState],
         view: View,
     ) -> Result<Self, RecordError> {
-        Peeler::build(gpu, geometry, triangles, frames, view, None)
+        Peeler::build(
+            gpu,
+            geometry,
+            triangles,
+            frames,
+            view,
+            None,
+            &Default::default(),
+        )
     }
 
     /// [`Peeler::new`] over the triangles grown by `robust`'s tolerance in pixels
@@ -331,20 +285,30 @@ impl<'g> Peeler<'g> {
         view: View,
         robust: &Robust,
     ) -> Result<Self, RecordError> {
-        Peeler::build(gpu, geometry, triangles, frames, view, Some(robust))
+        Peeler::build(
+            gpu,
+            geometry,
+            triangles,
+            frames,
+            view,
+            Some(robust),
+            &Default::default(),
+        )
     }
 
-    fn build(
+    /// [`Peeler::new`] (`grow` `None`) or [`Peeler::grown`], built as `internals` say.
+    pub(crate) fn build(
         gpu: &'g Gpu,
         geometry: &Geometry,
         triangles: &[u32],
         frames: &[FrameState],
         view: View,
         grow: Option<&Robust>,
+        internals: &crate::Internals,
     ) -> Result<Self, RecordError> {
         let device = &gpu.device;
         check_device(gpu, view)?;
-        let scene = visibility_scene(gpu, geometry, frames, view);
+        let scene = visibility_scene(gpu, geometry, frames, view, internals);
         let source = match grow {
             None => trisort_gpu::peel_shader(view.samples),
             Some(_) => trisort_gpu::peel_grown_shader(view.samples),
@@ -404,7 +368,7 @@ impl<'g> Peeler<'g> {
             }
         };
 
-        let interleaved = interleaved();
+        let interleaved = internals.interleaved_readback;
         let (gather_layout, gather_pipeline) = gather_pipeline(device, view.samples, interleaved);
 
         let mut index_data: Vec<u32> = Vec::with_capacity(triangles.len() * 3);
@@ -493,7 +457,7 @@ impl<'g> Peeler<'g> {
     }
 
     /// Bytes read back from the device per layer: one word a sample for the ids and for each
-    /// field read back (16 a sample with [`with_interleaved_readback`]).
+    /// field read back (16 a sample with [`crate::Internals::interleaved_readback`]).
     pub fn readback_bytes(&self) -> u64 {
         let words = if self.interleaved {
             4

@@ -5,17 +5,36 @@
 //! pool must grow and when a frame's fragments are split into bands of rows.
 
 use trisort_format::RecordSettings;
-use trisort_recorder::{capture_counters, with_peeling, with_pool_limits};
+use trisort_recorder::{capture_counters, Internals};
 use trisort_scene::Scene;
 
-use crate::compact_readback::{assert_switch_keeps_recording, shared_scene, variants};
+use crate::compact_readback::{assert_internals_keep_recording, shared_scene, variants};
 
 fn capture_matches_peeling(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) {
-    assert_switch_keeps_recording(
+    capture_in_pools_matches_peeling(gpu, scene, settings, None);
+}
+
+/// [`capture_matches_peeling`] with captures' pools limited to `pools` (first nodes, most
+/// fragments a pass: [`Internals::pool_limits`]).
+fn capture_in_pools_matches_peeling(
+    gpu: &trisort_gpu::Gpu,
+    scene: &Scene,
+    settings: RecordSettings,
+    pools: Option<(u64, u64)>,
+) {
+    let capture = Internals {
+        pool_limits: pools,
+        ..Internals::default()
+    };
+    let peel = Internals {
+        peel: true,
+        ..capture
+    };
+    assert_internals_keep_recording(
         gpu,
         scene,
         settings,
-        |run| with_peeling(run),
+        (capture, peel),
         "capturing instead of peeling",
     );
 }
@@ -44,10 +63,9 @@ fn capture_with_a_growing_pool_matches_peeling() {
     };
     let scene = trisort_scene::demo_car(20_000);
     let before = capture_counters();
-    with_pool_limits(256, u64::MAX, || {
-        capture_matches_peeling(&gpu, &scene, variants()[0]);
-        capture_matches_peeling(&gpu, &scene, variants()[2]);
-    });
+    for s in [variants()[0], variants()[2]] {
+        capture_in_pools_matches_peeling(&gpu, &scene, s, Some((256, u64::MAX)));
+    }
     let after = capture_counters();
     // Other tests may capture at the same time, so only a lower bound.
     assert!(after[1] > before[1], "the pool never grew");
@@ -99,7 +117,7 @@ fn capture_in_bands_matches_peeling() {
             ..s
         };
         let before = capture_counters();
-        with_pool_limits(256, most, || capture_matches_peeling(&gpu, &scene, s));
+        capture_in_pools_matches_peeling(&gpu, &scene, s, Some((256, most)));
         let after = capture_counters();
         assert!(
             after[2] > before[2],

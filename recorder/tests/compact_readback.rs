@@ -4,17 +4,18 @@
 //! and a real scene, plain, robust and conservative, at 4× and 1× MSAA.
 
 use trisort_format::{Phase, ProfileName, RecordSettings, Recording, Robust};
-use trisort_recorder::{record, with_interleaved_readback, with_peeling, RecordJob};
+use trisort_recorder::{record, Internals, RecordJob};
 use trisort_scene::Scene;
 
-/// Records three frames spread around `scene`'s orbit with `settings`, once under `switch`
-/// (a hidden switch restoring a former path) and once as shipped, and asserts the serialised
-/// `Recording`s are byte-identical; `change` names what the switch changes, for the message.
-pub(crate) fn assert_switch_keeps_recording(
+/// Records three frames spread around `scene`'s orbit with `settings`, once with the
+/// recorder working as `other` says (another route, such as a former path) and once as
+/// `base` says, and asserts the serialised `Recording`s are byte-identical; `change` names
+/// what `other` changes, for the message.
+pub(crate) fn assert_internals_keep_recording(
     gpu: &trisort_gpu::Gpu,
     scene: &Scene,
     settings: RecordSettings,
-    switch: impl FnOnce(&dyn Fn() -> Recording) -> Recording,
+    (base, other): (Internals, Internals),
     change: &str,
 ) {
     let timeline = trisort_paths::load("orbit", scene, &Default::default()).expect("orbit path");
@@ -35,10 +36,17 @@ pub(crate) fn assert_switch_keeps_recording(
         range: None,
         phase: Phase::Graphs,
         known_visible: None,
+        internals: base,
     };
-    let run = || record(gpu, &job, None, |_| {}).expect("recording succeeds");
-    let before: Recording = switch(&run);
-    let after: Recording = run();
+    let run = |internals| {
+        let job = RecordJob {
+            internals,
+            ..job.clone()
+        };
+        record(gpu, &job, None, |_| {}).expect("recording succeeds")
+    };
+    let before: Recording = run(other);
+    let after: Recording = run(base);
     // Not vacuous: something was seen, ordered and tied... or at least seen and ordered.
     assert!(after.frames.iter().all(|f| !f.visible.is_empty()));
     assert!(after.frames.iter().any(|f| !f.edges.is_empty()));
@@ -50,18 +58,24 @@ pub(crate) fn assert_switch_keeps_recording(
     );
 }
 
-/// Both readbacks of the peeler: the recorder peels inside [`with_peeling`] (it captures
-/// where it can, which `capture` compares with peeling).
+/// Both readbacks of the peeler: the recorder peels ([`Internals::peel`]; it captures where
+/// it can, which `capture` compares with peeling).
 fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene, settings: RecordSettings) {
-    with_peeling(|| {
-        assert_switch_keeps_recording(
-            gpu,
-            scene,
-            settings,
-            |run| with_interleaved_readback(run),
-            "the compact readback",
-        )
-    });
+    let peel = Internals {
+        peel: true,
+        ..Internals::default()
+    };
+    let interleaved = Internals {
+        interleaved_readback: true,
+        ..peel
+    };
+    assert_internals_keep_recording(
+        gpu,
+        scene,
+        settings,
+        (peel, interleaved),
+        "the compact readback",
+    );
 }
 
 /// The shared scene at `rel` under `TRISORT_SCENES`, loaded; `None` (the test skips) where

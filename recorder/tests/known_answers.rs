@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use trisort_format::{FrameState, Geometry, Phase, RecordSettings, Recording};
-use trisort_recorder::{record, with_peeling, RecordJob};
+use trisort_recorder::{record, Internals, RecordJob};
 use trisort_testkit::fixtures::{flat_quad, frame_at, material, scene, settings, tri};
 
 fn run(g: &Geometry, frames: &[FrameState], settings: RecordSettings) -> Option<Recording> {
@@ -18,11 +18,19 @@ fn run(g: &Geometry, frames: &[FrameState], settings: RecordSettings) -> Option<
         range: None,
         phase: Phase::Graphs,
         known_visible: None,
+        internals: Default::default(),
     };
     let r = record(&gpu, &job, None, |_| {}).expect("recording succeeds");
     // Every known answer holds for both ways of getting the layers: the one-pass capture (as
     // shipped) and depth peeling, which record the same bytes.
-    let peeled = with_peeling(|| record(&gpu, &job, None, |_| {}).expect("peeling succeeds"));
+    let peel = RecordJob {
+        internals: Internals {
+            peel: true,
+            ..Internals::default()
+        },
+        ..job.clone()
+    };
+    let peeled = record(&gpu, &peel, None, |_| {}).expect("peeling succeeds");
     let bytes = |r: &Recording| postcard::to_stdvec(r).expect("serialises");
     assert!(bytes(&r) == bytes(&peeled), "capture and peeling differ");
     Some(r)

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use trisort_format::{Geometry, Phase, ProfileName, RecordSettings, Recording, Robust};
-use trisort_recorder::{record, with_conservative_passes, RecordJob};
+use trisort_recorder::{record, Internals, RecordJob};
 use trisort_testkit::fixtures::{flat_quad, frame_at, material, scene, settings, tri};
 
 /// 16×16, one sample per pixel at its centre, 90° field of view: at z = −1 a pixel is 0.125
@@ -55,6 +55,20 @@ fn run(robust: Robust) -> Option<Recording> {
 }
 
 fn run_on(g: Geometry, robust: Robust) -> Option<Recording> {
+    run_with(g, robust, Internals::default())
+}
+
+/// Phase 1's conservative set from the three passes, even where the device captures.
+const PASSES: Internals = Internals {
+    conservative_passes: true,
+    peel: false,
+    interleaved_readback: false,
+    full_texture_upload: false,
+    pool_limits: None,
+};
+
+/// [`run_on`] with the recorder working as `internals` say.
+fn run_with(g: Geometry, robust: Robust, internals: Internals) -> Option<Recording> {
     let gpu = trisort_testkit::gpu()?;
     let frames = [frame_at(DVec3::ZERO)];
     let job = RecordJob {
@@ -69,6 +83,7 @@ fn run_on(g: Geometry, robust: Robust) -> Option<Recording> {
         range: None,
         phase: Phase::Graphs,
         known_visible: None,
+        internals,
     };
     Some(record(&gpu, &job, None, |_| {}).expect("recording succeeds"))
 }
@@ -159,7 +174,7 @@ fn the_envelope_keeps_what_a_gap_narrower_than_the_samples_shows() {
     // The slit crosses the wall's diagonal: both of its triangles show in it.
     let cons = run_on(scene_with_a_slit(), robust(1, true)).unwrap();
     assert_eq!(wall(&cons), [true, true]);
-    let passes = with_conservative_passes(|| run_on(scene_with_a_slit(), robust(1, true)));
+    let passes = run_with(scene_with_a_slit(), robust(1, true), PASSES);
     assert_eq!(wall(&passes.unwrap()), [false, false]);
     // A box below the slit's near edge (0.05 px) does not reach it: 0.015 px and the 4-bit
     // snap's 1/32.
@@ -231,7 +246,7 @@ fn slivers_behind_a_surface_are_kept_and_an_ordinary_triangle_is_not() {
 /// capture record with).
 #[test]
 fn the_conservative_passes_keep_the_near_miss_and_not_the_hidden_triangle() {
-    let Some(cons) = with_conservative_passes(|| run(robust(1, true))) else {
+    let Some(cons) = run_with(scene_with_a_near_miss(), robust(1, true), PASSES) else {
         return;
     };
     assert_eq!(cons.frames[0].visible, vec![0, 1, 2, 3]);

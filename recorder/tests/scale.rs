@@ -80,6 +80,7 @@ fn five_million_triangles_record_one_frame() {
         range: None,
         phase: Phase::Graphs,
         known_visible: None,
+        internals: Default::default(),
     };
     let rec = record(&gpu, &job, None, |_| {}).unwrap();
     let f = &rec.frames[0];

@@ -5,20 +5,24 @@
 
 use trisort_format::{FrameState, Texture, TextureSlot};
 use trisort_gpu::scene_gpu::{SceneGpu, View};
-use trisort_recorder::with_full_texture_upload;
+use trisort_recorder::Internals;
 use trisort_scene::Scene;
 
-use crate::compact_readback::{assert_switch_keeps_recording, shared_scene, variants};
+use crate::compact_readback::{assert_internals_keep_recording, shared_scene, variants};
 
 /// Records three frames of `scene`'s orbit with the visibility-only and the full upload, for
 /// every settings of [`variants`], and asserts the bytes agree.
 fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene) {
     for settings in variants() {
-        assert_switch_keeps_recording(
+        let full = Internals {
+            full_texture_upload: true,
+            ..Internals::default()
+        };
+        assert_internals_keep_recording(
             gpu,
             scene,
             settings,
-            |run| with_full_texture_upload(run),
+            (Internals::default(), full),
             "leaving out the linear maps",
         );
     }

@@ -178,6 +178,7 @@ pub fn record_to_file(
         range,
         phase,
         known_visible,
+        internals: Default::default(),
     };
     let partial_dir = partial_path(output);
     let (partial, resumed) = PartialDir::open(&partial_dir, &job)?;

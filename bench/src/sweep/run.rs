@@ -302,6 +302,7 @@ impl Sweep<'_> {
             range: None,
             phase: Phase::Graphs,
             known_visible: None,
+            internals: Default::default(),
         };
         let rec = trisort_recorder::record(self.gpu, &job, None, |_| {})?;
         if let Some(f) = rec.frames.iter().find(|f| f.truncated) {
