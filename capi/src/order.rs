@@ -98,7 +98,7 @@ pub enum OrderError {
         /// The baked file.
         path: PathBuf,
         /// What is wrong.
-        problem: String,
+        problem: trisort_format::StructureError,
     },
     /// The glTF scene could not be imported.
     #[error(transparent)]

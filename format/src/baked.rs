@@ -147,11 +147,12 @@ pub struct Baked {
 }
 
 /// Checks a stored frame rate: absent, or finite and positive (a player divides by it).
-pub(crate) fn check_fps(fps: Option<f64>) -> Result<(), String> {
+pub(crate) fn check_fps(fps: Option<f64>) -> Result<(), crate::StructureError> {
     match fps {
-        Some(fps) if !(fps.is_finite() && fps > 0.0) => {
-            Err(format!("frame rate {fps} is not a positive number"))
-        }
+        Some(fps) if !(fps.is_finite() && fps > 0.0) => Err(crate::StructureError::new(
+            crate::Part::FrameRate,
+            format!("frame rate {fps} is not a positive number"),
+        )),
         _ => Ok(()),
     }
 }
@@ -185,19 +186,28 @@ impl Baked {
     /// once per frame, counted: a frame draws no more triangles than the buffer holds), one frame state
     /// and one removed-edge list per frame, finite cameras and poses of existing nodes
     /// ([`crate::camera::check_frame_state`]). Returns the first problem found.
-    pub fn check_structure(&self) -> Result<(), String> {
+    pub fn check_structure(&self) -> Result<(), crate::StructureError> {
         self.settings.check_stored()?;
         let g = &self.geometry;
         g.check_structure()?;
         if self.scene_ids.len() != g.triangles.len() {
-            return Err("scene_ids and triangles differ in length".into());
+            return Err(crate::StructureError::new(
+                crate::Part::Layout,
+                "scene_ids and triangles differ in length",
+            ));
         }
         if self.scene_ids.windows(2).any(|w| w[0] >= w[1]) {
-            return Err("scene_ids are not strictly ascending".into());
+            return Err(crate::StructureError::new(
+                crate::Part::Layout,
+                "scene_ids are not strictly ascending",
+            ));
         }
         let ntri = g.triangles.len() as u64;
         if let Some(k) = self.copies.iter().position(|&c| c as u64 >= ntri) {
-            return Err(format!("copy {k} refers to a triangle beyond {ntri}"));
+            return Err(crate::StructureError::new(
+                crate::Part::Layout,
+                format!("copy {k} refers to a triangle beyond {ntri}"),
+            ));
         }
         let nidx = self.copies.len() as u64 * 3;
         for (k, d) in self.draws.iter().enumerate() {
@@ -208,7 +218,10 @@ impl Baked {
                 || d.base_vertex != 0
                 || d.first_instance != 0
             {
-                return Err(format!("draw {k} is malformed or outside the index buffer"));
+                return Err(crate::StructureError::new(
+                    crate::Part::Layout,
+                    format!("draw {k} is malformed or outside the index buffer"),
+                ));
             }
         }
         // Per-frame work is bounded by what a merge can produce: a merge draws each copy at
@@ -224,25 +237,31 @@ impl Baked {
         for (f, w) in self.frames.iter().enumerate() {
             let (a, b) = (w.first as u64, w.first as u64 + w.count as u64);
             if b > self.draws.len() as u64 {
-                return Err(format!("frame {f}'s window lies outside the draw list"));
+                return Err(crate::StructureError::new(
+                    crate::Part::Layout,
+                    format!("frame {f}'s window lies outside the draw list"),
+                ));
             }
             if w.count as u64 > ncopies + 1 {
-                return Err(format!(
+                return Err(crate::StructureError::new(crate::Part::Layout, format!(
                     "frame {f} has {} draws, more than a merge gives a buffer of {ncopies} copies (at most one draw per copy)",
                     w.count
-                ));
+                )));
             }
             let triangles = drawn[b as usize] - drawn[a as usize];
             if triangles > ncopies {
-                return Err(format!(
+                return Err(crate::StructureError::new(crate::Part::Layout, format!(
                     "frame {f} draws {triangles} triangles, more than the {ncopies} copies of the index buffer (a merge draws each copy at most once per frame)"
-                ));
+                )));
             }
         }
         if self.frame_states.len() != self.frames.len()
             || self.removed_edges.len() != self.frames.len()
         {
-            return Err("per-frame lists differ in length".into());
+            return Err(crate::StructureError::new(
+                crate::Part::Layout,
+                "per-frame lists differ in length",
+            ));
         }
         for (f, s) in self.frame_states.iter().enumerate() {
             crate::camera::check_frame_state(f, s, Some(g.nodes.len()))?;

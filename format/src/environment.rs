@@ -322,27 +322,40 @@ impl Environment {
 
     /// Checks what a reader relies on: at least one level, each of its size, finite values, no
     /// negative light (texels, sun colour, exposure).
-    pub fn check_structure(&self) -> Result<(), String> {
+    pub fn check_structure(&self) -> Result<(), crate::StructureError> {
         if self.width == 0 || self.height == 0 || self.levels.is_empty() {
-            return Err("the environment has no texels".into());
+            return Err(crate::StructureError::new(
+                crate::Part::Environment,
+                "the environment has no texels",
+            ));
         }
         if self.levels.len() > 16 {
-            return Err(format!("the environment has {} levels", self.levels.len()));
+            return Err(crate::StructureError::new(
+                crate::Part::Environment,
+                format!("the environment has {} levels", self.levels.len()),
+            ));
         }
         for (k, level) in self.levels.iter().enumerate() {
             let (w, h) = self.level_size(k);
             if level.len() as u64 != w as u64 * h as u64 * 4 {
-                return Err(format!(
-                    "environment level {k} has the wrong number of texels"
+                return Err(crate::StructureError::new(
+                    crate::Part::Environment,
+                    format!("environment level {k} has the wrong number of texels"),
                 ));
             }
             // binary16 exponent all ones: infinity or NaN.
             if level.iter().any(|&b| b & 0x7c00 == 0x7c00) {
-                return Err(format!("environment level {k} has a non-finite texel"));
+                return Err(crate::StructureError::new(
+                    crate::Part::Environment,
+                    format!("environment level {k} has a non-finite texel"),
+                ));
             }
             // Sign bit on anything but −0: negative radiance.
             if level.iter().any(|&b| b > 0x8000) {
-                return Err(format!("environment level {k} has a negative texel"));
+                return Err(crate::StructureError::new(
+                    crate::Part::Environment,
+                    format!("environment level {k} has a negative texel"),
+                ));
             }
         }
         let sun = self
@@ -357,19 +370,25 @@ impl Environment {
             .chain([&self.exposure])
             .all(|x| x.is_finite())
         {
-            return Err("the environment has a non-finite value".into());
+            return Err(crate::StructureError::new(
+                crate::Part::Environment,
+                "the environment has a non-finite value",
+            ));
         }
         // Negative light would darken what it shines on; shading has no meaning for it.
         if self.exposure < 0.0 {
-            return Err(format!(
-                "the environment's exposure is negative ({})",
-                self.exposure
+            return Err(crate::StructureError::new(
+                crate::Part::Environment,
+                format!("the environment's exposure is negative ({})", self.exposure),
             ));
         }
         if let Some(sun) = self.sun.filter(|s| s.color.iter().any(|&c| c < 0.0)) {
-            return Err(format!(
-                "the environment's sun has a negative colour {:?}",
-                sun.color
+            return Err(crate::StructureError::new(
+                crate::Part::Environment,
+                format!(
+                    "the environment's sun has a negative colour {:?}",
+                    sun.color
+                ),
             ));
         }
         Ok(())
@@ -1159,6 +1178,7 @@ mod tests {
         assert!(env
             .check_structure()
             .unwrap_err()
+            .problem
             .contains("non-finite texel"));
     }
 
@@ -1168,20 +1188,20 @@ mod tests {
         env.levels[0][1] = 0x8000; // −0 is zero light
         env.check_structure().unwrap();
         env.levels[0][1] = half_bits(-0.5);
-        let e = env.check_structure().unwrap_err();
+        let e = env.check_structure().unwrap_err().problem;
         assert!(e.contains("level 0 has a negative texel"), "{e}");
         let mut env = Environment::uniform(1.0);
         env.exposure = 0.0;
         env.check_structure().unwrap();
         env.exposure = -1.0;
-        let e = env.check_structure().unwrap_err();
+        let e = env.check_structure().unwrap_err().problem;
         assert!(e.contains("exposure is negative (-1)"), "{e}");
         let mut env = Environment::uniform(1.0);
         env.sun = Some(Sun {
             direction: [0.0, 1.0, 0.0],
             color: [1.0, -0.25, 1.0],
         });
-        let e = env.check_structure().unwrap_err();
+        let e = env.check_structure().unwrap_err().problem;
         assert!(e.contains("sun has a negative colour"), "{e}");
     }
 }

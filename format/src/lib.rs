@@ -19,6 +19,7 @@ pub mod environment;
 pub mod geometry;
 pub mod options;
 pub mod recording;
+pub mod structure;
 
 pub use baked::{Baked, DrawIndexedIndirectArgs, FrameWindow, MatrixCell, MergeInfo, MergeStats};
 pub use camera::{world_transforms, Camera, FrameState, NodePose};
@@ -38,6 +39,7 @@ pub use recording::{
     DepthAt, DeviceInfo, Edge, FrameRecord, Phase, ProfileName, RasterProfile, RecordSettings,
     Recording, Robust, SettingsError,
 };
+pub use structure::{Part, StructureError};
 
 /// The version of the trisort tool that wrote a file (stored in every file).
 pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -136,7 +136,7 @@ pub enum MergeError {
         /// Index of the recording.
         recording: usize,
         /// The first problem found.
-        why: String,
+        why: trisort_format::StructureError,
     },
     /// A recording holds only phase 1 (visibility).
     #[error("recording {recording} has no graphs (phase 1 only); record phase 2 first")]

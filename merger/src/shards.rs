@@ -282,7 +282,10 @@ pub fn join(recordings: &[Recording]) -> Result<Recording, MergeError> {
     }
     out.check_structure().map_err(|why| MergeError::Invalid {
         recording: order[0],
-        why: format!("the joined recording: {why}"),
+        why: trisort_format::StructureError {
+            problem: format!("the joined recording: {}", why.problem),
+            ..why
+        },
     })?;
     Ok(out)
 }

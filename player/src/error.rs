@@ -14,7 +14,7 @@ pub enum PlayerError {
         /// The file, when it came from one.
         path: Option<PathBuf>,
         /// The first problem found.
-        reason: String,
+        reason: trisort_format::StructureError,
     },
     /// A frame index beyond the file's frames.
     #[error("frame {frame} does not exist (the file has {frames} frames)")]
