@@ -80,6 +80,15 @@ impl ImageCheck {
             tone_map: ToneMap::Neutral,
         }
     }
+
+    /// Whether this check is at the recorded pattern of `settings` (the recording's, or the
+    /// file's without one): the recorded size and sample count, no sub-pixel offset, on
+    /// whatever device (the device a file names is the file's word).
+    pub fn at_recorded_pattern(&self, settings: &RecordSettings) -> bool {
+        self.size == (settings.width, settings.height)
+            && self.samples == settings.samples.max(1)
+            && self.subpixel_offset == [0.0, 0.0]
+    }
 }
 
 /// One frame's figures.
@@ -262,9 +271,7 @@ impl<'g> ImageVerifier<'g> {
         // another device was once measured only, and passed, however wrong (issue 28). Frames
         // played here on another device are held to the recorded pattern's rule, as frames
         // captured elsewhere are; the report says so.
-        let at_pattern = check.size == (s.width, s.height)
-            && check.samples == s.samples.max(1)
-            && check.subpixel_offset == [0.0, 0.0];
+        let at_pattern = check.at_recorded_pattern(s);
         let other_device = !check.captured && gpu.device_info() != *truth.device;
         let player = if check.captured {
             None

@@ -392,16 +392,6 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
     Ok(ExitCode::from(code))
 }
 
-/// Whether a check at `size`, `samples` and `offset` is at the recorded pattern of
-/// `settings` (the recording's, or the file's without one): the same rule as
-/// [`ImageVerifier::at_recorded_pattern`], decided before anything is rendered so that an
-/// unchecked run is refused up front.
-fn at_pattern(settings: &RecordSettings, size: (u32, u32), samples: u32, offset: [f64; 2]) -> bool {
-    size == (settings.width, settings.height)
-        && samples == settings.samples.max(1)
-        && offset == [0.0, 0.0]
-}
-
 /// The image check of `verify --scene SPEC`: the scene as recorded (split where the
 /// recording split it, by the recording's path and settings where given), checked against the
 /// files' scene hashes, then every frame of `--frames`.
@@ -469,10 +459,7 @@ fn image_check(
     if check.samples != 1 && check.samples != 4 {
         bail!("--samples {}: only 1 and 4 are supported", check.samples);
     }
-    if !a.measure_only
-        && check.max_error.is_none()
-        && !at_pattern(&settings, check.size, check.samples, check.subpixel_offset)
-    {
+    if !a.measure_only && check.max_error.is_none() && !check.at_recorded_pattern(&settings) {
         bail!(
             "{}x{} with {}x MSAA{} is off the recorded pattern ({}x{}, {}x): nothing would be verified there unless you give --max-error N (fail a frame whose ordered pixels differ by more than N/255), or --measure-only to measure without verifying (exit 4 unless --allow-unverified)",
             check.size.0,
