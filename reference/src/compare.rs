@@ -51,12 +51,7 @@ pub fn compare(
     for p in 0..pixels {
         let a = &test[p * 4..p * 4 + 3];
         let b = &reference[p * 4..p * 4 + 3];
-        let d = a
-            .iter()
-            .zip(b)
-            .map(|(x, y)| x.abs_diff(*y))
-            .max()
-            .unwrap_or(0);
+        let d = channel_diff(a, b);
         squared += a
             .iter()
             .zip(b)
@@ -89,6 +84,46 @@ pub fn compare(
     c
 }
 
+/// The largest colour-channel difference of two pixels (RGB or RGBA; alpha ignored), in
+/// 1/255 units.
+fn channel_diff(a: &[u8], b: &[u8]) -> u8 {
+    a[..3]
+        .iter()
+        .zip(&b[..3])
+        .map(|(x, y)| x.abs_diff(*y))
+        .max()
+        .unwrap_or(0)
+}
+
+/// Pixels of `test` more than `tolerance` (1/255 units) off `reference` (both RGBA8), told
+/// apart: those with a hole sample (`holes`, per pixel), and the ordered rest (not
+/// `unordered`, per pixel; empty: every pixel ordered). Returns (hole pixels, order-error
+/// pixels).
+pub fn holes_and_order_errors(
+    test: &[u8],
+    reference: &[u8],
+    unordered: &[bool],
+    holes: &[bool],
+    tolerance: u8,
+) -> (u64, u64) {
+    let (mut hole, mut order) = (0u64, 0u64);
+    for (p, (a, b)) in test
+        .chunks_exact(4)
+        .zip(reference.chunks_exact(4))
+        .enumerate()
+    {
+        if channel_diff(a, b) <= tolerance {
+            continue;
+        }
+        if holes.get(p).copied().unwrap_or(false) {
+            hole += 1;
+        } else if !unordered.get(p).copied().unwrap_or(false) {
+            order += 1;
+        }
+    }
+    (hole, order)
+}
+
 fn rgb(rgba: &[u8]) -> Vec<u8> {
     rgba.chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])
@@ -113,12 +148,7 @@ pub fn difference_image(test: &[u8], reference: &[u8], unordered: &[bool]) -> Ve
         .zip(reference.chunks_exact(4))
         .enumerate()
     {
-        let d = a[..3]
-            .iter()
-            .zip(&b[..3])
-            .map(|(x, y)| x.abs_diff(*y))
-            .max()
-            .unwrap_or(0);
+        let d = channel_diff(a, b);
         let grey = ((b[0] as u32 + b[1] as u32 + b[2] as u32) / 9) as u8;
         let px = if d == 0 {
             [grey, grey, grey, 255]
@@ -155,6 +185,23 @@ mod tests {
 
     fn image(px: &[[u8; 3]]) -> Vec<u8> {
         px.iter().flat_map(|p| [p[0], p[1], p[2], 255]).collect()
+    }
+
+    #[test]
+    fn holes_and_order_errors_are_told_apart() {
+        let reference = image(&[[10, 10, 10], [10, 10, 10], [10, 10, 10], [10, 10, 10]]);
+        let test = image(&[[40, 10, 10], [10, 40, 10], [10, 10, 40], [11, 10, 10]]);
+        // Pixel 0 has a hole sample, pixel 1 is unordered, pixel 2 is ordered and off, pixel 3
+        // is within the tolerance.
+        let unordered = [false, true, false, false];
+        let holes = [true, false, false, false];
+        let got = holes_and_order_errors(&test, &reference, &unordered, &holes, 1);
+        assert_eq!(got, (1, 1));
+        // Depth mode's tolerance is 0: pixel 3 counts too.
+        assert_eq!(
+            holes_and_order_errors(&test, &reference, &unordered, &holes, 0),
+            (1, 2)
+        );
     }
 
     #[test]

@@ -108,11 +108,12 @@ pub struct UnorderedEdges {
 
 impl UnorderedEdges {
     /// Per frame of `recordings` (frame ranges of one path, any order), the edges of E_f on a
-    /// cycle of E_f; of the edges depth mode needs for a depth-only bake
-    /// (`depth_only`: [`Recording::depth_mode_edges`]), which keeps only those. Errors when a recording names scene ids beyond the scene's `scene_triangles`.
+    /// cycle of E_f; with `depth_mode` (a depth-only bake checked in depth mode), of the edges
+    /// depth mode needs ([`Recording::depth_mode_edges`]), all that such a bake keeps. Errors
+    /// when a recording names scene ids beyond the scene's `scene_triangles`.
     pub fn of_recordings(
         recordings: &[Recording],
-        depth_only: bool,
+        depth_mode: bool,
         scene_triangles: usize,
     ) -> Result<UnorderedEdges, ReferenceError> {
         let mut edges = UnorderedEdges::empty(scene_triangles);
@@ -120,7 +121,7 @@ impl UnorderedEdges {
             edges.add_g(&r.unique_visible, "a recording")?;
             for fr in &r.frames {
                 let depth_edges;
-                let source = if depth_only {
+                let source = if depth_mode {
                     depth_edges = r.depth_mode_edges(fr);
                     &depth_edges
                 } else {
@@ -147,19 +148,12 @@ impl UnorderedEdges {
         let mut edges = UnorderedEdges::empty(scene_triangles);
         edges.add_g(&baked.scene_ids, "the baked file")?;
         let scene = |t: u32| baked.scene_ids.get(t as usize).copied().unwrap_or(u32::MAX);
+        let drawn = DrawnSets::new(baked);
         for (f, removed) in baked.removed_edges.iter().enumerate() {
-            let mut drawn: Vec<u32> = baked
-                .frame_draws(f)
-                .iter()
-                .flat_map(|d| {
-                    let (a, b) = (d.first_index / 3, (d.first_index + d.index_count) / 3);
-                    baked.copies.get(a as usize..b as usize).unwrap_or_default()
-                })
-                .map(|&c| scene(c))
-                .collect();
-            drawn.sort_unstable();
-            drawn.dedup();
-            edges.set_drawn(f, drawn);
+            let mut ids: Vec<u32> = drawn.of_frame(f).collect();
+            ids.sort_unstable();
+            ids.dedup();
+            edges.set_drawn(f, ids);
             edges.set_frame(
                 f,
                 removed
@@ -246,6 +240,45 @@ pub struct ReferenceFrame {
     /// that is not of a triangle whose every fragment has alpha 0; 0 where the sample has
     /// none. What a verifier tells holes by.
     pub front: Vec<u32>,
+}
+
+/// The triangles each frame of a baked file draws, by scene id: the scene id of every copy,
+/// and per frame its draws' copy ranges (compact however long the path).
+pub(crate) struct DrawnSets {
+    /// Scene id of each copy (`u32::MAX` for a G-local id outside `scene_ids`).
+    copies: Vec<u32>,
+    /// Per frame: half-open copy ranges.
+    frames: Vec<Vec<(u32, u32)>>,
+}
+
+impl DrawnSets {
+    pub(crate) fn new(baked: &Baked) -> DrawnSets {
+        let scene = |t: u32| baked.scene_ids.get(t as usize).copied().unwrap_or(u32::MAX);
+        DrawnSets {
+            copies: baked.copies.iter().map(|&t| scene(t)).collect(),
+            frames: (0..baked.frames.len())
+                .map(|f| {
+                    baked
+                        .frame_draws(f)
+                        .iter()
+                        .map(|d| (d.first_index / 3, (d.first_index + d.index_count) / 3))
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+
+    /// The scene ids frame `f` draws, in draw order (with repeats where it draws a triangle
+    /// twice).
+    pub(crate) fn of_frame(&self, f: usize) -> impl Iterator<Item = u32> + '_ {
+        self.frames
+            .get(f)
+            .map(Vec::as_slice)
+            .unwrap_or(&[])
+            .iter()
+            .flat_map(|&(a, b)| self.copies.get(a as usize..b as usize).unwrap_or(&[]))
+            .copied()
+    }
 }
 
 /// Composite-pass resources of one layer.

@@ -31,9 +31,9 @@ use trisort_format::{Baked, DeviceInfo, FrameState, Geometry, RecordSettings, Re
 use trisort_gpu::{Gpu, Lighting, Shading, ToneMap};
 use trisort_player::{HeadlessConfig, HeadlessRenderer, Mode};
 
-use crate::compare::{compare, Comparison};
+use crate::compare::{compare, holes_and_order_errors, Comparison};
 use crate::deploy::Srgb8Player;
-use crate::exact::{ExactReference, ReferenceConfig, ReferenceFrame, UnorderedEdges};
+use crate::exact::{DrawnSets, ExactReference, ReferenceConfig, ReferenceFrame, UnorderedEdges};
 use crate::ReferenceError;
 
 /// What to verify.
@@ -175,9 +175,10 @@ impl<'a> Truth<'a> {
                 baked.frames.len()
             )));
         }
-        // A depth-only file's ties are its order only where the depth test is on.
-        let ties = baked.merge.depth_only && mode == Mode::Depth;
-        let unordered = UnorderedEdges::of_recordings(recordings, ties, scene_triangles)?;
+        // A depth-only file holds only the edges depth mode needs, and is its own order only
+        // where the depth test is on.
+        let depth_mode = baked.merge.depth_only && mode == Mode::Depth;
+        let unordered = UnorderedEdges::of_recordings(recordings, depth_mode, scene_triangles)?;
         Ok(Truth {
             settings: first.settings,
             device: &first.device,
@@ -199,56 +200,10 @@ pub struct ImageVerifier<'g> {
     reference: ExactReference<'g>,
     srgb8: Option<Srgb8Player<'g>>,
     unordered: Option<UnorderedEdges>,
-    /// What the file draws, for telling holes: the scene id of every copy, and per frame its
-    /// draws' copy ranges.
-    drawn: Drawn,
-}
-
-/// The triangles each frame of a baked file draws, by scene id.
-struct Drawn {
-    /// Scene id of each copy (`u32::MAX` for a G-local id outside `scene_ids`).
-    copies: Vec<u32>,
-    /// Per frame: half-open copy ranges.
-    frames: Vec<Vec<(u32, u32)>>,
+    /// What the file draws, for telling holes.
+    drawn: DrawnSets,
     /// Triangles of the scene.
     scene_triangles: usize,
-}
-
-impl Drawn {
-    fn new(baked: &Baked, scene_triangles: usize) -> Drawn {
-        let scene = |t: u32| baked.scene_ids.get(t as usize).copied().unwrap_or(u32::MAX);
-        Drawn {
-            copies: baked.copies.iter().map(|&t| scene(t)).collect(),
-            frames: (0..baked.frames.len())
-                .map(|f| {
-                    baked
-                        .frame_draws(f)
-                        .iter()
-                        .map(|d| (d.first_index / 3, (d.first_index + d.index_count) / 3))
-                        .collect()
-                })
-                .collect(),
-            scene_triangles,
-        }
-    }
-
-    /// Per scene triangle: whether frame `f` draws it.
-    fn of_frame(&self, f: u32) -> Vec<bool> {
-        let mut out = vec![false; self.scene_triangles];
-        for &(a, b) in self
-            .frames
-            .get(f as usize)
-            .map(Vec::as_slice)
-            .unwrap_or(&[])
-        {
-            for &t in self.copies.get(a as usize..b as usize).unwrap_or(&[]) {
-                if let Some(x) = out.get_mut(t as usize) {
-                    *x = true;
-                }
-            }
-        }
-        out
-    }
 }
 
 impl<'g> ImageVerifier<'g> {
@@ -328,7 +283,8 @@ impl<'g> ImageVerifier<'g> {
             reference,
             srgb8,
             unordered: truth.unordered,
-            drawn: Drawn::new(baked, geometry.triangles.len()),
+            drawn: DrawnSets::new(baked),
+            scene_triangles: geometry.triangles.len(),
         };
         if check.subpixel_offset != [0.0, 0.0] {
             verifier.shift(check.subpixel_offset);
@@ -406,7 +362,12 @@ impl<'g> ImageVerifier<'g> {
         // Holes: samples whose nearest fragment is of a triangle the file does not draw in
         // this frame. A differing pixel with one is a hole pixel, any other differing ordered
         // pixel an order error (depth: any difference; blend, saturate: over 1/255).
-        let drawn = self.drawn.of_frame(frame);
+        let mut drawn = vec![false; self.scene_triangles];
+        for t in self.drawn.of_frame(frame as usize) {
+            if let Some(d) = drawn.get_mut(t as usize) {
+                *d = true;
+            }
+        }
         let samples = (reference.front.len() / (w as usize * h as usize).max(1)).max(1);
         let mut hole_pixel = vec![false; w as usize * h as usize];
         let mut hole_samples = 0u64;
@@ -419,22 +380,13 @@ impl<'g> ImageVerifier<'g> {
             }
         }
         let tolerance = if self.check.mode == Mode::Depth { 0 } else { 1 };
-        let (mut hole_pixels, mut order_error_pixels) = (0u64, 0u64);
-        for p in 0..hole_pixel.len() {
-            let d = test[p * 4..p * 4 + 3]
-                .iter()
-                .zip(&reference.rgba8[p * 4..p * 4 + 3])
-                .map(|(a, b)| a.abs_diff(*b))
-                .max()
-                .unwrap_or(0);
-            if d > tolerance {
-                if hole_pixel[p] {
-                    hole_pixels += 1;
-                } else if !reference.unordered.get(p).copied().unwrap_or(false) {
-                    order_error_pixels += 1;
-                }
-            }
-        }
+        let (hole_pixels, order_error_pixels) = holes_and_order_errors(
+            &test,
+            &reference.rgba8,
+            &reference.unordered,
+            &hole_pixel,
+            tolerance,
+        );
         let srgb8 = srgb8.map(|img| compare(&img, &reference.rgba8, w, h, &reference.unordered));
         let ok = if self.at_pattern {
             !reference.truncated
