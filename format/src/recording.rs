@@ -555,7 +555,8 @@ impl Recording {
     /// (a → b → c: c drawn before a shows through it), must come after a. Behind opaque
     /// triangles only, the order does not matter: the nearest opaque fragment is what remains
     /// whichever is drawn first. Sorted; a tie that is also a kept edge is listed once, with
-    /// the edge's weight. A triangle outside G counts as translucent.
+    /// the edge's weight. A triangle outside G counts as translucent. `fr`'s edges and ties
+    /// are sorted, as [`Recording::check_structure`] requires.
     pub fn depth_mode_edges(&self, fr: &FrameRecord) -> Vec<Edge> {
         let g = &self.geometry;
         let opaque = |t: u32| {
@@ -567,12 +568,11 @@ impl Recording {
                 .and_then(|v| g.materials.get(v.material as usize))
                 .is_some_and(|m| m.every_fragment_opaque(self.settings.glass_opacity))
         };
-        let mut edges = fr.edges.clone();
-        edges.sort_unstable();
+        let edges = &fr.edges;
         // Triangles translucent or behind a translucent one (reachable in E_f).
         let mut behind = std::collections::HashSet::new();
         let mut stack: Vec<u32> = Vec::new();
-        for e in &edges {
+        for e in edges {
             if !opaque(e.from) && behind.insert(e.from) {
                 stack.push(e.from);
             }
@@ -586,8 +586,9 @@ impl Recording {
             }
         }
         let mut out: Vec<Edge> = edges
-            .into_iter()
+            .iter()
             .filter(|e| behind.contains(&e.from))
+            .copied()
             .collect();
         let kept = out.len();
         for t in &fr.ties {

@@ -83,8 +83,8 @@ pub struct FrameReport {
     /// Rule 3: samples the file's cut removes beyond the least cut, over the cyclic
     /// components of at most 20 triangles (solved exactly here, as the merger solves them).
     pub cut_excess: u64,
-    /// Cyclic components of more than 20 triangles: their cut is checked to be needed, not
-    /// to be least.
+    /// Cyclic components of more than 20 triangles that the file cuts: their cut is checked
+    /// to be needed, not to be least.
     pub cut_components_unbounded: u64,
     /// Rule 1: visible triangles not drawn.
     pub visible_missing: u64,
@@ -190,9 +190,9 @@ pub fn check_graph(recordings: &[Recording], baked: &Baked) -> GraphReport {
 /// f) + |G|) time plus one search inside its component per removed edge; never panics on
 /// malformed input.
 pub fn check_graph_for(recordings: &[Recording], baked: &Baked, played: PlayedIn) -> GraphReport {
-    let ties = baked.merge.depth_only && played == PlayedIn::Depth;
+    let depth_mode = baked.merge.depth_only && played == PlayedIn::Depth;
     let mut report = GraphReport {
-        checked: if ties { "depth" } else { "edges" },
+        checked: if depth_mode { "depth" } else { "edges" },
         bridge_claimed: baked.merge.bridge,
         bridge_derived: Bridge::Visible,
         depth_only: baked.merge.depth_only,
@@ -209,7 +209,7 @@ pub fn check_graph_for(recordings: &[Recording], baked: &Baked, played: PlayedIn
     let mut copies = Copies::new(baked.copies.len());
     let mut frame = FrameCheck {
         baked,
-        depth: ties.then(|| &recordings[0]),
+        depth: depth_mode.then(|| &recordings[0]),
         pos: vec![0; baked.scene_ids.len()],
         stamp: vec![u32::MAX; baked.scene_ids.len()],
     };
@@ -267,9 +267,7 @@ impl Copies {
             }
         }
     }
-}
 
-impl Copies {
     /// The file's matrix cells (`merge.cells`, what `inspect --matrix` draws), where it lists
     /// any: they tile the index buffer in order, and every copy of cell (i, j) is drawn in
     /// exactly frames i..=j.
@@ -284,11 +282,10 @@ impl Copies {
             let (a, n) = (cell.first_copy as u64, cell.triangles as u64);
             if a != next || n == 0 || cell.first_frame > cell.last_frame {
                 report.problem(format!(
-                    "merge cell {c} (frames {}..={}, copies {a}..{}) does not follow cell {} in the index buffer, or is empty",
+                    "merge cell {c} (frames {}..={}, copies {a}..{}) is empty or does not start at copy {next}, where the cells before it end",
                     cell.first_frame,
                     cell.last_frame,
                     a + n,
-                    c.wrapping_sub(1) as i64
                 ));
                 return;
             }
