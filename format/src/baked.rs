@@ -149,10 +149,9 @@ pub struct Baked {
 /// Checks a stored frame rate: absent, or finite and positive (a player divides by it).
 pub(crate) fn check_fps(fps: Option<f64>) -> Result<(), crate::StructureError> {
     match fps {
-        Some(fps) if !(fps.is_finite() && fps > 0.0) => Err(crate::StructureError::new(
-            crate::Part::FrameRate,
-            format!("frame rate {fps} is not a positive number"),
-        )),
+        Some(fps) if !(fps.is_finite() && fps > 0.0) => {
+            Err(crate::Part::FrameRate.error(format!("frame rate {fps} is not a positive number")))
+        }
         _ => Ok(()),
     }
 }
@@ -191,23 +190,16 @@ impl Baked {
         let g = &self.geometry;
         g.check_structure()?;
         if self.scene_ids.len() != g.triangles.len() {
-            return Err(crate::StructureError::new(
-                crate::Part::Layout,
-                "scene_ids and triangles differ in length",
-            ));
+            return Err(crate::Part::Layout.error("scene_ids and triangles differ in length"));
         }
         if self.scene_ids.windows(2).any(|w| w[0] >= w[1]) {
-            return Err(crate::StructureError::new(
-                crate::Part::Layout,
-                "scene_ids are not strictly ascending",
-            ));
+            return Err(crate::Part::Layout.error("scene_ids are not strictly ascending"));
         }
         let ntri = g.triangles.len() as u64;
         if let Some(k) = self.copies.iter().position(|&c| c as u64 >= ntri) {
-            return Err(crate::StructureError::new(
-                crate::Part::Layout,
-                format!("copy {k} refers to a triangle beyond {ntri}"),
-            ));
+            return Err(
+                crate::Part::Layout.error(format!("copy {k} refers to a triangle beyond {ntri}"))
+            );
         }
         let nidx = self.copies.len() as u64 * 3;
         for (k, d) in self.draws.iter().enumerate() {
@@ -218,10 +210,8 @@ impl Baked {
                 || d.base_vertex != 0
                 || d.first_instance != 0
             {
-                return Err(crate::StructureError::new(
-                    crate::Part::Layout,
-                    format!("draw {k} is malformed or outside the index buffer"),
-                ));
+                return Err(crate::Part::Layout
+                    .error(format!("draw {k} is malformed or outside the index buffer")));
             }
         }
         // Per-frame work is bounded by what a merge can produce: a merge draws each copy at
@@ -237,20 +227,18 @@ impl Baked {
         for (f, w) in self.frames.iter().enumerate() {
             let (a, b) = (w.first as u64, w.first as u64 + w.count as u64);
             if b > self.draws.len() as u64 {
-                return Err(crate::StructureError::new(
-                    crate::Part::Layout,
-                    format!("frame {f}'s window lies outside the draw list"),
-                ));
+                return Err(crate::Part::Layout
+                    .error(format!("frame {f}'s window lies outside the draw list")));
             }
             if w.count as u64 > ncopies + 1 {
-                return Err(crate::StructureError::new(crate::Part::Layout, format!(
+                return Err(crate::Part::Layout.error(format!(
                     "frame {f} has {} draws, more than a merge gives a buffer of {ncopies} copies (at most one draw per copy)",
                     w.count
                 )));
             }
             let triangles = drawn[b as usize] - drawn[a as usize];
             if triangles > ncopies {
-                return Err(crate::StructureError::new(crate::Part::Layout, format!(
+                return Err(crate::Part::Layout.error(format!(
                     "frame {f} draws {triangles} triangles, more than the {ncopies} copies of the index buffer (a merge draws each copy at most once per frame)"
                 )));
             }
@@ -258,10 +246,7 @@ impl Baked {
         if self.frame_states.len() != self.frames.len()
             || self.removed_edges.len() != self.frames.len()
         {
-            return Err(crate::StructureError::new(
-                crate::Part::Layout,
-                "per-frame lists differ in length",
-            ));
+            return Err(crate::Part::Layout.error("per-frame lists differ in length"));
         }
         for (f, s) in self.frame_states.iter().enumerate() {
             crate::camera::check_frame_state(f, s, Some(g.nodes.len()))?;

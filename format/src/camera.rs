@@ -99,38 +99,33 @@ pub fn check_frame_state(
 ) -> Result<(), crate::StructureError> {
     let c = &s.camera;
     if !c.view.iter().all(|x| x.is_finite()) {
-        return Err(crate::StructureError::at_frame(
-            crate::Part::Camera,
+        return Err(crate::Part::Camera.at_frame(
             f as u32,
             format!("frame {f}: the camera's view matrix is not finite"),
         ));
     }
     let det = c.view_matrix().determinant();
     if !(det.is_finite() && det.abs() > 1e-300) {
-        return Err(crate::StructureError::at_frame(
-            crate::Part::Camera,
+        return Err(crate::Part::Camera.at_frame(
             f as u32,
             format!("frame {f}: the camera's view matrix is not invertible"),
         ));
     }
     if !(c.yfov > 0.0 && c.yfov < std::f64::consts::PI) {
-        return Err(crate::StructureError::at_frame(
-            crate::Part::Camera,
+        return Err(crate::Part::Camera.at_frame(
             f as u32,
             format!("frame {f}: yfov {} is outside (0, π)", c.yfov),
         ));
     }
     if !(c.znear > 0.0 && c.znear.is_finite()) {
-        return Err(crate::StructureError::at_frame(
-            crate::Part::Camera,
+        return Err(crate::Part::Camera.at_frame(
             f as u32,
             format!("frame {f}: znear {} is not a positive number", c.znear),
         ));
     }
     if let Some(far) = c.zfar {
         if !(far.is_finite() && far > c.znear) {
-            return Err(crate::StructureError::at_frame(
-                crate::Part::Camera,
+            return Err(crate::Part::Camera.at_frame(
                 f as u32,
                 format!(
                     "frame {f}: zfar {far} is not a finite number above znear {}",
@@ -141,22 +136,17 @@ pub fn check_frame_state(
     }
     for (k, p) in s.poses.iter().enumerate() {
         if nodes.is_some_and(|n| p.node as usize >= n) {
-            return Err(crate::StructureError::at_frame(
-                crate::Part::Camera,
-                f as u32,
-                format!("frame {f} poses missing node {}", p.node),
-            ));
+            return Err(crate::Part::Camera
+                .at_frame(f as u32, format!("frame {f} poses missing node {}", p.node)));
         }
         if k > 0 && s.poses[k - 1].node >= p.node {
-            return Err(crate::StructureError::at_frame(
-                crate::Part::Camera,
+            return Err(crate::Part::Camera.at_frame(
                 f as u32,
                 format!("frame {f}: poses are not in ascending node order"),
             ));
         }
         if !p.local.iter().all(|x| x.is_finite()) {
-            return Err(crate::StructureError::at_frame(
-                crate::Part::Camera,
+            return Err(crate::Part::Camera.at_frame(
                 f as u32,
                 format!("frame {f}: node {}'s pose is not finite", p.node),
             ));

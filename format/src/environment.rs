@@ -324,38 +324,28 @@ impl Environment {
     /// negative light (texels, sun colour, exposure).
     pub fn check_structure(&self) -> Result<(), crate::StructureError> {
         if self.width == 0 || self.height == 0 || self.levels.is_empty() {
-            return Err(crate::StructureError::new(
-                crate::Part::Environment,
-                "the environment has no texels",
-            ));
+            return Err(crate::Part::Environment.error("the environment has no texels"));
         }
         if self.levels.len() > 16 {
-            return Err(crate::StructureError::new(
-                crate::Part::Environment,
-                format!("the environment has {} levels", self.levels.len()),
-            ));
+            return Err(crate::Part::Environment
+                .error(format!("the environment has {} levels", self.levels.len())));
         }
         for (k, level) in self.levels.iter().enumerate() {
             let (w, h) = self.level_size(k);
             if level.len() as u64 != w as u64 * h as u64 * 4 {
-                return Err(crate::StructureError::new(
-                    crate::Part::Environment,
-                    format!("environment level {k} has the wrong number of texels"),
-                ));
+                return Err(crate::Part::Environment.error(format!(
+                    "environment level {k} has the wrong number of texels"
+                )));
             }
             // binary16 exponent all ones: infinity or NaN.
             if level.iter().any(|&b| b & 0x7c00 == 0x7c00) {
-                return Err(crate::StructureError::new(
-                    crate::Part::Environment,
-                    format!("environment level {k} has a non-finite texel"),
-                ));
+                return Err(crate::Part::Environment
+                    .error(format!("environment level {k} has a non-finite texel")));
             }
             // Sign bit on anything but −0: negative radiance.
             if level.iter().any(|&b| b > 0x8000) {
-                return Err(crate::StructureError::new(
-                    crate::Part::Environment,
-                    format!("environment level {k} has a negative texel"),
-                ));
+                return Err(crate::Part::Environment
+                    .error(format!("environment level {k} has a negative texel")));
             }
         }
         let sun = self
@@ -370,26 +360,20 @@ impl Environment {
             .chain([&self.exposure])
             .all(|x| x.is_finite())
         {
-            return Err(crate::StructureError::new(
-                crate::Part::Environment,
-                "the environment has a non-finite value",
-            ));
+            return Err(crate::Part::Environment.error("the environment has a non-finite value"));
         }
         // Negative light would darken what it shines on; shading has no meaning for it.
         if self.exposure < 0.0 {
-            return Err(crate::StructureError::new(
-                crate::Part::Environment,
-                format!("the environment's exposure is negative ({})", self.exposure),
-            ));
+            return Err(crate::Part::Environment.error(format!(
+                "the environment's exposure is negative ({})",
+                self.exposure
+            )));
         }
         if let Some(sun) = self.sun.filter(|s| s.color.iter().any(|&c| c < 0.0)) {
-            return Err(crate::StructureError::new(
-                crate::Part::Environment,
-                format!(
-                    "the environment's sun has a negative colour {:?}",
-                    sun.color
-                ),
-            ));
+            return Err(crate::Part::Environment.error(format!(
+                "the environment's sun has a negative colour {:?}",
+                sun.color
+            )));
         }
         Ok(())
     }

@@ -481,24 +481,19 @@ impl Geometry {
         let nv = self.vertices.len() as u64;
         for (k, t) in self.triangles.iter().enumerate() {
             if t.iter().any(|&v| v as u64 >= nv) {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!("triangle {k} refers to a vertex beyond {nv}"),
-                ));
+                return Err(crate::Part::Geometry
+                    .error(format!("triangle {k} refers to a vertex beyond {nv}")));
             }
         }
         for (k, v) in self.vertices.iter().enumerate() {
             if v.material as usize >= self.materials.len() || v.node as usize >= self.nodes.len() {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!("vertex {k} refers to a missing material or node"),
-                ));
+                return Err(crate::Part::Geometry
+                    .error(format!("vertex {k} refers to a missing material or node")));
             }
             if !v.position.iter().all(|x| x.is_finite()) {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!("vertex {k} has a non-finite position"),
-                ));
+                return Err(
+                    crate::Part::Geometry.error(format!("vertex {k} has a non-finite position"))
+                );
             }
         }
         for (k, m) in self.materials.iter().enumerate() {
@@ -513,10 +508,9 @@ impl Geometry {
                 &m.clearcoat_roughness,
             ]);
             if !factors.into_iter().all(|x| x.is_finite()) {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!("material {k} has a non-finite factor"),
-                ));
+                return Err(
+                    crate::Part::Geometry.error(format!("material {k} has a non-finite factor"))
+                );
             }
             let base = m.base_color_texture.map(|texture| TextureSlot {
                 texture,
@@ -534,115 +528,92 @@ impl Geometry {
                 let Some(slot) = slot else { continue };
                 let t = slot.texture;
                 if t as usize >= self.textures.len() {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Geometry,
-                        format!("material {k}'s {what} texture refers to missing texture {t}"),
-                    ));
+                    return Err(crate::Part::Geometry.error(format!(
+                        "material {k}'s {what} texture refers to missing texture {t}"
+                    )));
                 }
                 if slot.tex_coord > 1 {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Geometry,
-                        format!(
-                            "material {k}'s {what} texture samples texture coordinate set {} \
+                    return Err(crate::Part::Geometry.error(format!(
+                        "material {k}'s {what} texture samples texture coordinate set {} \
                          (only 0 and 1 exist)",
-                            slot.tex_coord
-                        ),
-                    ));
+                        slot.tex_coord
+                    )));
                 }
                 if !slot.transform.is_finite() {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Geometry,
-                        format!("material {k}'s {what} texture transform is not finite"),
-                    ));
+                    return Err(crate::Part::Geometry.error(format!(
+                        "material {k}'s {what} texture transform is not finite"
+                    )));
                 }
             }
             if m.base_color_tex_coord > 1 {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!(
-                        "material {k}'s base-colour texture coordinate set {} does not exist \
+                return Err(crate::Part::Geometry.error(format!(
+                    "material {k}'s base-colour texture coordinate set {} does not exist \
                      (only 0 and 1 do)",
-                        m.base_color_tex_coord
-                    ),
-                ));
+                    m.base_color_tex_coord
+                )));
             }
         }
         for (t, tex) in self.textures.iter().enumerate() {
             if tex.width == 0 || tex.height == 0 {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!("texture {t} is empty ({}x{})", tex.width, tex.height),
-                ));
+                return Err(crate::Part::Geometry.error(format!(
+                    "texture {t} is empty ({}x{})",
+                    tex.width, tex.height
+                )));
             }
             if tex.rgba8.len() as u64 != tex.width as u64 * tex.height as u64 * 4 {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!("texture {t} has the wrong number of bytes"),
-                ));
+                return Err(crate::Part::Geometry
+                    .error(format!("texture {t} has the wrong number of bytes")));
             }
             let levels = Texture::mip_count(tex.width, tex.height);
             if tex.mips.len() != levels {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!(
-                        "texture {t} {:?} ({}x{}) has {} mip levels, a full chain has {levels} \
+                return Err(crate::Part::Geometry.error(format!(
+                    "texture {t} {:?} ({}x{}) has {} mip levels, a full chain has {levels} \
                      (levels 1, 2, … down to 1x1, made at import)",
-                        tex.name,
-                        tex.width,
-                        tex.height,
-                        tex.mips.len()
-                    ),
-                ));
+                    tex.name,
+                    tex.width,
+                    tex.height,
+                    tex.mips.len()
+                )));
             }
             for (k, mip) in tex.mips.iter().enumerate() {
                 let (w, h) = Texture::level_size(tex.width, tex.height, k as u32 + 1);
                 if mip.len() as u64 != w as u64 * h as u64 * 4 {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Geometry,
-                        format!(
-                            "texture {t}'s mip level {} has {} bytes, {w}x{h} RGBA8 needs {}",
-                            k + 1,
-                            mip.len(),
-                            w as u64 * h as u64 * 4
-                        ),
-                    ));
+                    return Err(crate::Part::Geometry.error(format!(
+                        "texture {t}'s mip level {} has {} bytes, {w}x{h} RGBA8 needs {}",
+                        k + 1,
+                        mip.len(),
+                        w as u64 * h as u64 * 4
+                    )));
                 }
             }
         }
         for (k, v) in self.variants.iter().enumerate() {
             if v.materials.len() != self.materials.len() {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!(
-                        "material variant {k} maps {} material slots, the geometry has {}",
-                        v.materials.len(),
-                        self.materials.len()
-                    ),
-                ));
+                return Err(crate::Part::Geometry.error(format!(
+                    "material variant {k} maps {} material slots, the geometry has {}",
+                    v.materials.len(),
+                    self.materials.len()
+                )));
             }
             if let Some(m) = v
                 .materials
                 .iter()
                 .find(|&&m| m as usize >= self.materials.len())
             {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!("material variant {k} refers to missing material {m}"),
-                ));
+                return Err(crate::Part::Geometry.error(format!(
+                    "material variant {k} refers to missing material {m}"
+                )));
             }
         }
         for (k, n) in self.nodes.iter().enumerate() {
             if n.parent.is_some_and(|p| p as usize >= k) {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!("node {k} has a parent that does not precede it"),
-                ));
+                return Err(crate::Part::Geometry
+                    .error(format!("node {k} has a parent that does not precede it")));
             }
             if !n.rest.iter().all(|x| x.is_finite()) {
-                return Err(crate::StructureError::new(
-                    crate::Part::Geometry,
-                    format!("node {k}'s rest transform is not finite"),
-                ));
+                return Err(
+                    crate::Part::Geometry.error(format!("node {k}'s rest transform is not finite"))
+                );
             }
         }
         Ok(())

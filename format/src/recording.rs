@@ -356,30 +356,20 @@ impl RecordSettings {
     pub fn check_stored(&self) -> Result<(), crate::StructureError> {
         let s = self;
         if s.width == 0 || s.height == 0 || (s.samples != 1 && s.samples != 4) {
-            return Err(crate::StructureError::new(
-                crate::Part::Settings,
-                format!(
-                    "settings {}x{} at {} samples are impossible",
-                    s.width, s.height, s.samples
-                ),
-            ));
+            return Err(crate::Part::Settings.error(format!(
+                "settings {}x{} at {} samples are impossible",
+                s.width, s.height, s.samples
+            )));
         }
         let saturation_ok = s.saturation > 0.0 && s.saturation <= 1.0;
         if !saturation_ok || !(0.0..=1.0).contains(&s.glass_opacity) {
-            return Err(crate::StructureError::new(
-                crate::Part::Settings,
-                format!(
-                    "saturation {} or glass opacity {} is out of range",
-                    s.saturation, s.glass_opacity
-                ),
-            ));
+            return Err(crate::Part::Settings.error(format!(
+                "saturation {} or glass opacity {} is out of range",
+                s.saturation, s.glass_opacity
+            )));
         }
-        self.validate().map_err(|e| {
-            crate::StructureError::new(
-                crate::Part::Settings,
-                format!("settings are impossible: {e}"),
-            )
-        })
+        self.validate()
+            .map_err(|e| crate::Part::Settings.error(format!("settings are impossible: {e}")))
     }
 
     /// Checks that the settings can be recorded: size 1..=[`RecordSettings::MAX_SIDE`], 1 or
@@ -630,19 +620,13 @@ impl Recording {
         self.settings.check_stored()?;
         let g = &self.unique_visible;
         if g.windows(2).any(|w| w[0] >= w[1]) {
-            return Err(crate::StructureError::new(
-                crate::Part::Graphs,
-                "the visible set G is not strictly ascending",
-            ));
+            return Err(crate::Part::Graphs.error("the visible set G is not strictly ascending"));
         }
         if let Some(&t) = g.last().filter(|&&t| t >= self.scene_triangles) {
-            return Err(crate::StructureError::new(
-                crate::Part::Graphs,
-                format!(
-                    "G names triangle {t}, but the scene has {}",
-                    self.scene_triangles
-                ),
-            ));
+            return Err(crate::Part::Graphs.error(format!(
+                "G names triangle {t}, but the scene has {}",
+                self.scene_triangles
+            )));
         }
         let in_g = |t: u32| g.binary_search(&t).is_ok();
         let path_frames = self.frame_states.len() as u64;
@@ -650,31 +634,24 @@ impl Recording {
         for (k, fr) in self.frames.iter().enumerate() {
             let f = fr.frame;
             if f as u64 != first as u64 + k as u64 {
-                return Err(crate::StructureError::new(
-                    crate::Part::Graphs,
-                    format!(
-                        "frame record {k} is frame {f}; frames must be contiguous from {first}"
-                    ),
-                ));
+                return Err(crate::Part::Graphs.error(format!(
+                    "frame record {k} is frame {f}; frames must be contiguous from {first}"
+                )));
             }
             if f as u64 >= path_frames {
-                return Err(crate::StructureError::new(
-                    crate::Part::Graphs,
-                    format!("frame {f} lies beyond the path's {path_frames} frames"),
-                ));
+                return Err(crate::Part::Graphs.error(format!(
+                    "frame {f} lies beyond the path's {path_frames} frames"
+                )));
             }
             for (what, set) in [("visible", &fr.visible), ("covered", &fr.covered)] {
                 if set.windows(2).any(|w| w[0] >= w[1]) {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Graphs,
-                        format!("frame {f}: the {what} set is not strictly ascending"),
-                    ));
+                    return Err(crate::Part::Graphs.error(format!(
+                        "frame {f}: the {what} set is not strictly ascending"
+                    )));
                 }
                 if let Some(&t) = set.iter().find(|&&t| !in_g(t)) {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Graphs,
-                        format!("frame {f}: {what} triangle {t} is not in G"),
-                    ));
+                    return Err(crate::Part::Graphs
+                        .error(format!("frame {f}: {what} triangle {t} is not in G")));
                 }
             }
             for (what, list) in [("edges", &fr.edges), ("ties", &fr.ties)] {
@@ -682,54 +659,42 @@ impl Recording {
                     .windows(2)
                     .any(|w| (w[0].from, w[0].to) >= (w[1].from, w[1].to))
                 {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Graphs,
-                        format!("frame {f}: {what} are not sorted without duplicates"),
-                    ));
+                    return Err(crate::Part::Graphs.error(format!(
+                        "frame {f}: {what} are not sorted without duplicates"
+                    )));
                 }
                 if let Some(e) = list
                     .iter()
                     .find(|e| e.from == e.to || e.weight == 0 || !in_g(e.from) || !in_g(e.to))
                 {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Graphs,
-                        format!(
+                    return Err(crate::Part::Graphs.error(format!(
                         "frame {f}: edge {} → {} (weight {}) is a loop, has no weight or leaves G",
                         e.from, e.to, e.weight
-                    ),
-                    ));
+                    )));
                 }
             }
             if self.phase == Phase::Visibility
                 && !(fr.covered.is_empty() && fr.edges.is_empty() && fr.ties.is_empty())
             {
-                return Err(crate::StructureError::new(
-                    crate::Part::Graphs,
-                    format!("frame {f}: a visibility recording holds graphs"),
-                ));
+                return Err(crate::Part::Graphs
+                    .error(format!("frame {f}: a visibility recording holds graphs")));
             }
         }
         let nodes = match self.phase {
             Phase::Graphs => {
                 if self.geometry.triangles.len() != g.len() {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Graphs,
-                        format!(
-                            "the geometry holds {} triangles for the {} of G",
-                            self.geometry.triangles.len(),
-                            g.len()
-                        ),
-                    ));
+                    return Err(crate::Part::Graphs.error(format!(
+                        "the geometry holds {} triangles for the {} of G",
+                        self.geometry.triangles.len(),
+                        g.len()
+                    )));
                 }
                 self.geometry.check_structure()?;
                 Some(self.geometry.nodes.len())
             }
             Phase::Visibility => {
                 if !self.geometry.triangles.is_empty() {
-                    return Err(crate::StructureError::new(
-                        crate::Part::Graphs,
-                        "a visibility recording holds geometry",
-                    ));
+                    return Err(crate::Part::Graphs.error("a visibility recording holds geometry"));
                 }
                 None
             }

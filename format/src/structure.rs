@@ -23,6 +23,18 @@ pub enum Part {
     FrameRate,
 }
 
+impl Part {
+    /// A problem of this part, of no one frame.
+    pub fn error(self, problem: impl Into<String>) -> StructureError {
+        StructureError::new(self, problem)
+    }
+
+    /// A problem of this part at frame `frame`.
+    pub fn at_frame(self, frame: u32, problem: impl Into<String>) -> StructureError {
+        StructureError::at_frame(self, frame, problem)
+    }
+}
+
 impl fmt::Display for Part {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
