@@ -101,6 +101,13 @@ pub(crate) enum Grow<'a> {
     Envelope(&'a Robust, &'a [[u32; 4]]),
 }
 
+/// What a capture captures: the drawn triangles as they are (phase 1 may stop behind the
+/// nearest always-opaque one: `until_opaque`), or grown ([`Capture::grown`]).
+enum Kind<'a> {
+    Plain { until_opaque: bool },
+    Grown(Grow<'a>),
+}
+
 impl Grow<'_> {
     /// The tolerance and raster profile grown by.
     fn robust(&self) -> &Robust {
@@ -132,16 +139,8 @@ impl<'g> Capture<'g> {
         until_opaque: bool,
         internals: &crate::Internals,
     ) -> Result<Self, RecordError> {
-        Capture::build(
-            gpu,
-            geometry,
-            triangles,
-            frames,
-            view,
-            until_opaque,
-            None,
-            internals,
-        )
+        let kind = Kind::Plain { until_opaque };
+        Capture::build(gpu, geometry, triangles, frames, view, kind, internals)
     }
 
     /// [`Capture::new`] over the triangles grown by a tolerance box (`capture_grown.wgsl`):
@@ -160,29 +159,23 @@ impl<'g> Capture<'g> {
         grow: Grow,
         internals: &crate::Internals,
     ) -> Result<Self, RecordError> {
-        Capture::build(
-            gpu,
-            geometry,
-            triangles,
-            frames,
-            view,
-            false,
-            Some(grow),
-            internals,
-        )
+        let kind = Kind::Grown(grow);
+        Capture::build(gpu, geometry, triangles, frames, view, kind, internals)
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn build(
         gpu: &'g Gpu,
         geometry: &Geometry,
         triangles: &[u32],
         frames: &[FrameState],
         view: View,
-        until_opaque: bool,
-        grow: Option<Grow>,
+        kind: Kind,
         internals: &crate::Internals,
     ) -> Result<Self, RecordError> {
+        let (until_opaque, grow) = match kind {
+            Kind::Plain { until_opaque } => (until_opaque, None),
+            Kind::Grown(grow) => (false, Some(grow)),
+        };
         let device = &gpu.device;
         // Before anything is allocated: the list heads must fit one binding.
         let slots = view.width as u64 * view.height as u64 * view.samples as u64;
