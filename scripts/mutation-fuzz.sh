@@ -8,7 +8,8 @@
 #
 # The mutants come from testkit/examples/mutate.rs (fields changed and re-encoded, payload
 # bytes in a correct container, container bytes), one per seed, so a failure replays with
-# `cargo run --release -p trisort-testkit --example mutate -- KIND IN OUT SEED`.
+# `cargo run --release -p trisort-testkit --example mutate -- KIND IN OUT SEED`; what each
+# fields mutant changed is listed in OUT_DIR/mutants.txt.
 # Needs a Vulkan (or GL) adapter for play and verify --scene: lavapipe on a machine without a GPU.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -44,14 +45,14 @@ run() {
 }
 start=$(date +%s)
 for seed in $(seq 1 "$n_rec"); do
-  "$mutate" recording seed.baked.rec m.rec "$seed"
+  "$mutate" recording seed.baked.rec m.rec "$seed" 2>>mutants.txt
   run rec-inspect "$seed" "$t" inspect m.rec
   run rec-merge "$seed" "$t" merge m.rec -o m-merged.baked
   rm -f m-merged.baked
   if ((seed % 100 == 0)); then echo "recordings: $seed of $n_rec" >&2; fi
 done
 for seed in $(seq 1 "$n_baked"); do
-  "$mutate" baked seed.baked m.baked "$seed"
+  "$mutate" baked seed.baked m.baked "$seed" 2>>mutants.txt
   run baked-inspect "$seed" "$t" inspect m.baked
   run baked-play "$seed" "$t" play m.baked --out-dir frames
   run baked-verify-recording "$seed" "$t" verify m.baked --recording seed.baked.rec

@@ -80,17 +80,19 @@ fn mutate_number(x: &serde_json::Number, rng: &mut Rng) -> Value {
 
 /// Changes one place of `v`, reached by a random walk from the root: at a list it may stop
 /// (and change the list) or go into an element; at a map into a field; at a leaf it changes
-/// the leaf.
-fn mutate_tree(v: &mut Value, rng: &mut Rng) {
+/// the leaf. `at` is the place's path (`/merge/strategy`, `/draws/7`), extended as the walk
+/// goes; returns the path of the place changed.
+fn mutate_tree(v: &mut Value, rng: &mut Rng, at: String) -> String {
     match v {
         Value::Object(map) if !map.is_empty() => {
             let k = rng.below(map.len());
             let key = map.keys().nth(k).cloned().expect("k < len");
-            mutate_tree(map.get_mut(&key).expect("present"), rng);
+            let at = format!("{at}/{key}");
+            return mutate_tree(map.get_mut(&key).expect("present"), rng, at);
         }
         Value::Array(list) if !list.is_empty() && rng.below(3) > 0 => {
             let k = rng.below(list.len());
-            mutate_tree(&mut list[k], rng);
+            return mutate_tree(&mut list[k], rng, format!("{at}/{k}"));
         }
         Value::Array(list) => match rng.below(5) {
             0 => list.clear(),
@@ -117,21 +119,24 @@ fn mutate_tree(v: &mut Value, rng: &mut Rng) {
         Value::Null => *v = Value::from(rng.below(4)),
         Value::Object(_) => {}
     }
+    at
 }
 
-/// A fields mutant of `value` (retried until one decodes as `T` again).
-fn fields<T: Serialize + DeserializeOwned>(value: &T, rng: &mut Rng) -> T {
+/// A fields mutant of `value` (retried until one decodes as `T` again), and the paths of the
+/// places changed.
+fn fields<T: Serialize + DeserializeOwned>(value: &T, rng: &mut Rng) -> (T, Vec<String>) {
     let tree = serde_json::to_value(value).expect("trisort files serialize to a serde tree");
     for _ in 0..100 {
         let mut t = tree.clone();
-        for _ in 0..1 + rng.below(3) {
-            mutate_tree(&mut t, rng);
-        }
+        let changed: Vec<String> = (0..1 + rng.below(3))
+            .map(|_| mutate_tree(&mut t, rng, String::new()))
+            .collect();
         if let Ok(mutant) = serde_json::from_value::<T>(t) {
-            return mutant;
+            return (mutant, changed);
         }
     }
-    serde_json::from_value(tree).expect("the unmutated tree decodes")
+    let same = serde_json::from_value(tree).expect("the unmutated tree decodes");
+    (same, vec![])
 }
 
 /// `bytes` with a few flips, overwrites, cuts or repeats.
@@ -169,7 +174,12 @@ fn mutant<T: Serialize + DeserializeOwned>(
     let value: T = decode(kind, &bytes, input).map_err(|e| e.to_string())?;
     let mut rng = Rng::new(seed);
     Ok(match seed % 3 {
-        0 => encode(kind, &fields(&value, &mut rng)),
+        0 => {
+            let (mutant, changed) = fields(&value, &mut rng);
+            // What changed, for whoever replays the seed.
+            eprintln!("mutate: seed {seed}: fields {}", changed.join(", "));
+            encode(kind, &mutant)
+        }
         1 => {
             let raw = postcard::to_stdvec(&value).map_err(|e| e.to_string())?;
             encode_payload(kind, &mutate_bytes(raw, &mut rng))
