@@ -1,0 +1,365 @@
+//! GPU resources of a scene shared by every pipeline: the vertex buffer, the materials, the
+//! texture arrays (sRGB and linear, with mips), the environment light, and per-frame uniforms
+//! and camera-relative node matrices bound by dynamic offset (group 0 of [`crate::COMMON`]).
+//!
+//! [`SceneGpu`] owns them; its parts live in submodules and are re-exported here:
+//! the uniforms the shaders read (`uniforms`, `materials`), how group 0 carries them on each
+//! binding tier (`bindings`), the texture arrays and the environment (`textures`,
+//! `environment`), the peel passes' shared layout (`peel`) and the render pipeline builder
+//! over the scene's vertex buffer (`pipeline`).
+
+mod bindings;
+mod environment;
+mod materials;
+mod peel;
+mod pipeline;
+mod textures;
+mod uniforms;
+
+pub use bindings::{bind_group_layout, bind_group_layout_for, Bindings, DATA_WIDTH};
+pub(crate) use bindings::{sized_buffer_entry, surface_entries, MaterialStore, SharedBindings};
+pub use materials::MaterialGpu;
+pub use peel::{begin_peel_pass, previous_key_entries};
+pub use pipeline::{vertex_layout, ScenePipeline, VERTEX_ATTRIBUTES};
+pub use trisort_format::{Shading, ToneMap};
+pub(crate) use uniforms::FrameData;
+pub use uniforms::{
+    frame_uniform, shading_constants, subpixel_shift, FrameUniform, Lighting, LightingUniform,
+    LIGHT,
+};
+
+use bindings::storage_bind_group;
+use environment::upload_environment;
+use materials::material_table;
+use textures::{upload_textures, TexturePlace};
+use trisort_format::{FrameState, Geometry, Material, Vertex};
+use uniforms::{frame_data, projection};
+use wgpu::util::DeviceExt;
+
+/// How frames are drawn: image size, sample count and glass opacity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// MSAA samples.
+    pub samples: u32,
+    /// Opacity of transmissive glass.
+    pub glass_opacity: f32,
+}
+
+/// Scene resources on the GPU.
+pub struct SceneGpu {
+    /// Vertex buffer.
+    pub vertices: wgpu::Buffer,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    /// Bind group layout of group 0.
+    pub layout: wgpu::BindGroupLayout,
+    /// Bind group 0 (bind with [`SceneGpu::offsets`]).
+    pub bind_group: wgpu::BindGroup,
+    frame_stride: u64,
+    node_stride: u64,
+    frames: u32,
+    /// The frame uniforms (binding 0), rewritten by [`SceneGpu::set_subpixel_offset`].
+    frame_buffer: wgpu::Buffer,
+    /// Per frame: the uniform as uploaded with no offset, and its projection in f64.
+    uniforms: Vec<(FrameUniform, glam::DMat4)>,
+    view: View,
+    /// Where the material table lives (rewritten by [`SceneGpu::set_materials`]).
+    material_store: MaterialStore,
+    /// Per texture, where it lies in the arrays (for rewriting the material table).
+    texture_places: Vec<TexturePlace>,
+    /// Number of materials uploaded.
+    material_count: usize,
+    /// [`SceneGpu::texture_bytes`].
+    texture_bytes: u64,
+}
+
+impl SceneGpu {
+    /// Uploads the geometry, materials, textures and the uniforms of every frame, on the
+    /// storage tier ([`SceneGpu::with_bindings`] with [`Bindings::Storage`]), lit by
+    /// [`Shading::Pbr`] under a uniform environment of radiance 1 (for tools that draw without
+    /// the file's light; players light with [`SceneGpu::with_lighting`], and the recorder,
+    /// which reads only visibility, uploads less with [`SceneGpu::for_visibility`]).
+    ///
+    /// Textures share two arrays (sRGB and linear, each texture in the array of its colour
+    /// space, with its mips): each layer is as large as the array's largest texture, and a
+    /// smaller texture fills the top-left corner of every level (its uv scaled to fit), so one
+    /// bind group serves every material. Node matrices are computed in f64 and cast once.
+    /// Every texture's mips are uploaded as the geometry stores them: the geometry must pass
+    /// [`Geometry::check_structure`] (which requires each texture's full chain), else this
+    /// may panic.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+    ) -> SceneGpu {
+        SceneGpu::with_bindings(device, queue, geometry, frames, view, Bindings::Storage)
+    }
+
+    /// [`SceneGpu::new`] with node matrices and materials carried as `bindings` says; the
+    /// layout and bind group match shaders composed with [`crate::compose_with`] for it.
+    pub fn with_bindings(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+        bindings: Bindings,
+    ) -> SceneGpu {
+        let lighting = Lighting::default();
+        SceneGpu::with_lighting(device, queue, geometry, frames, view, bindings, lighting)
+    }
+
+    /// [`SceneGpu::new`] for shaders that read only what decides visibility: `surface_base`'s
+    /// alpha and `culled` (the recorder's peel and conservative passes), never a material's
+    /// other maps nor the light. The linear texture array, which holds only the
+    /// metallic-roughness, normal and occlusion maps such shaders skip, is one white texel
+    /// unless some material's base-colour texture is linear (then it is uploaded as
+    /// [`SceneGpu::new`] uploads it). The sRGB array, every texture's place (layer and uv
+    /// scale), the material table, frames and the 1×1 uniform environment are those of
+    /// [`SceneGpu::new`], so such shaders draw the same bytes with a smaller upload
+    /// ([`SceneGpu::texture_bytes`]). A shader that shades through it reads that white texel
+    /// for every linear map.
+    pub fn for_visibility(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+    ) -> SceneGpu {
+        SceneGpu::upload(
+            device,
+            queue,
+            geometry,
+            frames,
+            view,
+            Bindings::Storage,
+            Lighting::default(),
+            true,
+        )
+    }
+
+    /// [`SceneGpu::with_bindings`] lit as `lighting` says (the player and the reference pass
+    /// the baked file's environment, so both light alike).
+    pub fn with_lighting(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+        bindings: Bindings,
+        lighting: Lighting<'_>,
+    ) -> SceneGpu {
+        SceneGpu::upload(
+            device, queue, geometry, frames, view, bindings, lighting, false,
+        )
+    }
+
+    /// [`SceneGpu::with_lighting`], or with `visibility_only` [`SceneGpu::for_visibility`]'s
+    /// smaller texture upload.
+    #[allow(clippy::too_many_arguments)]
+    fn upload(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+        bindings: Bindings,
+        lighting: Lighting<'_>,
+        visibility_only: bool,
+    ) -> SceneGpu {
+        let limits = device.limits();
+        let vertex_bytes: &[u8] = if geometry.vertices.is_empty() {
+            &[0u8; std::mem::size_of::<Vertex>()]
+        } else {
+            bytemuck::cast_slice(&geometry.vertices)
+        };
+        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("vertices"),
+            contents: vertex_bytes,
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let textures = upload_textures(device, queue, geometry, visibility_only);
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("material textures"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let env = upload_environment(device, queue, lighting.environment);
+        let environment_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("environment"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let lighting_uniform = LightingUniform::new(&lighting, env.levels);
+        let lighting_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("lighting"),
+            contents: bytemuck::bytes_of(&lighting_uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let materials = material_table(&geometry.materials, &textures.places);
+        // The texture tier packs every frame's matrices contiguously (64 bytes a node).
+        let node_align = match bindings {
+            Bindings::Storage => limits.min_storage_buffer_offset_alignment as u64,
+            Bindings::Textures => 64,
+        };
+        let data = frame_data(&limits, geometry, frames, view, node_align);
+        let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("frame uniforms"),
+            contents: &data.frame_bytes,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let view_entry = |binding, view| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(view),
+        };
+        let sampler_entry = |binding, sampler| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::Sampler(sampler),
+        };
+        let shared = SharedBindings {
+            frame: wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &frame_buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniform>() as u64),
+                }),
+            },
+            surface: [
+                view_entry(3, &textures.srgb),
+                sampler_entry(4, &sampler),
+                view_entry(6, &textures.linear),
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: lighting_buffer.as_entire_binding(),
+                },
+                view_entry(8, &env.view),
+                sampler_entry(9, &environment_sampler),
+            ],
+        };
+        let (layout, bind_group, node_stride, material_store) = match bindings {
+            Bindings::Storage => storage_bind_group(device, shared, &data, &materials),
+            Bindings::Textures => crate::data_textures::bind_group(
+                device,
+                queue,
+                shared,
+                &data,
+                bytemuck::cast_slice(&materials),
+                frames.len(),
+            ),
+        };
+        SceneGpu {
+            vertices,
+            vertex_count: geometry.vertices.len() as u32,
+            layout,
+            bind_group,
+            frame_stride: data.frame_stride,
+            node_stride,
+            frames: frames.len() as u32,
+            uniforms: frames
+                .iter()
+                .map(|state| (frame_uniform(state, view), projection(state, view)))
+                .collect(),
+            frame_buffer,
+            view,
+            material_store,
+            texture_places: textures.places,
+            material_count: geometry.materials.len(),
+            texture_bytes: textures.bytes + env.bytes,
+        }
+    }
+
+    /// Bytes of GPU memory the scene's textures take: both material texture arrays with every
+    /// mip level of every layer (unused corners included), and the prefiltered environment.
+    pub fn texture_bytes(&self) -> u64 {
+        self.texture_bytes
+    }
+
+    /// Rewrites the material table with `materials` in place of the uploaded ones (a material
+    /// variant: slot k draws as `materials[k]`; textures are those uploaded, named by index).
+    /// Takes effect for commands submitted after it. Panics unless `materials` has as many
+    /// entries as the geometry uploaded.
+    pub fn set_materials(&self, queue: &wgpu::Queue, materials: &[Material]) {
+        assert_eq!(
+            materials.len(),
+            self.material_count,
+            "a material table replaces one of the same length"
+        );
+        let table = material_table(materials, &self.texture_places);
+        let bytes: &[u8] = bytemuck::cast_slice(&table);
+        match &self.material_store {
+            MaterialStore::Buffer(buffer) => queue.write_buffer(buffer, 0, bytes),
+            MaterialStore::Texture(texture) => {
+                crate::data_textures::write_data_texture(queue, texture, bytes)
+            }
+        }
+    }
+
+    /// Shifts every frame's projection by `offset` pixels (x right, y down) at this scene's
+    /// view size, or back to the recorded projection with `[0.0, 0.0]`: the image moves by
+    /// `offset`, as if the sample pattern moved by `-offset`. A test aid that stands for
+    /// another rasterizer's vertex snapping (`play --subpixel-offset`), and the recorder's
+    /// jittered patterns (`record --robust N`). Applied in f64 before the one cast, so the
+    /// zero offset rasterizes exactly what [`SceneGpu::new`] uploads. Takes effect for
+    /// commands submitted after it.
+    pub fn set_subpixel_offset(&self, queue: &wgpu::Queue, offset: [f64; 2]) {
+        self.set_subpixel_offset_of(queue, offset, 0..self.uniforms.len() as u32);
+    }
+
+    /// [`SceneGpu::set_subpixel_offset`] for the frames of `frames` only (the recorder's
+    /// jittered patterns move one frame at a time: rewriting every frame's uniforms for each
+    /// pattern of each frame grew with the square of the path's length).
+    pub fn set_subpixel_offset_of(
+        &self,
+        queue: &wgpu::Queue,
+        offset: [f64; 2],
+        frames: std::ops::Range<u32>,
+    ) {
+        let frames = frames.start as usize..(frames.end as usize).min(self.uniforms.len());
+        for (f, (u, proj)) in self
+            .uniforms
+            .iter()
+            .enumerate()
+            .skip(frames.start)
+            .take(frames.len())
+        {
+            let mut u = *u;
+            u.proj = (subpixel_shift(offset, self.view) * *proj)
+                .as_mat4()
+                .to_cols_array_2d();
+            queue.write_buffer(
+                &self.frame_buffer,
+                f as u64 * self.frame_stride,
+                bytemuck::bytes_of(&u),
+            );
+        }
+    }
+
+    /// Number of frames uploaded.
+    pub fn frames(&self) -> u32 {
+        self.frames
+    }
+
+    /// The dynamic offsets that bind frame `f`'s uniforms and node matrices.
+    pub fn offsets(&self, f: u32) -> [u32; 2] {
+        assert!(f < self.frames.max(1), "frame {f} out of range");
+        [
+            (f as u64 * self.frame_stride) as u32,
+            (f as u64 * self.node_stride) as u32,
+        ]
+    }
+}
