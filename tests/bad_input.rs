@@ -82,7 +82,9 @@ fn write_rec(dir: &Path, name: &str, rec: &Recording) {
 /// A valid recording `good.rec` and its bake `good.baked` in `dir`.
 fn good_files(dir: &Path) -> (Recording, Baked) {
     let rec = small_turntable(7);
-    let baked = merge(std::slice::from_ref(&rec), &MergeOptions::default()).unwrap();
+    let baked = merge(std::slice::from_ref(&rec), &MergeOptions::default())
+        .unwrap()
+        .lit(trisort_format::Environment::studio());
     write_rec(dir, "good.rec", &rec);
     trisort_format::write_file_atomic(FileKind::Baked, &dir.join("good.baked"), &baked).unwrap();
     (rec, baked)

@@ -52,7 +52,8 @@ fn bake(
     };
     let rec = record(gpu, &job, None, |_| {}).expect("recording succeeds");
     let baked = trisort_merger::merge(std::slice::from_ref(&rec), &Default::default())
-        .expect("merge succeeds");
+        .expect("merge succeeds")
+        .lit(trisort_format::Environment::studio());
     let graph = trisort_verify::check_graph(std::slice::from_ref(&rec), &baked);
     assert!(graph.ok, "graph rules: {:?}", graph.problems);
     (rec, baked)

@@ -449,8 +449,9 @@ fn run_real(
     let measure = |axis: &str, opts: &MergeOptions, window: PeakWindow| {
         let cpu1 = cpu_seconds();
         let t1 = Instant::now();
-        let baked = trisort_merger::merge(std::slice::from_ref(&rec), opts)?;
+        let merged = trisort_merger::merge(std::slice::from_ref(&rec), opts)?;
         let merge_seconds = t1.elapsed().as_secs_f64();
+        let baked = merged.lit(trisort_format::Environment::studio());
         let merge_cpu_seconds = cpu_since(cpu1);
         let peak = window.peak();
         let s = &baked.stats;
@@ -610,6 +611,7 @@ fn synthetic(frames: u32, segment: u32, progress: &dyn Fn(&str)) -> Result<Scali
         },
     )?;
     let merge_seconds = t0.elapsed().as_secs_f64();
+    let baked = baked.lit(trisort_format::Environment::studio());
     let merge_cpu_seconds = cpu_since(cpu0);
     let peak = window.peak();
     let s = &baked.stats;

@@ -1,4 +1,4 @@
-//! Measurement (not a test): what the environment light costs a baked file (issue 17).
+//! Measurement (not a test): what the environment light costs a baked file.
 //!
 //! `cargo run -p trisort-merger --example environment_cost`
 //!
@@ -23,11 +23,10 @@ fn main() {
         frames: 3,
         ..Turntable::default()
     });
-    let mut baked = merge(std::slice::from_ref(&rec), &MergeOptions::default()).expect("merge");
-    baked.environment = studio.clone();
-    let with_studio = container::encode(FileKind::Baked, &baked).len();
-    baked.environment = Environment::uniform(1.0);
-    let with_uniform = container::encode(FileKind::Baked, &baked).len();
+    let merged = merge(std::slice::from_ref(&rec), &MergeOptions::default()).expect("merge");
+    let with_studio = container::encode(FileKind::Baked, &merged.clone().lit(studio.clone())).len();
+    let with_uniform =
+        container::encode(FileKind::Baked, &merged.lit(Environment::uniform(1.0))).len();
     println!("studio prefilter: {seconds:.3} s (first call in the process)");
     println!(
         "studio: {} levels, {}x{} .. {:?}; texels {} bytes raw",

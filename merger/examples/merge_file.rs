@@ -89,7 +89,9 @@ fn main() {
     }
     for opts in runs {
         let t = Instant::now();
-        let b = merge(&recs, &opts).expect("merge");
+        let b = merge(&recs, &opts)
+            .expect("merge")
+            .lit(trisort_format::Environment::uniform(1.0));
         let secs = t.elapsed().as_secs_f64();
         let valid = if verify {
             let r = trisort_verify::check_graph(&recs, &b);

@@ -36,7 +36,9 @@ fn main() {
     for n in sizes {
         let rec = hidden_chain(n, pairs);
         let t = Instant::now();
-        let baked = merge(std::slice::from_ref(&rec), &opts).expect("merge");
+        let baked = merge(std::slice::from_ref(&rec), &opts)
+            .expect("merge")
+            .lit(trisort_format::Environment::uniform(1.0));
         println!(
             "hidden chain {n}, {pairs} pairs: {:.3} s, {} index triangles",
             t.elapsed().as_secs_f64(),

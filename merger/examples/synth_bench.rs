@@ -64,7 +64,9 @@ fn main() {
                         ..MergeOptions::default()
                     };
                     let t = Instant::now();
-                    let b = merge(std::slice::from_ref(&rec), &opts).expect("merge");
+                    let b = merge(std::slice::from_ref(&rec), &opts)
+                        .expect("merge")
+                        .lit(trisort_format::Environment::uniform(1.0));
                     let secs = t.elapsed().as_secs_f64();
                     let s = &b.stats;
                     println!(

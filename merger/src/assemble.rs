@@ -40,14 +40,14 @@ impl Assembled {
         self.windows.iter().map(|w| w.count).max().unwrap_or(0)
     }
 
-    /// The Baked file, lit by `environment`.
+    /// The Baked file, its light a placeholder (a uniform black environment) that
+    /// [`crate::Merged::lit`] replaces.
     pub fn into_baked(
         self,
         first: &Recording,
         recording_hashes: Vec<trisort_format::Hash>,
         graphs: &[FrameGraph],
         opts: &MergeOptions,
-        environment: trisort_format::Environment,
     ) -> Baked {
         let frames = self.windows.len().max(1) as f64;
         let mut drawn_not_visible = 0u64;
@@ -103,7 +103,7 @@ impl Assembled {
             frame_states: first.frame_states.clone(),
             removed_edges,
             fps: first.fps,
-            environment,
+            environment: trisort_format::Environment::uniform(0.0),
         }
     }
 }

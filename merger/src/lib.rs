@@ -100,6 +100,11 @@ pub struct MergeOptions {
     pub segment: Option<u32>,
     /// Seeding (default [`Seeding::Interval`]).
     pub seeding: Seeding,
+    /// Accept recordings made on different devices (adapter, driver or backend; everything
+    /// else must still agree). The baked file then names every device with its frames, each
+    /// field of its `device` starting `mixed: ` (`merge --allow-mixed-devices`). Off by
+    /// default: graphs from different rasterizers make a bake that is exact on neither.
+    pub allow_mixed_devices: bool,
 }
 
 impl MergeOptions {
@@ -119,6 +124,7 @@ impl Default for MergeOptions {
             depth_only: false,
             segment: Some(MergeOptions::DEFAULT_SEGMENT),
             seeding: Seeding::default(),
+            allow_mixed_devices: false,
         }
     }
 }
@@ -220,60 +226,32 @@ pub enum MergeError {
 }
 
 /// Merges recordings (contiguous frame ranges of one scene and path, any order) into a
-/// [`Baked`] file whose draws satisfy rules 1–3 at every frame.
+/// [`Merged`] file whose draws satisfy rules 1–3 at every frame; [`Merged::lit`] attaches
+/// the light and gives the [`Baked`] file. The merger does not choose a light: whoever runs
+/// the pipeline does (the studio by default).
 ///
 /// For every strategy × layout the options allow (in parallel with rayon), each segment is
 /// seeded, split until valid, its adjacent copies joined where the rules allow, and
 /// serialized; the result kept is the best by the objective (fewest index triangles, then
 /// fewest draws in the worst frame, then the first in [`Strategy::ALL`] × [`Layout::ALL`]
 /// order). A path of several segments picks the combination by that objective on its first
-/// segment and merges every segment with it. With several combinations, ILB and IBL compact run first and the others are
-/// abandoned once their copies exceed 1.5 × the better of those two (`PRUNE_FACTOR`). Output ids are G-local. The result is
-/// deterministic — the same inputs give the same bytes whatever the thread count — so
-/// `stats.seconds` is left 0 (callers measure and report the time). The file is lit by the
-/// built-in studio ([`trisort_format::Environment::studio`]); [`merge_lit`] lights it
-/// otherwise.
+/// segment and merges every segment with it. With several combinations, ILB and IBL compact
+/// run first and the others are abandoned once their copies exceed 1.5 × the better of those
+/// two (`PRUNE_FACTOR`). Output ids are G-local. The result is deterministic — the same
+/// inputs give the same bytes whatever the thread count — so `stats.seconds` is left 0
+/// (callers measure and report the time).
 ///
 /// Errors when the recordings are not frame ranges of one path recorded with graphs (see
 /// [`MergeError`]). Frames the recorder marked truncated are merged as recorded (their graph
 /// is incomplete); the validator fails on them. Recordings made on different devices (adapter,
-/// driver or backend) are refused ([`MergeError::Differs`]): their graphs come from different
-/// rasterizers, so the bake would be exact on neither; see [`merge_mixed_devices`].
-pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Baked, MergeError> {
-    merge_checked(recordings, opts, false, None)
-}
-
-/// [`merge`], accepting recordings made on different devices (everything else must still
-/// agree). The baked file then names every device with its frames, each field of its
-/// `device` starting `mixed: ` (`merge --allow-mixed-devices`).
-pub fn merge_mixed_devices(
-    recordings: &[Recording],
-    opts: &MergeOptions,
-) -> Result<Baked, MergeError> {
-    merge_checked(recordings, opts, true, None)
-}
-
-/// [`merge`], or [`merge_mixed_devices`] when `allow_mixed_devices`, with the file lit by
-/// `environment` (`--environment`) instead of the built-in studio, which is then not built.
-pub fn merge_lit(
-    recordings: &[Recording],
-    opts: &MergeOptions,
-    allow_mixed_devices: bool,
-    environment: trisort_format::Environment,
-) -> Result<Baked, MergeError> {
-    merge_checked(recordings, opts, allow_mixed_devices, Some(environment))
-}
-
-fn merge_checked(
-    recordings: &[Recording],
-    opts: &MergeOptions,
-    allow_mixed_devices: bool,
-    environment: Option<trisort_format::Environment>,
-) -> Result<Baked, MergeError> {
+/// driver or backend) are refused ([`MergeError::Differs`]) unless
+/// [`MergeOptions::allow_mixed_devices`]: their graphs come from different rasterizers, so
+/// the bake would be exact on neither.
+pub fn merge(recordings: &[Recording], opts: &MergeOptions) -> Result<Merged, MergeError> {
     if opts.segment == Some(0) {
         return Err(MergeError::ZeroSegment);
     }
-    let input = graph::check_recordings(recordings, allow_mixed_devices)?;
+    let input = graph::check_recordings(recordings, opts.allow_mixed_devices)?;
     let index_of = |r: &Recording| {
         recordings
             .iter()
@@ -321,10 +299,30 @@ fn merge_checked(
         .par_iter()
         .map(|r| r.content_hash())
         .collect();
-    let environment = environment.unwrap_or_else(trisort_format::Environment::studio);
-    let mut baked = best.into_baked(first, recording_hashes, &graphs, opts, environment);
+    let mut baked = best.into_baked(first, recording_hashes, &graphs, opts);
     baked.device = shards::device_of(&input.recordings);
-    Ok(baked)
+    Ok(Merged { baked })
+}
+
+/// A merged file without its light: every part of the [`Baked`] file but the environment,
+/// which the merger does not choose. [`Merged::lit`] attaches it.
+#[derive(Clone, Debug)]
+pub struct Merged {
+    /// The baked file, its environment a placeholder that [`Merged::lit`] replaces.
+    baked: Baked,
+}
+
+impl Merged {
+    /// The baked file, lit by `environment`.
+    pub fn lit(mut self, environment: trisort_format::Environment) -> Baked {
+        self.baked.environment = environment;
+        self.baked
+    }
+
+    /// The merge's statistics (the same as the lit file's).
+    pub fn stats(&self) -> &trisort_format::MergeStats {
+        &self.baked.stats
+    }
 }
 
 /// The best combination of `combos` for `segments` (see [`merge`]). With several segments and

@@ -1,9 +1,10 @@
 //! Long synthetic paths: draws per frame stay bounded, cells stay sparse, and the result
 //! still validates.
 
+use crate::merge;
 use trisort_format::Baked;
 use trisort_merger::synth::{turntable, Turntable};
-use trisort_merger::{merge, Choice, Layout, MergeOptions, Strategy};
+use trisort_merger::{Choice, Layout, MergeOptions, Strategy};
 use trisort_verify::check_graph;
 
 /// Merges the turntable `t` (IBL, compact layout, segments of `segment` frames), prints the

@@ -1,11 +1,12 @@
 //! The merger against the independent validator: random graphs, hand-made cases, mutations,
 //! determinism and long synthetic paths.
 
+use crate::merge;
 use proptest::prelude::*;
 use proptest::strategy::Strategy as _;
 use trisort_format::{Baked, Recording};
 use trisort_merger::synth::{recording_from_frames, split_frames, turntable, FrameSpec, Turntable};
-use trisort_merger::{merge, Bridge, Choice, Layout, MergeOptions, Seeding, Strategy};
+use trisort_merger::{Bridge, Choice, Layout, MergeOptions, Seeding, Strategy};
 use trisort_verify::{check_graph, check_graph_for, PlayedIn};
 
 fn opts(strategy: Strategy, layout: Layout, bridge: Bridge, seeding: Seeding) -> MergeOptions {
@@ -181,38 +182,31 @@ fn turntable_half_turn_validates() {
     assert_all_valid(std::slice::from_ref(&rec), "turntable");
 }
 
-/// A merged file is lit by the built-in studio (prefiltered levels and a sun), which passes
-/// the structure check a reader runs, or by the light given to `merge_lit`.
+/// The merger leaves the light to its caller: [`trisort_merger::Merged::lit`] stores the
+/// light it is given, changes nothing else, and the result passes a reader's structure check.
 #[test]
-fn merged_files_are_lit_by_the_studio() {
+fn merged_files_take_the_light_they_are_given() {
     let rec = turntable(&Turntable {
         objects: 2,
         sides: 6,
         frames: 3,
         ..Turntable::default()
     });
-    let baked = merge(std::slice::from_ref(&rec), &MergeOptions::default()).expect("merge");
-    baked.check_structure().expect("structure");
-    let env = &baked.environment;
-    assert_eq!(env.name, "studio");
-    assert_eq!(*env, trisort_format::Environment::studio());
-    assert!(env.levels.len() > 1 && env.sun.is_some());
-    // merge_lit stores the light it is given and changes nothing else.
-    let uniform = trisort_format::Environment::uniform(0.5);
-    let lit = trisort_merger::merge_lit(
-        std::slice::from_ref(&rec),
-        &MergeOptions::default(),
-        false,
-        uniform.clone(),
-    )
-    .expect("merge");
-    assert_eq!(lit.environment, uniform);
+    let merged =
+        trisort_merger::merge(std::slice::from_ref(&rec), &MergeOptions::default()).expect("merge");
+    let dim = trisort_format::Environment::uniform(0.5);
+    let bright = trisort_format::Environment::uniform(2.0);
+    let a = merged.clone().lit(dim.clone());
+    a.check_structure().expect("structure");
+    assert_eq!(a.environment, dim);
+    let b = merged.lit(bright.clone());
+    assert_eq!(b.environment, bright);
     assert_eq!(
         Baked {
-            environment: uniform,
-            ..baked
+            environment: bright,
+            ..a
         },
-        lit
+        b
     );
 }
 

@@ -1,9 +1,10 @@
 //! Regression tests for the merger's robustness on long chains (issue 13, part 4): results
 //! only, never times (the times are in `merger/BENCHMARKS.md` § Robustness).
 
+use crate::merge;
 use trisort_merger::cycles::feedback_arc_set;
 use trisort_merger::synth::hidden_chain;
-use trisort_merger::{merge, Choice, Layout, MergeOptions, Strategy};
+use trisort_merger::{Choice, Layout, MergeOptions, Strategy};
 use trisort_verify::check_graph;
 
 /// Copies joined back across a chain of 32,768 hidden triangles (8 pairs of swapping

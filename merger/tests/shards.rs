@@ -1,10 +1,11 @@
 //! Frame ranges recorded apart: [`join`] gives back the whole recording, merging refuses
 //! recordings that differ (naming each difference with both values) and merges recordings of
-//! different devices only through [`merge_mixed_devices`], whose bake says so.
+//! different devices only with [`MergeOptions::allow_mixed_devices`], whose bake says so.
 
+use crate::merge;
 use trisort_format::Recording;
 use trisort_merger::synth::{split_frames, turntable, Turntable};
-use trisort_merger::{differences, join, merge, merge_mixed_devices, MergeError, MergeOptions};
+use trisort_merger::{differences, join, MergeError, MergeOptions};
 
 fn parts() -> (Recording, Vec<Recording>) {
     let rec = turntable(&Turntable {
@@ -84,7 +85,11 @@ fn mixed_devices_are_refused_unless_allowed_and_then_recorded() {
     );
     let e = join(&parts).unwrap_err().to_string();
     assert!(e.contains("recording 2") && e.contains("Other GPU"), "{e}");
-    let baked = merge_mixed_devices(&parts, &opts).unwrap();
+    let mixed = MergeOptions {
+        allow_mixed_devices: true,
+        ..opts
+    };
+    let baked = merge(&parts, &mixed).unwrap();
     assert!(
         baked.device.adapter.starts_with("mixed: "),
         "{:?}",
@@ -97,6 +102,6 @@ fn mixed_devices_are_refused_unless_allowed_and_then_recorded() {
     );
     // Only the device may differ.
     parts[1].settings.max_layers += 1;
-    let e = merge_mixed_devices(&parts, &opts).unwrap_err().to_string();
+    let e = merge(&parts, &mixed).unwrap_err().to_string();
     assert!(e.contains("recording 1") && e.contains("max layers"), "{e}");
 }

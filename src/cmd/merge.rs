@@ -260,7 +260,11 @@ fn merge_to_file_with(
     names: &[String],
     allow_mixed_devices: bool,
 ) -> Result<Baked> {
-    let merged = trisort_merger::merge_lit(recs, opts, allow_mixed_devices, environment);
+    let opts = MergeOptions {
+        allow_mixed_devices,
+        ..*opts
+    };
+    let merged = trisort_merger::merge(recs, &opts).map(|m| m.lit(environment));
     // Errors name recordings by index; say which file that is.
     let baked = merged.map_err(|e| anyhow::anyhow!("{}", name_files(&e.to_string(), names)))?;
     trisort_format::write_file_atomic(FileKind::Baked, output, &baked)

@@ -147,8 +147,9 @@ impl Sweep<'_> {
                 }
                 (self.progress)(&format!("{step}: merging"));
                 let t = Instant::now();
-                let baked = trisort_merger::merge(std::slice::from_ref(&rec), &v.merge)?;
+                let merged = trisort_merger::merge(std::slice::from_ref(&rec), &v.merge)?;
                 let merge_seconds = t.elapsed().as_secs_f64();
+                let baked = merged.lit(trisort_format::Environment::studio());
                 // The reference lights like the bake: with its environment.
                 if let Entry::Vacant(slot) = references.entry(glass_key) {
                     slot.insert(self.reference_frames(settings.glass_opacity, &baked.environment)?);
