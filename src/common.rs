@@ -2,47 +2,20 @@
 //! progress bars and JSON output.
 
 use std::ops::Range;
-use std::path::Path;
 use std::sync::OnceLock;
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use trisort_format::{Choice, Choosable, OptionValue, ParseOptionError, RecordSettings};
 use trisort_scene::Scene;
 
-/// Loads a scene: a `.glb`/`.gltf` file, or `demo` / `demo:TRIANGLES` for the built-in car.
+/// Loads a scene ([`trisort_bake::load_scene`]) and prints the importer's notes on stderr.
 pub fn load_scene(spec: &str) -> Result<Scene> {
-    if let Some(rest) = spec.strip_prefix("demo") {
-        let triangles = match rest.strip_prefix(':') {
-            Some(n) => n
-                .parse()
-                .with_context(|| format!("scene {spec}: expected demo:TRIANGLES"))?,
-            None if rest.is_empty() => trisort_scene::demo_car::DEFAULT_TRIANGLES,
-            None => return load_file(spec),
-        };
-        return Ok(trisort_scene::demo_car::demo_car(triangles));
-    }
-    load_file(spec)
-}
-
-fn load_file(spec: &str) -> Result<Scene> {
-    let scene = trisort_scene::load(Path::new(spec))?;
+    let scene = trisort_bake::load_scene(spec)?;
     for note in &scene.notes {
         eprintln!("trisort: note: {note}");
     }
     Ok(scene)
-}
-
-/// Loads a path over a scene (`demo` gives the demo car's default path).
-pub fn load_path(spec: &str, scene: &Scene, fps: f64) -> Result<trisort_paths::Timeline> {
-    if spec == "demo" {
-        return Ok(trisort_paths::demo_default(scene));
-    }
-    Ok(trisort_paths::load(
-        spec,
-        scene,
-        &trisort_paths::PathOptions { fps },
-    )?)
 }
 
 /// Parses `WIDTHxHEIGHT` or a single number for a square.
@@ -145,11 +118,12 @@ impl FrameRange {
     pub fn resolve(&self, n: u32) -> Result<Range<u32>> {
         let r = self.start.unwrap_or(0)..self.end.unwrap_or(n);
         if r.start >= r.end || r.end > n {
-            bail!(
-                "frame range {}..{} is empty or outside the path's frames 0..{n}",
-                r.start,
-                r.end
-            );
+            return Err(trisort_bake::BakeError::FrameRange {
+                start: r.start,
+                end: r.end,
+                frames: n,
+            }
+            .into());
         }
         Ok(r)
     }
@@ -205,69 +179,56 @@ pub fn open_gpu_with(options: trisort_gpu::GpuOptions) -> Result<trisort_gpu::Gp
     Ok(gpu)
 }
 
-/// The scene `scene_spec` and the path `path_spec` over it (at `fps`), with the scene made the
-/// one a recording with `settings` is made of ([`working_scene`]): what `record` and `bake`
-/// start from. Returns the scene, the path's timeline and the split report.
+/// The scene `scene_spec` and the path `path_spec` over it (at `fps`), made the scene a
+/// recording with `settings` is made of ([`trisort_bake::Working::load`]); prints the
+/// importer's notes and what was split on stderr.
 pub fn load_working(
     scene_spec: &str,
     path_spec: &str,
     fps: f64,
     settings: &RecordSettings,
-) -> Result<(
-    Scene,
-    trisort_paths::Timeline,
-    Option<trisort_intersect::SplitReport>,
-)> {
-    let mut scene = load_scene(scene_spec)?;
-    let timeline = load_path(path_spec, &scene, fps)?;
-    let from = format!("path {path_spec}");
-    let split = working_scene(&mut scene, scene_spec, &timeline.frames, &from, settings)?;
-    Ok((scene, timeline, split))
+) -> Result<trisort_bake::Working> {
+    let working = trisort_bake::Working::load(scene_spec, path_spec, fps, settings)?;
+    for note in &working.scene.notes {
+        eprintln!("trisort: note: {note}");
+    }
+    if let Some(line) = working.split_summary() {
+        eprintln!("trisort: {line}");
+    }
+    Ok(working)
 }
 
-/// Makes `scene` the scene a recording with `settings` is made of: with
-/// `settings.split_intersections`, its triangles that pass through each other (within a rigid
-/// group, then across groups as the first frame poses them) are split along their intersection (`trisort_intersect::working_geometry`), which
-/// changes the scene's triangles and hash. Says on stderr what was split; returns the report.
-///
-/// `frames` come from `frames_from` (a path, a recording or a baked file, for the message):
-/// their poses must name nodes of the scene (`spec`), or the scene is not the one they were
-/// made over, and this is an error naming both rather than an out-of-range node.
-pub fn working_scene(
-    scene: &mut Scene,
-    spec: &str,
-    frames: &[trisort_format::FrameState],
-    frames_from: &str,
-    settings: &trisort_format::RecordSettings,
-) -> Result<Option<trisort_intersect::SplitReport>> {
-    let nodes = scene.geometry.nodes.len();
-    for (f, s) in frames.iter().enumerate() {
-        if let Err(why) = trisort_format::camera::check_frame_state(f, s, Some(nodes)) {
-            bail!(
-                "scene {spec} ({nodes} nodes) is not the scene {frames_from} was made over: {why}; \
-                 give the same scene file, or for demo the same demo:TRIANGLES"
-            );
+/// The pipeline's [`trisort_bake::Events`] on the terminal: notes on stderr, recording
+/// progress as a bar (hidden when stderr is not a terminal).
+pub struct Console {
+    bar: indicatif::ProgressBar,
+}
+
+impl Console {
+    /// A console with its bar not yet shown.
+    pub fn new() -> Console {
+        Console {
+            bar: progress_bar(0, "record"),
         }
     }
-    let t0 = std::time::Instant::now();
-    let Some(split) = trisort_intersect::working_geometry(&scene.geometry, frames, settings) else {
-        return Ok(None);
-    };
-    let r = split.report;
-    if r.pairs_split > 0 || r.pairs_skipped_sliver > 0 || r.pairs_split_across_groups > 0 {
-        let across = match r.pairs_split_across_groups {
-            0 => String::new(),
-            n => format!("{n} of them of parts that move apart, as the first frame poses them; "),
-        };
-        eprintln!(
-            "trisort: split {} pairs of triangles that pass through each other ({across}+{} \
-             triangles; {} pairs left, their pieces would be slivers) in {:.2} s",
-            r.pairs_split + r.pairs_split_across_groups,
-            r.triangles_added,
-            r.pairs_skipped_sliver,
-            t0.elapsed().as_secs_f64()
-        );
+}
+
+impl trisort_bake::Events for Console {
+    fn note(&mut self, text: &str) {
+        eprintln!("trisort: {text}");
     }
-    *scene.geometry_mut() = split.geometry;
-    Ok(Some(r))
+
+    fn progress(&mut self, p: &trisort_recorder::Progress) {
+        let bar = &self.bar;
+        if bar.length() != Some(p.total as u64) || bar.prefix() != format!("phase {}", p.phase) {
+            bar.set_prefix(format!("phase {}", p.phase));
+            bar.set_length(p.total as u64);
+        }
+        bar.set_position(p.done as u64);
+        bar.set_message(format!("frame {} ({} layers)", p.frame, p.layers));
+    }
+
+    fn recorded(&mut self) {
+        self.bar.finish_and_clear();
+    }
 }

@@ -17,9 +17,9 @@ use trisort_gpu::Gpu;
 use trisort_merger::MergeOptions;
 use trisort_player::Mode;
 
-use crate::cmd::bake::{bake, recording_path};
+use trisort_bake::{recording_path, Working};
+
 use crate::cmd::merge::MergeOpts;
-use crate::cmd::RecordOpts;
 use crate::common::{
     default_size, load_working, option_parser, parse_range, parse_size, print_json, FrameRange,
 };
@@ -134,13 +134,7 @@ struct BakeRun {
 }
 
 /// Bakes (or reuses the bake in `out` made from the same scene, path and settings).
-fn bake_for(
-    gpu: &Gpu,
-    scene: &trisort_scene::Scene,
-    timeline: &trisort_paths::Timeline,
-    a: &BenchArgs,
-    samples: u32,
-) -> Result<BakeRun> {
+fn bake_for(gpu: &Gpu, working: &Working, a: &BenchArgs, samples: u32) -> Result<BakeRun> {
     let merge = MergeOpts {
         bridge: a.bridge,
         ..MergeOpts::defaults()
@@ -159,7 +153,7 @@ fn bake_for(
         glass_opacity: a.glass_opacity,
         ..RecordSettings::new(a.size, samples)
     };
-    let record = RecordOpts::new(settings, a.fps);
+    let (scene, timeline) = (&working.scene, &working.timeline);
     if path.exists() && rec_path.exists() {
         match reusable(&path, &rec_path, scene, timeline, &settings, &merge) {
             Ok((baked, recording)) => {
@@ -185,9 +179,28 @@ fn bake_for(
         a.size.1,
         samples
     ));
-    let environment = merge.environment()?;
-    let (recording, baked, record_s, merge_s, reused) =
-        bake(gpu, scene, timeline, &record, &merge, environment, &path)?;
+    let bake_settings = trisort_bake::Settings {
+        fps: a.fps,
+        record: settings,
+        merge: merge.options(),
+        light: merge.light(),
+        ..trisort_bake::Settings::new(&a.scene, &a.path)
+    };
+    let environment = bake_settings.light.load()?;
+    let done = trisort_bake::bake(
+        gpu,
+        working,
+        &bake_settings,
+        environment,
+        &path,
+        &mut crate::common::Console::new(),
+    )?;
+    let (recording, baked) = (done.recording, done.baked);
+    let (record_s, merge_s, reused) = (
+        done.record_seconds,
+        done.merge_seconds,
+        done.recording_reused,
+    );
     let bytes = std::fs::metadata(&path)?.len();
     say(&format!(
         "baked {} in {:.1} s (record {record_s:.1} s, merge {merge_s:.1} s): {} index triangles, |G| = {}",
@@ -250,7 +263,8 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
     }
     let t0 = Instant::now();
     // Every bake and rival below sees the scene as the default settings record it.
-    let (scene, timeline, _) = load_working(&a.scene, &a.path, a.fps, &RecordSettings::default())?;
+    let working = load_working(&a.scene, &a.path, a.fps, &RecordSettings::default())?;
+    let (scene, timeline) = (&working.scene, &working.timeline);
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let gpu = crate::common::open_gpu()?;
     let n = timeline.frames.len() as u32;
@@ -260,7 +274,7 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
     };
     let frames = measured_frames(range, a.max_frames);
     if a.sweep {
-        return run_sweep(&a, &gpu, &scene, &timeline, frames);
+        return run_sweep(&a, &gpu, scene, timeline, frames);
     }
     let unvalidated = if a.no_unvalidated || !a.methods.contains(&MethodKind::Merged) {
         None
@@ -295,7 +309,7 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
 
     let mut bakes = Vec::new();
     for &s in &a.samples {
-        bakes.push(bake_for(&gpu, &scene, &timeline, &a, s)?);
+        bakes.push(bake_for(&gpu, &working, &a, s)?);
     }
     let mut groups: Vec<GroupReport> = Vec::new();
     for b in &bakes {
@@ -325,7 +339,7 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
         }
     }
 
-    let value = report_json(&a, &gpu, &scene, &timeline, &frames, &bakes, &groups, t0);
+    let value = report_json(&a, &gpu, scene, timeline, &frames, &bakes, &groups, t0);
     write_outputs(&a.out, &value, &groups, &bakes)?;
     let md = markdown(&value, &groups, &bakes);
     trisort_format::container::write_bytes_atomic(&a.out.join("bench.md"), md.as_bytes())?;

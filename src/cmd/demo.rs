@@ -9,10 +9,7 @@ use clap::Args;
 use trisort_format::RecordSettings;
 use trisort_player::headless::HeadlessConfig;
 
-use crate::cmd::bake::bake;
-use crate::cmd::merge::MergeOpts;
 use crate::cmd::play::play_frames;
-use crate::cmd::RecordOpts;
 use crate::common::parse_size;
 
 /// Arguments of `demo`.
@@ -67,28 +64,43 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         a.glass_opacity,
         path.frames.len()
     );
-    let record = RecordOpts::new(settings, path.fps);
-    crate::common::working_scene(
-        &mut scene,
-        "demo",
-        &path.frames,
-        "the demo path",
-        &record.settings()?,
-    )?;
-    let merge = MergeOpts::defaults();
+    let t_split = Instant::now();
+    let split =
+        trisort_bake::working_scene(&mut scene, "demo", &path.frames, "the demo path", &settings)?;
+    let working = trisort_bake::Working {
+        scene,
+        timeline: path,
+        split,
+        split_seconds: t_split.elapsed().as_secs_f64(),
+    };
+    if let Some(line) = working.split_summary() {
+        eprintln!("trisort: {line}");
+    }
+    let bake_settings = trisort_bake::Settings {
+        fps: working.timeline.fps,
+        record: settings,
+        ..trisort_bake::Settings::new("demo", "demo")
+    };
     let gpu = crate::common::open_gpu()?;
     println!("device: {}", gpu.describe());
     let baked_path = a.out_dir.join("demo.baked");
-    let environment = merge.environment()?;
-    let (rec, baked, record_s, merge_s, reused) = bake(
+    let environment = bake_settings.light.load()?;
+    let done = trisort_bake::bake(
         &gpu,
-        &scene,
-        &path,
-        &record,
-        &merge,
+        &working,
+        &bake_settings,
         environment,
         &baked_path,
+        &mut crate::common::Console::new(),
     )?;
+    let scene = &working.scene;
+    let trisort_bake::Baking {
+        recording: rec,
+        baked,
+        record_seconds: record_s,
+        merge_seconds: merge_s,
+        recording_reused: reused,
+    } = done;
     let report = trisort_verify::check_graph(std::slice::from_ref(&rec), &baked);
     let frames_dir = a.out_dir.join("frames");
     let t_play = Instant::now();
@@ -117,7 +129,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     println!("frames:                 {}", baked.frames.len());
     println!(
         "raster profile:         {}",
-        crate::cmd::record::profile_summary(&baked.settings)
+        trisort_bake::figures::profile_summary(&baked.settings)
     );
     println!(
         "|G| (visible at least once): {} of {} triangles",

@@ -48,7 +48,7 @@ fn inspect_recording(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         anyhow::bail!("{}: --matrix needs a baked file, not a recording", a.file);
     }
     let rec: Recording = crate::cmd::merge::read_recording(path)?;
-    let v = crate::cmd::record::recording_json(&rec, None);
+    let v = trisort_bake::figures::recording_json(&rec, None);
     if a.json {
         print_json(&v);
     } else {
@@ -73,7 +73,7 @@ fn inspect_recording(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         );
         println!(
             "  raster profile {}",
-            crate::cmd::record::profile_summary(&rec.settings)
+            trisort_bake::figures::profile_summary(&rec.settings)
         );
         for f in &rec.frames {
             println!(
@@ -116,9 +116,9 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         }).collect::<serde_json::Map<_, _>>(),
         "split_intersections": baked.settings.split_intersections,
         // What the bake assumes about the rasterizer that plays it (record --raster-profile).
-        "raster_profile": crate::cmd::record::raster_profile_json(&baked.settings),
+        "raster_profile": trisort_bake::figures::raster_profile_json(&baked.settings),
         // The light stored in the file (`bake --environment`).
-        "environment": crate::cmd::merge::environment_json(&baked.environment),
+        "environment": trisort_bake::figures::environment_json(&baked.environment),
         // The recording device; `mixed: …` (each device with its frames) when the recordings
         // were merged with `merge --allow-mixed-devices`.
         "device": baked.device.adapter, "driver": baked.device.driver,

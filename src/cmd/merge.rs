@@ -5,10 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use serde_json::json;
-use trisort_format::{
-    Baked, Bridge, Choice, Environment, FileKind, Layout, Recording, Seeding, Strategy,
-};
+use trisort_format::{Bridge, Choice, FileKind, Layout, Recording, Seeding, Strategy};
 use trisort_merger::MergeOptions;
 
 use crate::common::{choice_parser, option_parser, print_json};
@@ -52,15 +49,6 @@ pub struct MergeOpts {
 /// `--environment`'s name of the built-in studio.
 const STUDIO: &str = "studio";
 
-/// An `--environment` light: `studio`, the built-in studio, or an .hdr file loaded and
-/// prefiltered (an error naming the file when it cannot be).
-pub fn load_environment(spec: &str) -> Result<Environment> {
-    if spec == STUDIO {
-        return Ok(Environment::studio());
-    }
-    Ok(trisort_scene::load_hdr(std::path::Path::new(spec))?)
-}
-
 impl MergeOpts {
     /// The command line's defaults: [`MergeOptions::default`].
     pub fn defaults() -> MergeOpts {
@@ -76,10 +64,9 @@ impl MergeOpts {
         }
     }
 
-    /// The `--environment` light: the built-in studio, or the .hdr file loaded and prefiltered
-    /// (an error naming the file when it cannot be).
-    pub fn environment(&self) -> Result<Environment> {
-        load_environment(&self.environment)
+    /// The `--environment` light: the built-in studio, or an .hdr file.
+    pub fn light(&self) -> trisort_bake::Light {
+        trisort_bake::Light::parse(&self.environment)
     }
 
     /// The merger's options (`--segment 0`: no segments).
@@ -91,6 +78,7 @@ impl MergeOpts {
             depth_only: self.depth_only,
             segment: (self.segment > 0).then_some(self.segment),
             seeding: self.seeding,
+            allow_mixed_devices: false,
         }
     }
 }
@@ -120,49 +108,6 @@ pub struct MergeArgs {
     /// Print the figures as JSON.
     #[arg(long)]
     json: bool,
-}
-
-/// The `--json` figures of a baked file (DESIGN's CLI contract). `seconds` is the measured
-/// wall time of the merge: the file's `stats.seconds` stays 0 so that bakes are
-/// byte-identical.
-pub fn baked_json(b: &Baked, seconds: f64) -> serde_json::Value {
-    let s = &b.stats;
-    json!({
-        "strategy": b.merge.strategy,
-        "layout": b.merge.layout,
-        "bridge": b.merge.bridge,
-        "seeding": b.merge.seeding,
-        "depth_only": b.merge.depth_only,
-        "segment": b.merge.segment,
-        "frames": b.frames.len(),
-        "index_triangles": s.index_triangles,
-        "source_triangles": s.source_triangles,
-        "unique_visible": s.unique_visible,
-        "draws_per_frame_mean": s.draws_per_frame_mean,
-        "draws_per_frame_max": s.draws_per_frame_max,
-        "drawn_not_visible_mean": s.drawn_not_visible_mean,
-        "unordered_samples": s.unordered_samples,
-        "exact_components": s.exact_components,
-        "heuristic_components": s.heuristic_components,
-        "heuristic_unordered_samples": s.heuristic_unordered_samples,
-        "environment": environment_json(&b.environment),
-        "raster_profile": crate::cmd::record::raster_profile_json(&b.settings),
-        "seconds": seconds,
-    })
-}
-
-/// The `environment` of `--json`: its name, level 0's size, levels, bytes of texels and sun
-/// (`null` without one; else `direction` towards the light and `color`), and exposure.
-pub fn environment_json(e: &Environment) -> serde_json::Value {
-    json!({
-        "name": e.name,
-        "width": e.width,
-        "height": e.height,
-        "levels": e.levels.len(),
-        "bytes": e.texel_bytes(),
-        "sun": e.sun.map(|s| json!({"direction": s.direction, "color": s.color})),
-        "exposure": e.exposure,
-    })
 }
 
 /// Reads recordings and checks their structure ([`Recording::check_structure`]), naming the
@@ -240,38 +185,6 @@ pub fn check_compatible(
     Ok(warnings)
 }
 
-/// Merges, lights the result with `environment` and writes atomically.
-pub fn merge_to_file(
-    recs: &[Recording],
-    opts: &MergeOptions,
-    environment: Environment,
-    output: &std::path::Path,
-    names: &[String],
-) -> Result<Baked> {
-    merge_to_file_with(recs, opts, environment, output, names, false)
-}
-
-/// [`merge_to_file`], merging recordings of different devices when `allow_mixed_devices`.
-fn merge_to_file_with(
-    recs: &[Recording],
-    opts: &MergeOptions,
-    environment: Environment,
-    output: &std::path::Path,
-    names: &[String],
-    allow_mixed_devices: bool,
-) -> Result<Baked> {
-    let opts = MergeOptions {
-        allow_mixed_devices,
-        ..*opts
-    };
-    let merged = trisort_merger::merge(recs, &opts).map(|m| m.lit(environment));
-    // Errors name recordings by index; say which file that is.
-    let baked = merged.map_err(|e| anyhow::anyhow!("{}", name_files(&e.to_string(), names)))?;
-    trisort_format::write_file_atomic(FileKind::Baked, output, &baked)
-        .with_context(|| format!("writing {}", output.display()))?;
-    Ok(baked)
-}
-
 pub fn run(a: MergeArgs) -> Result<ExitCode> {
     let mut recs = read_recordings(&a.recordings)?;
     for (r, f) in recs.iter().zip(&a.recordings) {
@@ -285,7 +198,7 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
     }
     check_compatible(&recs, &a.recordings, a.allow_mixed_devices)?;
     // Before anything is written: a bad light leaves no output.
-    let environment = a.opts.environment()?;
+    let environment = a.opts.light().load()?;
     let mut names: Vec<String> = a
         .recordings
         .iter()
@@ -300,47 +213,17 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
         recs = vec![joined];
         names = vec![join.display().to_string()];
     }
-    let baked = merge_to_file_with(
-        &recs,
-        &a.opts.options(),
-        environment,
-        &a.output,
-        &names,
-        a.allow_mixed_devices,
-    )?;
+    let opts = MergeOptions {
+        allow_mixed_devices: a.allow_mixed_devices,
+        ..a.opts.options()
+    };
+    let baked = trisort_bake::merge_to_file(&recs, &names, &opts, environment, &a.output)?;
     let seconds = t0.elapsed().as_secs_f64();
     if a.json {
-        print_json(&baked_json(&baked, seconds));
+        print_json(&trisort_bake::figures::baked_json(&baked, seconds));
     } else {
-        print_summary(&baked, seconds);
+        println!("{}", trisort_bake::figures::merge_summary(&baked, seconds));
         println!("wrote {}", a.output.display());
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// One human summary of a merge that took `seconds` (wall time, measured by the caller).
-pub fn print_summary(b: &Baked, seconds: f64) {
-    let s = &b.stats;
-    println!(
-        "merged {} frames ({} {}, bridge {}): {} index triangles for |G| = {} ({:.2}x), Σ|V_f| = {}; draws per frame {:.1} mean, {} max; drawn-not-visible {:.0} per frame; {} unordered samples (cycle components: {} solved exactly, {} by heuristic); {:.2} s",
-        b.frames.len(),
-        b.merge.strategy,
-        b.merge.layout,
-        b.merge.bridge,
-        s.index_triangles,
-        s.unique_visible,
-        s.index_triangles as f64 / s.unique_visible.max(1) as f64,
-        s.source_triangles,
-        s.draws_per_frame_mean,
-        s.draws_per_frame_max,
-        s.drawn_not_visible_mean,
-        s.unordered_samples,
-        s.exact_components,
-        s.heuristic_components,
-        seconds
-    );
-    println!(
-        "raster profile: {}",
-        crate::cmd::record::profile_summary(&b.settings)
-    );
 }

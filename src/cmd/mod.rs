@@ -140,27 +140,6 @@ fn parse_bits(s: &str) -> Result<(u32, u32), String> {
 }
 
 impl RecordOpts {
-    /// Options recording the whole path with `settings`, sampling generated paths at `fps`.
-    pub fn new(settings: RecordSettings, fps: f64) -> RecordOpts {
-        let r = settings.robust;
-        RecordOpts {
-            size: (settings.width, settings.height),
-            samples: settings.samples,
-            saturation: settings.saturation,
-            glass_opacity: settings.glass_opacity,
-            max_layers: settings.max_layers,
-            frames: None,
-            fps,
-            keep_intersections: !settings.split_intersections,
-            robust: r.patterns,
-            raster_profile: Some(r.profile.name),
-            conservative: Some(r.conservative),
-            robust_tolerance: Some(r.tolerance),
-            subpixel_bits: Some((r.profile.subpixel_bits_min, r.profile.subpixel_bits_max)),
-            depth_at: Some(r.profile.depth_at),
-        }
-    }
-
     /// The settings stored in the recording: the named raster profile (by default the
     /// conformant one, `exact` under `--conservative=false`) with the knobs given on top.
     pub fn settings(&self) -> Result<RecordSettings> {

@@ -280,7 +280,7 @@ pub fn profile_check_json(
     json!({
         "ok": c.ok,
         "differences": c.differences,
-        "profile": crate::cmd::record::raster_profile_json(&baked.settings),
+        "profile": trisort_bake::figures::raster_profile_json(&baked.settings),
         "api": {
             "subpixel_bits": c.api.subpixel_bits,
             "standard_sample_locations": c.api.standard_sample_locations,

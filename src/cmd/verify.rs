@@ -30,7 +30,8 @@ use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFra
 
 use crate::cmd::merge::read_recordings;
 use crate::cmd::play::write_png;
-use crate::common::{load_scene, parse_range, parse_size, print_json, working_scene, FrameRange};
+use crate::common::{load_scene, parse_range, parse_size, print_json, FrameRange};
+use trisort_bake::working_scene;
 
 /// Exit code of a verification that ran and found the baked file wrong.
 pub const VERIFY_FAILED: u8 = 3;
@@ -293,7 +294,7 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
     let environment = match &a.environment {
         None => None,
         Some(spec) => {
-            let expected = crate::cmd::merge::load_environment(spec)?;
+            let expected = trisort_bake::Light::parse(spec).load()?;
             Some(baked.environment.difference(&expected))
         }
     };
