@@ -9,7 +9,14 @@ fn generate() -> String {
     let mut out = Vec::new();
     cbindgen::Builder::new()
         .with_config(config)
-        .with_src(dir.join("src/ffi.rs"))
+        // The header's functions come in the order of these files (`[fn] sort_by = "None"`).
+        .with_src(dir.join("src/ffi/types.rs"))
+        .with_src(dir.join("src/ffi/boundary.rs"))
+        .with_src(dir.join("src/ffi/baked.rs"))
+        .with_src(dir.join("src/ffi/materials.rs"))
+        .with_src(dir.join("src/ffi/playback.rs"))
+        .with_src(dir.join("src/ffi/environment.rs"))
+        .with_src(dir.join("src/ffi/order.rs"))
         .with_src(dir.join("src/order.rs"))
         .generate()
         .expect("cbindgen generates the header")
