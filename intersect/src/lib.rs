@@ -1,4 +1,5 @@
-//! Interpenetration removed before recording (DESIGN § "Cycles are removed at the source").
+//! Interpenetration removed before recording: cycles are removed at the source, where the
+//! geometry still says how to cut them, not left for the merger.
 //!
 //! Two triangles that cross each other have no depth order: each is in front of the other
 //! somewhere, a cycle the sorted player cannot draw. Splitting both along the line where

@@ -1,5 +1,4 @@
-//! Benchmark (not a test): the merger on long chains and the cost of exact cycle breaking
-//! (issue 13, parts 2 and 4).
+//! Benchmark (not a test): the merger on long chains and the cost of exact cycle breaking.
 //!
 //! `cargo run --release -p trisort-merger --example robustness_bench -- [PAIRS [N ...]]`
 //!
@@ -9,7 +8,7 @@
 //!    20-edge component that keeps the most vertices after the exact reductions (13), random
 //!    components of 20 and 24 edges (on ≤ 10 and ≤ 16 vertices), 30 edges on ≤ 20 (the subset
 //!    programme's range), and 40, 48 and 64 edges on ≤ 24, 28 and 32 vertices (branch and
-//!    bound's, issue 28), with how many were solved exactly; the complete digraphs on 16, 20,
+//!    bound's), with how many were solved exactly; the complete digraphs on 16, 20,
 //!    21, 24 and 32 vertices, and a 50,000-vertex cycle.
 
 use std::time::Instant;

@@ -129,7 +129,8 @@ impl CopyTable {
 }
 
 /// A vertex of a cell's constraint graph: a copy, or a triangle not drawn at one frame
-/// (reachability passes through undrawn triangles, DESIGN rule 3).
+/// (reachability passes through undrawn triangles: rule 3 orders drawn a before drawn b
+/// wherever b is reachable from a in E_f through any triangles, drawn or not).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub(crate) struct NodeRef(u64);
 

@@ -11,7 +11,7 @@
 //! parallel from the previous diagonal, then removed from it (Figure 4's serialized
 //! subtraction).
 //!
-//! Departures from the paper, as DESIGN asks: no transitive reduction before violator removal
+//! Departures from the paper: no transitive reduction before violator removal
 //! (dropping a middle triangle after reduction loses constraints), and no cycle removal by
 //! dropping edges across frames; cycles and the conflicts the pairwise test cannot see (cells
 //! other than L and B in a window, paths through undrawn triangles) are left to interval

@@ -1,5 +1,5 @@
 //! Strategy order: the six merging strategies and the two layouts that linearize the
-//! upper-triangular matrix of cells (paper §5.1, Figure 11; DESIGN § Merger, Strategies).
+//! upper-triangular matrix of cells (paper §5.1, Figure 11).
 //!
 //! A copy in cell (i, j), i ≤ j, is drawn in every frame i..=j. With L = (i, j−1),
 //! I = (i, j) and B = (i+1, j), a strategy fixes the order of L, I and B; a layout is one total

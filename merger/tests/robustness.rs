@@ -1,5 +1,5 @@
-//! Regression tests for the merger's robustness on long chains (issue 13, part 4): results
-//! only, never times (the times are in `merger/BENCHMARKS.md` § Robustness).
+//! Regression tests for the merger's robustness on long chains: results only, never times (the
+//! times are in `merger/BENCHMARKS.md` § Robustness).
 
 use crate::merge;
 use trisort_merger::cycles::feedback_arc_set;

@@ -284,7 +284,7 @@ fn zero_scale_rest_node_can_be_animated() {
     assert_eq!(m.transform_vector3(DVec3::ONE), DVec3::ZERO, "still hidden");
 }
 
-/// `gltf:animation=NAME,camera=NAME` (issue 17, part 3): one animation plays (others keep
+/// `gltf:animation=NAME,camera=NAME`: one animation plays (others keep
 /// their nodes at rest) and its length decides the frames; the named camera views; unknown
 /// names and parameters are errors listing what the scene has.
 #[test]

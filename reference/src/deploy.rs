@@ -1,6 +1,6 @@
 //! The player on an 8-bit sRGB deployment target (`Rgba8UnormSrgb`), which rounds to 8 bits
 //! after every blend. Its error against the exact reference is reported separately and never
-//! gated on (DESIGN § Frame accuracy).
+//! gated on: the rounding is the target's, not the order's.
 
 use trisort_format::Baked;
 use trisort_gpu::Gpu;

@@ -1,4 +1,5 @@
-//! The exact reference of DESIGN.md § Frame accuracy.
+//! The exact reference: what each frame should look like, against which a baked file's frames
+//! are measured.
 //!
 //! `blend` and `saturate`: the *full* scene (every triangle, not only G) is peeled per sample
 //! to completion with the recorder's own [`Peeler`] (same shader, same (depth, id) keys, same
@@ -18,8 +19,8 @@
 //! writes) and *over*, so a sample shows, composited in that order, every fragment nearer than
 //! all those drawn before it. The reference lets through the same fragments of the rule's
 //! order. For opaque scenes that is the nearest fragment (on an exact tie, the one the rule
-//! puts first: the lower id unless the rule says otherwise), DESIGN's "plain z-buffer of all
-//! triangles in ascending id order with `Less`" ([`whole_scene_baked`] played in depth mode)
+//! puts first: the lower id unless the rule says otherwise), the plain z-buffer of all
+//! triangles in ascending id order with `Less` ([`whole_scene_baked`] played in depth mode)
 //! except at exact ties the rule breaks otherwise; with transparency the z-buffer in id order
 //! blends a near transparent fragment over whatever farther fragment happened to have a lower
 //! id, which no sorted front-to-back player draws, so it cannot be the reference there.
@@ -87,10 +88,10 @@ impl ReferenceConfig {
 /// The edges whose samples the image check may excuse, by scene id: a sample is *unordered*
 /// when two consecutive fragments of the peel of G there, a then b, form one of them.
 ///
-/// [`UnorderedEdges::of_recordings`] derives them from the recordings alone: the edges of E_f
-/// that lie on a cycle (both ends in one strongly connected component,
-/// [`trisort_verify::cycle_edges`]), the only ones any bake may leave unordered (DESIGN rule
-/// 3). Verification uses nothing else; without a recording no sample is excused.
+/// [`UnorderedEdges::of_recordings`] derives them from the recordings alone: the edges of E_f that
+/// lie on a cycle (both ends in one strongly connected component, [`trisort_verify::cycle_edges`]),
+/// the only ones any bake may leave unordered (rule 3 of [`trisort_verify::check_graph`]).
+/// Verification uses nothing else; without a recording no sample is excused.
 /// [`UnorderedEdges::of_baked`] takes the edges a baked file says its merger removed, for
 /// measurements that describe that bake (`bench`), never to verify it.
 pub struct UnorderedEdges {

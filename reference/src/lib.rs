@@ -1,5 +1,5 @@
 //! trisort's exact reference renderer, the default pipeline it is compared with, and image
-//! verification of baked files (DESIGN.md § Frame accuracy).
+//! verification of baked files.
 //!
 //! - [`ExactReference`]: the full scene peeled per sample with the recorder's peeler, its
 //!   layers composited through the player's shader, blend state and target (`blend`,

@@ -1,5 +1,5 @@
 //! Classic exact depth peeling run entirely on the GPU: the run-time rival that `trisort bench`
-//! times against the merged player (DESIGN.md § Frame accuracy).
+//! times against the merged player.
 //!
 //! [`ExactReference`](crate::ExactReference) peels with the recorder's peeler and reads every
 //! layer back to build per-layer index lists; [`PeelingRenderer`] records a frame as a fixed

@@ -2,12 +2,12 @@
 //! player (or captured elsewhere: `--frames-dir`) against the exact reference of the full
 //! scene, at the same size, sample count and mode.
 //!
-//! What may differ comes from the recordings, never from the baked file (DESIGN § Second
-//! wave): a pixel is *unordered*, and excused, only when one of its samples has consecutive
+//! What may differ comes from the recordings, never from the baked file (a file cannot excuse its
+//! own errors): a pixel is *unordered*, and excused, only when one of its samples has consecutive
 //! peel fragments a, b with a → b an edge on a cycle of the recording's E_f
 //! ([`UnorderedEdges::of_recordings`]). Without a recording no pixel is excused. With one, the
-//! reference also takes the path (cameras, poses), the recorded pattern and the recording
-//! device from it, not from the file.
+//! reference also takes the path (cameras, poses), the recorded pattern and the recording device
+//! from it, not from the file.
 //!
 //! The rule ([`ImageCheck`]):
 //! - At the recorded pattern (the recorded size and sample count, no sub-pixel offset, on
@@ -223,7 +223,7 @@ impl<'g> ImageVerifier<'g> {
         let truth = Truth::new(baked, recordings, geometry.triangles.len(), check.mode)?;
         let s = &truth.settings;
         // The device the file (or the recording) names does not decide: a file that named
-        // another device was once measured only, and passed, however wrong (issue 28). Frames
+        // another device would otherwise be measured only, and pass, however wrong. Frames
         // played here on another device are held to the recorded pattern's rule, as frames
         // captured elsewhere are; the report says so.
         let at_pattern = check.at_recorded_pattern(s);

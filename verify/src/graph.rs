@@ -213,7 +213,8 @@ impl Search<'_> {
 /// The edges of `edges` that lie on a cycle: both ends in one strongly connected component of
 /// the graph they form (in their order). Ids are any triangle ids (scene or G-local); O(E log E).
 ///
-/// These are the only edges a merger may leave unordered (DESIGN rule 3), so a sample whose
+/// These are the only edges a merger may leave unordered (rule 3 of [`crate::check_graph`]:
+/// a removed edge must lie on a cycle), so a sample whose
 /// consecutive peel fragments are one of them is the only kind an image check may excuse.
 pub fn cycle_edges(edges: &[Edge]) -> Vec<Edge> {
     let pairs: Vec<(usize, usize)> = edges

@@ -1,8 +1,10 @@
 //! The independent validator: checks a [`Baked`] file against the [`Recording`]s it was merged
 //! from, using only the file formats (it shares no code with the merger). It trusts nothing in
-//! the baked file that it can derive from the recordings (DESIGN § Second wave).
+//! the baked file that it can derive from the recordings, so a merger's mistake cannot vouch
+//! for itself.
 //!
-//! [`check_graph`] checks DESIGN's rules for every frame f, from the two files alone:
+//! [`check_graph`] checks the rules every baked frame must obey, for every frame f, from the
+//! two files alone:
 //! 1. every t ∈ V_f is drawn exactly once in f; no triangle is drawn twice in f; every copy
 //!    (index-buffer position) is drawn in a contiguous run of frames that contains a frame
 //!    where its triangle is visible;
@@ -30,7 +32,7 @@
 //! `drawn_not_visible_mean`, `unordered_samples`).
 //!
 //! The file's claims about its own merge are checked where the recordings and its draws
-//! decide them (issue 28): a depth-only file (`merge.depth_only`) is checked against the edges
+//! decide them: a depth-only file (`merge.depth_only`) is checked against the edges
 //! depth mode needs only when it is checked for depth mode ([`PlayedIn::Depth`]); for blend and saturate
 //! its order must hold every edge of E_f, as any other file's. The matrix cells
 //! (`merge.cells`) must tile the index buffer, each copy drawn in exactly its cell's frames;

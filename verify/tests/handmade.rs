@@ -482,7 +482,7 @@ fn a_cycle_through_forty_thousand_triangles() {
     assert_eq!(r.frames[0].unordered_samples, 1);
 }
 
-/// Issue 28: a cut that is on a cycle and needed, but heavier than the least, fails. In frame
+/// A cut that is on a cycle and needed, but heavier than the least, fails. In frame
 /// 1 of [`cyclic_recording`] (A → H 2, H → B 2, B → A 1) removing H → B (2 samples) and drawing
 /// B, A, H keeps every other edge, yet B → A alone (1 sample) suffices.
 #[test]

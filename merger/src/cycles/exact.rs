@@ -18,7 +18,7 @@
 //! what is left: with cost(S) the least backward weight of an order of S placed first,
 //! cost(S) = min over v ∈ S of cost(S \ v) + w(v → S \ v) (v last among S), O(2ⁿ′ · n′) with
 //! per-vertex tables of subset sums. From there up to [`MAX_VERTICES`] vertices a branch and
-//! bound builds the order from the front (issue 28): each placed prefix S costs the weight
+//! bound builds the order from the front: each placed prefix S costs the weight
 //! of its backward edges, the rest R at least its edges into S plus Σ over pairs
 //! {u, v} ⊂ R of min(w(u → v), w(v → u)) (one edge of every pair points backwards in any
 //! order; the bound never falls as the prefix grows), a prefix

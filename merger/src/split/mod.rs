@@ -1,6 +1,8 @@
-//! Building the matrix of one segment by interval splitting (DESIGN § Merger, "Building the
-//! matrix"): seed each triangle with copies spanning its visible frames (bridged per the
-//! policy), then split until rules 1–3 hold.
+//! Building the matrix of one segment by interval splitting: seed each triangle with copies
+//! spanning its visible frames (bridged per the policy), then split until rules 1–3 hold (the
+//! rules every frame of a baked file obeys, as `trisort-verify` checks them: each visible
+//! triangle drawn exactly once, drawn-but-hidden frames allowed by the bridge policy, and
+//! every order E_f demands kept).
 //!
 //! Every round finds, on a snapshot of the copies,
 //! - *inter-cell conflicts*: at frame f, a drawn ancestor x of drawn y in E_f* (through any
