@@ -20,7 +20,7 @@ mod source;
 
 pub use error::BakeError;
 pub use pipeline::{bake, finished_recording, merge_to_file, recording_path, Baking};
-pub use record::{record_to_file, RecordTarget};
+pub use record::{record_in_memory, record_to_file, RecordTarget};
 pub use source::{load_path, load_scene, working_scene, Light, Working};
 
 use std::ops::Range;

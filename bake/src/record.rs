@@ -6,8 +6,10 @@ use std::path::Path;
 
 use trisort_format::{FileKind, Phase, RecordSettings, Recording};
 use trisort_gpu::Gpu;
+use trisort_paths::Timeline;
 use trisort_recorder::partial::{partial_path, PartialDir};
 use trisort_recorder::{record, RecordJob};
+use trisort_scene::Scene;
 
 use crate::{BakeError, Events, Working};
 
@@ -23,6 +25,41 @@ pub struct RecordTarget<'a> {
     pub known_visible: Option<Vec<u32>>,
 }
 
+impl RecordTarget<'_> {
+    /// The recorder's job for `scene` along `timeline`.
+    fn job<'w>(&self, scene: &'w Scene, timeline: &'w Timeline) -> RecordJob<'w> {
+        RecordJob {
+            geometry: &scene.geometry,
+            frames: &timeline.frames,
+            scene_hash: scene.hash(),
+            path_hash: timeline.hash(),
+            settings: *self.settings,
+            range: self.frames.clone(),
+            phase: self.phase,
+            known_visible: self.known_visible.clone(),
+            internals: Default::default(),
+        }
+    }
+}
+
+/// Records `scene` along `timeline` as `target` says, in memory (no partial directory,
+/// nothing written); the path's rate travels with the recording. `scene` is recorded as it
+/// is: give [`Working::scene`] for the scene with its crossing triangles split.
+pub fn record_in_memory(
+    gpu: &Gpu,
+    scene: &Scene,
+    timeline: &Timeline,
+    target: RecordTarget<'_>,
+    events: &mut dyn Events,
+) -> Result<Recording, trisort_recorder::RecordError> {
+    let job = target.job(scene, timeline);
+    let recorded = record(gpu, &job, None, |p| events.progress(&p));
+    events.recorded();
+    let mut rec = recorded?;
+    rec.fps = Some(timeline.fps);
+    Ok(rec)
+}
+
 /// Records `working` as `target` says, resuming from `OUT.partial/` (a note says how many
 /// frames it found), and writes `output` atomically; the path's rate travels with the
 /// recording into the baked file (players default to it).
@@ -33,17 +70,7 @@ pub fn record_to_file(
     output: &Path,
     events: &mut dyn Events,
 ) -> Result<Recording, BakeError> {
-    let job = RecordJob {
-        geometry: &working.scene.geometry,
-        frames: &working.timeline.frames,
-        scene_hash: working.scene.hash(),
-        path_hash: working.timeline.hash(),
-        settings: *target.settings,
-        range: target.frames,
-        phase: target.phase,
-        known_visible: target.known_visible,
-        internals: Default::default(),
-    };
+    let job = target.job(&working.scene, &working.timeline);
     let partial_dir = partial_path(output);
     let (partial, resumed) = PartialDir::open(&partial_dir, &job)?;
     if resumed > 0 {

@@ -73,7 +73,12 @@ impl Working {
 
     /// The scene and path `settings` name, made the ones its recording is made of.
     pub fn for_settings(settings: &crate::Settings) -> Result<Working, BakeError> {
-        Working::load(&settings.scene, &settings.path, settings.fps, &settings.record)
+        Working::load(
+            &settings.scene,
+            &settings.path,
+            settings.fps,
+            &settings.record,
+        )
     }
 
     /// What the split did, in one line, when it changed anything: `split N pairs of

@@ -34,34 +34,14 @@ fn main() -> ExitCode {
     if args.len() < 5 || args.len() > 6 {
         return usage();
     }
-    let scene = if let Some(rest) = args[0].strip_prefix("demo") {
-        let n = match rest.strip_prefix(':') {
-            Some(n) => match n.parse() {
-                Ok(n) => n,
-                Err(_) => return usage(),
-            },
-            None if rest.is_empty() => trisort_scene::DEFAULT_TRIANGLES,
-            None => return usage(),
-        };
-        trisort_scene::demo_car(n)
-    } else {
-        match trisort_scene::load(std::path::Path::new(&args[0])) {
-            Ok(s) => s,
-            Err(e) => {
-                eprintln!("{}: {e}", args[0]);
-                return ExitCode::FAILURE;
-            }
-        }
-    };
-    let timeline = if args[1] == "demo" {
-        trisort_paths::demo_default(&scene)
-    } else {
-        match trisort_paths::load(&args[1], &scene, &Default::default()) {
-            Ok(t) => t,
-            Err(e) => {
-                eprintln!("{e}");
-                return ExitCode::FAILURE;
-            }
+    // The scene as the default settings record it (crossing triangles split), as `trisort
+    // bench --sweep` sees it.
+    let settings = trisort_format::RecordSettings::default();
+    let working = match trisort_bake::Working::load(&args[0], &args[1], 30.0, &settings) {
+        Ok(w) => w,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::FAILURE;
         }
     };
     let dims: Vec<u32> = match args[2].split('x').map(str::parse).collect() {
@@ -98,8 +78,7 @@ fn main() -> ExitCode {
     let t = std::time::Instant::now();
     let report = match run(
         &gpu,
-        &scene,
-        &timeline,
+        &working,
         &config,
         std::path::Path::new(&args[4]),
         &|s| eprintln!("{s}"),

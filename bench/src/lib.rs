@@ -1,4 +1,4 @@
-//! trisort's benchmarks (issue 7): what the speed/accuracy trade costs and buys.
+//! trisort's benchmarks: what the speed/accuracy trade costs and buys.
 //!
 //! - [`methods`]: the renderers compared frame by frame (`default`, `source`, `merged`,
 //!   `oit`, `peeling`) behind one [`methods::Method`] trait.
@@ -9,6 +9,7 @@
 pub mod harness;
 pub mod methods;
 pub mod plot;
+pub mod report;
 mod rivals;
 pub mod scaling;
 pub mod sweep;
@@ -46,4 +47,7 @@ pub enum BenchError {
     /// The inputs do not fit together.
     #[error("{0}")]
     Invalid(String),
+    /// A step of the pipeline (loading, recording, merging, writing) failed.
+    #[error(transparent)]
+    Bake(#[from] trisort_bake::BakeError),
 }

@@ -15,11 +15,11 @@ use std::time::Instant;
 
 use serde::Serialize;
 use serde_json::json;
+use trisort_bake::{record_in_memory, RecordTarget};
 use trisort_format::{Phase, RecordSettings, Recording};
 use trisort_gpu::Gpu;
 use trisort_merger::synth::{split_frames, turntable, Turntable};
 use trisort_merger::MergeOptions;
-use trisort_recorder::{record, RecordJob};
 
 use crate::plot::{write_svg, Chart, Series, Style};
 use crate::BenchError;
@@ -404,16 +404,14 @@ fn run_real(
         .map_err(|e| BenchError::Invalid(format!("path {spec}: {e}")))?;
     let n = timeline.frames.len() as u32;
     let triangles = scene.geometry.triangles.len() as u64;
-    let job = RecordJob {
-        geometry: &scene.geometry,
-        frames: &timeline.frames,
-        scene_hash: scene.hash(),
-        path_hash: timeline.hash(),
-        settings: config.settings(),
-        range: None,
+    // The demo car as generated: the scaling measures recording and merging cost against
+    // the scene's own size, without splitting its crossing triangles first.
+    let settings = config.settings();
+    let target = || RecordTarget {
+        settings: &settings,
+        frames: None,
         phase: Phase::Graphs,
         known_visible: None,
-        internals: Default::default(),
     };
     progress(&format!(
         "{axis}: recording {triangles} triangles, {n} frames ({spec}) at {}x{} {}x",
@@ -423,17 +421,13 @@ fn run_real(
     let cpu0 = cpu_seconds();
     let t0 = Instant::now();
     let step = (n / 10).max(1);
-    let rec: Recording = record(gpu, &job, None, |p| {
-        if p.done % step == 0 || p.done == p.total {
-            progress(&format!(
-                "{axis}: phase {} {}/{} frames ({:.1} s)",
-                p.phase,
-                p.done,
-                p.total,
-                t0.elapsed().as_secs_f64()
-            ));
-        }
-    })?;
+    let mut events = Progress {
+        axis,
+        step,
+        t0,
+        progress,
+    };
+    let rec: Recording = record_in_memory(gpu, scene, &timeline, target(), &mut events)?;
     let record_seconds = t0.elapsed().as_secs_f64();
     let record_cpu_seconds = cpu_since(cpu0);
     progress(&format!(
@@ -451,7 +445,7 @@ fn run_real(
         let t1 = Instant::now();
         let merged = trisort_merger::merge(std::slice::from_ref(&rec), opts)?;
         let merge_seconds = t1.elapsed().as_secs_f64();
-        let baked = merged.lit(trisort_format::Environment::studio());
+        let baked = merged.lit(trisort_bake::Light::Studio.load()?);
         let merge_cpu_seconds = cpu_since(cpu1);
         let peak = window.peak();
         let s = &baked.stats;
@@ -611,7 +605,7 @@ fn synthetic(frames: u32, segment: u32, progress: &dyn Fn(&str)) -> Result<Scali
         },
     )?;
     let merge_seconds = t0.elapsed().as_secs_f64();
-    let baked = baked.lit(trisort_format::Environment::studio());
+    let baked = baked.lit(trisort_bake::Light::Studio.load()?);
     let merge_cpu_seconds = cpu_since(cpu0);
     let peak = window.peak();
     let s = &baked.stats;
@@ -820,5 +814,28 @@ fn log_x_chart(
             })
             .filter(|s| !s.points.is_empty())
             .collect(),
+    }
+}
+
+/// Recording progress as a line every tenth of the frames.
+struct Progress<'a> {
+    axis: &'a str,
+    step: u32,
+    t0: Instant,
+    progress: &'a dyn Fn(&str),
+}
+
+impl trisort_bake::Events for Progress<'_> {
+    fn progress(&mut self, p: &trisort_recorder::Progress) {
+        if p.done.is_multiple_of(self.step) || p.done == p.total {
+            (self.progress)(&format!(
+                "{}: phase {} {}/{} frames ({:.1} s)",
+                self.axis,
+                p.phase,
+                p.done,
+                p.total,
+                self.t0.elapsed().as_secs_f64()
+            ));
+        }
     }
 }

@@ -28,7 +28,7 @@ fn tiny_sweep_writes_consistent_outputs() {
         ..SweepConfig::new((64, 64), 4)
     };
     let lines = std::cell::RefCell::new(Vec::new());
-    let report = run(&gpu, &scene, &timeline, &config, &out, &|s| {
+    let report = run(&gpu, &working(&scene, &timeline), &config, &out, &|s| {
         lines.borrow_mut().push(s.to_string())
     })
     .unwrap();
@@ -206,10 +206,29 @@ fn bad_configurations_are_refused_before_any_work() {
             "saturation",
         ),
     ] {
-        let e = run(&gpu, &scene, &timeline, &config, dir.path(), &|_| {})
-            .unwrap_err()
-            .to_string();
+        let e = run(
+            &gpu,
+            &working(&scene, &timeline),
+            &config,
+            dir.path(),
+            &|_| {},
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains(needle), "{e}");
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+/// The scene and path as given (no split): what these tests sweep.
+fn working(
+    scene: &trisort_scene::Scene,
+    timeline: &trisort_paths::Timeline,
+) -> trisort_bake::Working {
+    trisort_bake::Working {
+        scene: scene.clone(),
+        timeline: timeline.clone(),
+        split: None,
+        split_seconds: 0.0,
+    }
 }

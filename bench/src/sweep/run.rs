@@ -6,11 +6,11 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::time::Instant;
 
+use trisort_bake::{record_in_memory, RecordTarget, Silent, Working};
 use trisort_format::{Phase, RecordSettings, Recording};
 use trisort_gpu::Gpu;
 use trisort_merger::MergeOptions;
 use trisort_player::Mode;
-use trisort_recorder::RecordJob;
 use trisort_reference::{ExactReference, ReferenceConfig};
 
 use super::factors::{number, same_settings, variants, Factor, Variant};
@@ -20,12 +20,12 @@ use super::robustness;
 use super::{SweepConfig, SweepPoint, SweepReport};
 use crate::BenchError;
 
-/// Runs the sweep of `scene` along `timeline` and writes its outputs into `out_dir` (created
-/// if missing). `progress` receives one line per step (recordings take minutes on big scenes).
+/// Runs the sweep of the working scene along its path and writes its outputs into `out_dir`
+/// (created if missing). `progress` receives one line per step (recordings take minutes on
+/// big scenes).
 pub fn run(
     gpu: &Gpu,
-    scene: &trisort_scene::Scene,
-    timeline: &trisort_paths::Timeline,
+    working: &Working,
     config: &SweepConfig,
     out_dir: &Path,
     progress: &dyn Fn(&str),
@@ -33,6 +33,7 @@ pub fn run(
     let base = config.base_settings();
     base.validate()
         .map_err(|e| BenchError::Invalid(format!("sweep settings: {e}")))?;
+    let (scene, timeline) = (&working.scene, &working.timeline);
     let path_frames = timeline.frames.len() as u32;
     let frames: Vec<u32> = if config.frames.is_empty() {
         (0..path_frames).collect()
@@ -149,7 +150,7 @@ impl Sweep<'_> {
                 let t = Instant::now();
                 let merged = trisort_merger::merge(std::slice::from_ref(&rec), &v.merge)?;
                 let merge_seconds = t.elapsed().as_secs_f64();
-                let baked = merged.lit(trisort_format::Environment::studio());
+                let baked = merged.lit(trisort_bake::Light::Studio.load()?);
                 // The reference lights like the bake: with its environment.
                 if let Entry::Vacant(slot) = references.entry(glass_key) {
                     slot.insert(self.reference_frames(settings.glass_opacity, &baked.environment)?);
@@ -294,18 +295,13 @@ impl Sweep<'_> {
             self.timeline.frames.len()
         ));
         let t = Instant::now();
-        let job = RecordJob {
-            geometry: &self.scene.geometry,
-            frames: &self.timeline.frames,
-            scene_hash: self.scene.hash(),
-            path_hash: self.timeline.hash(),
-            settings,
-            range: None,
+        let target = RecordTarget {
+            settings: &settings,
+            frames: None,
             phase: Phase::Graphs,
             known_visible: None,
-            internals: Default::default(),
         };
-        let rec = trisort_recorder::record(self.gpu, &job, None, |_| {})?;
+        let rec = record_in_memory(self.gpu, self.scene, self.timeline, target, &mut Silent)?;
         if let Some(f) = rec.frames.iter().find(|f| f.truncated) {
             return Err(BenchError::Invalid(format!(
                 "frame {} hit the layer bound ({}) while recording {}x{}",
