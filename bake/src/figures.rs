@@ -167,3 +167,111 @@ pub fn merge_summary(b: &Baked, seconds: f64) -> String {
         profile_summary(&b.settings)
     )
 }
+
+/// `inspect --json` of a baked file: its merge figures, rate, material variants (and why
+/// `play --variant` refuses any), raster profile, light, device and the edges the merger
+/// removed to break depth-order cycles.
+pub fn baked_file_json(baked: &Baked) -> serde_json::Value {
+    let s = &baked.stats;
+    json!({
+        "strategy": baked.merge.strategy, "layout": baked.merge.layout,
+        "index_triangles": s.index_triangles, "source_triangles": s.source_triangles,
+        "unique_visible": s.unique_visible, "draws_per_frame_mean": s.draws_per_frame_mean,
+        "draws_per_frame_max": s.draws_per_frame_max, "drawn_not_visible_mean": s.drawn_not_visible_mean,
+        "unordered_samples": s.unordered_samples, "seconds": s.seconds,
+        "exact_components": s.exact_components, "heuristic_components": s.heuristic_components,
+        "heuristic_unordered_samples": s.heuristic_unordered_samples,
+        "frames": baked.frames.len(),
+        // The path's frame rate (null where the recordings did not store one); the material
+        // variants' names (as for a scene), and why `play --variant` refuses any of them.
+        "fps": baked.fps,
+        "variants": baked.geometry.variants.iter().map(|v| &v.name).collect::<Vec<_>>(),
+        "variants_refused": baked.geometry.variants.iter().filter_map(|v| {
+            let e = baked.geometry.variant_materials(Some(&v.name)).err()?;
+            Some((v.name.clone(), serde_json::Value::from(e.to_string())))
+        }).collect::<serde_json::Map<_, _>>(),
+        "split_intersections": baked.settings.split_intersections,
+        // What the bake assumes about the rasterizer that plays it (record --raster-profile).
+        "raster_profile": raster_profile_json(&baked.settings),
+        // The light stored in the file (`bake --environment`).
+        "environment": environment_json(&baked.environment),
+        // The recording device; `mixed: …` (each device with its frames) when the recordings
+        // were merged with `merge --allow-mixed-devices`.
+        "device": baked.device.adapter, "driver": baked.device.driver,
+        // The edges the merger removed to break depth-order cycles, front → back, as scene
+        // ids of the recorded scene (the file stores G-local ids): the samples they weigh are
+        // the unordered ones.
+        "removed_edges": baked.removed_edges.iter().enumerate().flat_map(|(f, edges)| {
+            let id = |t: u32| baked.scene_ids.get(t as usize).copied().unwrap_or(t);
+            edges.iter().map(move |e| json!({"frame": f, "from": id(e.from), "to": id(e.to), "weight": e.weight}))
+        }).collect::<Vec<_>>(),
+    })
+}
+
+/// The scene's nodes that its animations move, by name.
+pub fn animated_nodes(scene: &trisort_scene::Scene) -> std::collections::BTreeSet<&str> {
+    let g = &scene.geometry;
+    scene
+        .animations
+        .iter()
+        .flat_map(|an| {
+            an.channels
+                .iter()
+                .map(|c| g.nodes[c.node as usize].name.as_str())
+        })
+        .collect()
+}
+
+/// What `record` would split with every node at rest (a path that moves nodes apart splits
+/// only within the groups that stay rigid on it).
+pub fn split_at_rest(scene: &trisort_scene::Scene) -> trisort_intersect::SplitReport {
+    let rest = trisort_format::FrameState {
+        camera: trisort_format::Camera {
+            view: glam::DMat4::IDENTITY.to_cols_array(),
+            yfov: 1.0,
+            znear: 0.1,
+            zfar: None,
+        },
+        poses: Vec::new(),
+    };
+    trisort_intersect::split_intersections(
+        &scene.geometry,
+        std::slice::from_ref(&rest),
+        &trisort_intersect::SplitOptions::default(),
+    )
+    .report
+}
+
+/// `inspect --json` of a scene: counts, materials by alpha mode, animated nodes, bounds,
+/// notes, material variants and what `record` would split at rest (`split`).
+pub fn scene_json(
+    scene: &trisort_scene::Scene,
+    split: &trisort_intersect::SplitReport,
+) -> serde_json::Value {
+    let st = &scene.stats;
+    let g = &scene.geometry;
+    let count_mode =
+        |m: trisort_format::AlphaMode| g.materials.iter().filter(|x| x.alpha_mode == m).count();
+    let transmissive = g.materials.iter().filter(|m| m.transmission > 0.0).count();
+    let animated = animated_nodes(scene);
+    let bounds = scene
+        .bounds()
+        .map(|(lo, hi)| json!({"min": lo.to_array(), "max": hi.to_array()}));
+    json!({
+        "scene": scene.name,
+        "triangles": st.triangles, "zero_area_triangles": st.zero_area_triangles,
+        "meshes": st.meshes, "primitives": st.primitives, "nodes": st.nodes,
+        "materials": st.materials, "textures": st.textures,
+        "animations": st.animations, "cameras": st.cameras,
+        "materials_by_alpha_mode": {"opaque": count_mode(trisort_format::AlphaMode::Opaque), "mask": count_mode(trisort_format::AlphaMode::Mask), "blend": count_mode(trisort_format::AlphaMode::Blend)},
+        "transmissive_materials": transmissive,
+        "animated_nodes": animated,
+        "bounds": bounds,
+        "notes": scene.notes,
+        "variants": scene.variants,
+        "intersections_split": split.pairs_split + split.pairs_split_across_groups,
+        "intersections_split_across_groups": split.pairs_split_across_groups,
+        "triangles_added": split.triangles_added,
+        "intersections_left": split.pairs_skipped_sliver,
+    })
+}

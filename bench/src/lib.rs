@@ -7,6 +7,7 @@
 #![deny(missing_docs)]
 
 pub mod harness;
+pub mod matrix;
 pub mod methods;
 pub mod plot;
 pub mod report;

@@ -13,7 +13,6 @@ use std::process::ExitCode;
 use anyhow::{bail, Result};
 use clap::Args;
 use serde_json::json;
-use trisort_capi::Order;
 
 use crate::common::print_json;
 
@@ -46,7 +45,7 @@ pub fn run(a: ExportOrderArgs) -> Result<ExitCode> {
             a.scene.display()
         );
     }
-    let order = Order::export(&a.baked, &a.scene, &a.output)?;
+    let order = trisort_capi::order::export(&a.baked, &a.scene, &a.output)?;
     let repeated = order.triangles.windows(2).filter(|w| w[0] == w[1]).count();
     if a.json {
         print_json(&json!({

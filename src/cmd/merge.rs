@@ -50,20 +50,6 @@ pub struct MergeOpts {
 const STUDIO: &str = "studio";
 
 impl MergeOpts {
-    /// The command line's defaults: [`MergeOptions::default`].
-    pub fn defaults() -> MergeOpts {
-        let o = MergeOptions::default();
-        MergeOpts {
-            strategy: o.strategy,
-            layout: o.layout,
-            bridge: o.bridge,
-            depth_only: o.depth_only,
-            segment: o.segment.unwrap_or(0),
-            seeding: o.seeding,
-            environment: STUDIO.to_string(),
-        }
-    }
-
     /// The `--environment` light: the built-in studio, or an .hdr file.
     pub fn light(&self) -> trisort_bake::Light {
         trisort_bake::Light::parse(&self.environment)
