@@ -175,22 +175,40 @@ impl GrowBuffers {
     }
 }
 
+/// The shader stages of a [`pulled_pipeline`]: the module and its (vertex, fragment) entry
+/// points.
+#[derive(Clone, Copy)]
+pub(crate) struct PulledStages<'a> {
+    pub module: &'a wgpu::ShaderModule,
+    pub entries: (&'a str, &'a str),
+}
+
+/// What a [`pulled_pipeline`] draws into: an optional colour target (`None`: depth only), an
+/// optional depth test (written), and the MSAA sample count.
+#[derive(Clone, Copy)]
+pub(crate) struct PulledTargets {
+    pub target: Option<wgpu::TextureFormat>,
+    pub depth: Option<(wgpu::TextureFormat, wgpu::CompareFunction)>,
+    pub samples: u32,
+}
+
 /// A pipeline whose vertex stage pulls triangles from storage (no vertex buffers, the
 /// triangle is `vertex_index / 3`): counter-clockwise front faces, no hardware culling (the
-/// shader discards culled faces), `samples` MSAA samples, an optional colour target (`None`:
-/// depth only) with writes off unless it is the peel's id target, an optional depth test
-/// (written).
-#[allow(clippy::too_many_arguments)]
+/// shader discards culled faces), the MSAA samples of `targets`, its optional colour target
+/// with writes off unless it is the peel's id target, its optional depth test (written).
 pub(crate) fn pulled_pipeline(
     device: &wgpu::Device,
     label: &str,
     layouts: &[&wgpu::BindGroupLayout],
-    module: &wgpu::ShaderModule,
-    entries: (&str, &str),
-    target: Option<wgpu::TextureFormat>,
-    depth: Option<(wgpu::TextureFormat, wgpu::CompareFunction)>,
-    samples: u32,
+    stages: PulledStages,
+    targets: PulledTargets,
 ) -> wgpu::RenderPipeline {
+    let PulledStages { module, entries } = stages;
+    let PulledTargets {
+        target,
+        depth,
+        samples,
+    } = targets;
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
     let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
@@ -285,35 +303,7 @@ impl<'g> Conservative<'g> {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let base = GrowBuffers::layout_entries();
-        let occlude_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("conservative occluders"),
-            entries: &base,
-        });
-        let texture_entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: view.samples > 1,
-            },
-            count: None,
-        };
-        let spread_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("conservative spread"),
-            entries: &[base[0], texture_entry(5, wgpu::TextureSampleType::Depth)],
-        });
-        let mut mark_layout_entries = base.to_vec();
-        mark_layout_entries.push(texture_entry(
-            3,
-            wgpu::TextureSampleType::Float { filterable: false },
-        ));
-        mark_layout_entries.push(storage_entry(4, wgpu::ShaderStages::FRAGMENT, false));
-        let mark_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("conservative mark"),
-            entries: &mark_layout_entries,
-        });
+        let [occlude_layout, spread_layout, mark_layout] = pass_layouts(device, view.samples);
         let texture = |label, format| {
             crate::peeler::view_texture(device, &view, label, format)
                 .create_view(&Default::default())
@@ -352,35 +342,43 @@ impl<'g> Conservative<'g> {
             layout: &mark_layout,
             entries: &mark_entries,
         });
-        let occlude = pulled_pipeline(
-            device,
+        // Each pass's pipeline: the scene (group 0) and its own group 1.
+        let pulled = |label, layout, entries, target, depth| {
+            pulled_pipeline(
+                device,
+                label,
+                &[&scene.layout, layout],
+                PulledStages {
+                    module: &module,
+                    entries,
+                },
+                PulledTargets {
+                    target,
+                    depth,
+                    samples: view.samples,
+                },
+            )
+        };
+        let occlude = pulled(
             "conservative occluders",
-            &[&scene.layout, &occlude_layout],
-            &module,
+            &occlude_layout,
             ("vs_occlude", "fs_occlude"),
             None,
             Some((SURFACE_FORMAT, wgpu::CompareFunction::Less)),
-            view.samples,
         );
-        let spread = pulled_pipeline(
-            device,
+        let spread = pulled(
             "conservative spread",
-            &[&scene.layout, &spread_layout],
-            &module,
+            &spread_layout,
             ("vs_full", "fs_spread"),
             Some(OCCLUDER_FORMAT),
             None,
-            view.samples,
         );
-        let mark = pulled_pipeline(
-            device,
+        let mark = pulled(
             "conservative mark",
-            &[&scene.layout, &mark_layout],
-            &module,
+            &mark_layout,
             ("vs_dilate", "fs_mark"),
             Some(MARK_FORMAT),
             None,
-            view.samples,
         );
         Ok(Conservative {
             gpu,
@@ -399,20 +397,21 @@ impl<'g> Conservative<'g> {
             triangles: count,
         })
     }
-    /// Records one pass of frame `frame`: `vertices` of `pipeline` with `group` in group 1,
-    /// into the color target `color` (view, clear color, store) or, without one, into
-    /// `surface`'s depth cleared to 1 and stored.
-    #[allow(clippy::too_many_arguments)]
+    /// Records one pass of frame `frame`: `draw`, into the color target `color` (view, clear
+    /// color, store) or, without one, into `surface`'s depth cleared to 1 and stored.
     fn pass(
         &self,
         enc: &mut wgpu::CommandEncoder,
         frame: u32,
-        label: &str,
         color: Option<(&wgpu::TextureView, wgpu::Color, wgpu::StoreOp)>,
-        pipeline: &wgpu::RenderPipeline,
-        group: &wgpu::BindGroup,
-        vertices: std::ops::Range<u32>,
+        draw: PassDraw,
     ) {
+        let PassDraw {
+            label,
+            pipeline,
+            group,
+            vertices,
+        } = draw;
         let color = color.map(|(view, clear, store)| {
             Some(wgpu::RenderPassColorAttachment {
                 view,
@@ -463,21 +462,25 @@ impl<'g> Conservative<'g> {
         self.pass(
             &mut enc,
             frame,
-            "conservative occluders",
             None,
-            &self.occlude,
-            &self.occlude_group,
-            triangles.clone(),
+            PassDraw {
+                label: "conservative occluders",
+                pipeline: &self.occlude,
+                group: &self.occlude_group,
+                vertices: triangles.clone(),
+            },
         );
         let spread = (&self.occluder, wgpu::Color::WHITE, wgpu::StoreOp::Store);
         self.pass(
             &mut enc,
             frame,
-            "conservative spread",
             Some(spread),
-            &self.spread,
-            &self.spread_group,
-            0..3,
+            PassDraw {
+                label: "conservative spread",
+                pipeline: &self.spread,
+                group: &self.spread_group,
+                vertices: 0..3,
+            },
         );
         let mark = (
             &self.target,
@@ -487,11 +490,13 @@ impl<'g> Conservative<'g> {
         self.pass(
             &mut enc,
             frame,
-            "conservative mark",
             Some(mark),
-            &self.mark,
-            &self.mark_group,
-            triangles,
+            PassDraw {
+                label: "conservative mark",
+                pipeline: &self.mark,
+                group: &self.mark_group,
+                vertices: triangles,
+            },
         );
         enc.copy_buffer_to_buffer(&self.flags, 0, &self.staging, 0, self.flags.size());
         self.gpu.queue.submit([enc.finish()]);
@@ -506,4 +511,49 @@ impl<'g> Conservative<'g> {
             .map(|(t, _)| t as u32)
             .collect())
     }
+}
+
+/// What one of [`Conservative`]'s passes draws: `vertices` of `pipeline`, with `group` in
+/// group 1.
+struct PassDraw<'a> {
+    label: &'a str,
+    pipeline: &'a wgpu::RenderPipeline,
+    group: &'a wgpu::BindGroup,
+    vertices: std::ops::Range<u32>,
+}
+
+/// The bind group layouts (group 1) of the three passes: occluders (the grown triangles),
+/// spread (the occluders' depth) and mark (the grown triangles, the spread occluders and the
+/// flags).
+fn pass_layouts(device: &wgpu::Device, samples: u32) -> [wgpu::BindGroupLayout; 3] {
+    let base = GrowBuffers::layout_entries();
+    let occlude_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("conservative occluders"),
+        entries: &base,
+    });
+    let texture_entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: samples > 1,
+        },
+        count: None,
+    };
+    let spread_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("conservative spread"),
+        entries: &[base[0], texture_entry(5, wgpu::TextureSampleType::Depth)],
+    });
+    let mut mark_layout_entries = base.to_vec();
+    mark_layout_entries.push(texture_entry(
+        3,
+        wgpu::TextureSampleType::Float { filterable: false },
+    ));
+    mark_layout_entries.push(storage_entry(4, wgpu::ShaderStages::FRAGMENT, false));
+    let mark_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("conservative mark"),
+        entries: &mark_layout_entries,
+    });
+    [occlude_layout, spread_layout, mark_layout]
 }
