@@ -409,7 +409,7 @@ fn sub_pixel_texture_alpha_verifies_in_every_mode() {
         }
     }
     let (texture, _) =
-        trisort_format::Texture::with_mips("checker".into(), n, n, rgba8, true, 1024);
+        trisort_scene::mips::texture_with_mips("checker".into(), n, n, rgba8, true, 1024);
     let textured = |mode| Material {
         base_color: [1.0, 1.0, 1.0, 1.0],
         base_color_texture: Some(0),

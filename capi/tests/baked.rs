@@ -9,7 +9,7 @@ use trisort_capi::ffi::*;
 use trisort_format::container::encode;
 use trisort_format::{
     Baked, DeviceInfo, DrawIndexedIndirectArgs, FileKind, FrameWindow, MergeInfo, MergeStats,
-    RecordSettings, Texture, TextureSlot, TextureTransform,
+    RecordSettings, TextureSlot, TextureTransform,
 };
 use trisort_testkit::fixtures::{frame_at, material, quad, scene};
 
@@ -42,9 +42,11 @@ fn sample() -> Baked {
     });
     g.vertices[5].tangent = [1.0, 0.0, 0.0, -1.0];
     g.vertices[5].uv1 = [0.125, 0.875];
-    let (colour, _) = Texture::with_mips("t".into(), 2, 1, (1..=8).collect(), true, 1024);
+    let (colour, _) =
+        trisort_scene::mips::texture_with_mips("t".into(), 2, 1, (1..=8).collect(), true, 1024);
     g.textures.push(colour);
-    let (normals, _) = Texture::with_mips("n".into(), 4, 2, vec![128; 32], false, 1024);
+    let (normals, _) =
+        trisort_scene::mips::texture_with_mips("n".into(), 4, 2, vec![128; 32], false, 1024);
     g.textures.push(normals);
     let copies = vec![0, 1, 2, 3, 4, 5, 6, 7, 2, 3];
     let draw = |first: u32, count: u32| DrawIndexedIndirectArgs {

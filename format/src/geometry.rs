@@ -3,6 +3,10 @@
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 
+mod variants;
+
+pub use variants::{MaterialVariant, VariantError};
+
 /// One vertex, laid out as the vertex buffer of every pipeline (recorder, player, reference).
 ///
 /// `position`, `normal` and `tangent` are in the local space of `node`: the node whose
@@ -217,7 +221,7 @@ pub struct Texture {
     /// is stored twice.
     pub srgb: bool,
     /// Mip levels 1, 2, … down to 1×1 (level k is `max(1, width >> k)` ×
-    /// `max(1, height >> k)`, RGBA8), generated at import ([`Texture::with_mips`]). Always the
+    /// `max(1, height >> k)`, RGBA8), generated at import (`trisort_scene::mips`). Always the
     /// full chain ([`Texture::mip_count`] levels; empty only for a 1×1 texture):
     /// [`Geometry::check_structure`] requires it, and the GPU upload uses these levels as
     /// stored, so the file is the one source of every texture's mips.
@@ -225,10 +229,6 @@ pub struct Texture {
 }
 
 impl Texture {
-    /// The largest width or height [`Texture::with_mips`] stores by default: a bigger image is
-    /// stored from its first mip level that fits.
-    pub const MAX_SIZE: u32 = 1024;
-
     /// Width and height of mip level `level` of a `width` × `height` image:
     /// `max(1, width >> level)` × `max(1, height >> level)`.
     pub fn level_size(width: u32, height: u32, level: u32) -> (u32, u32) {
@@ -246,132 +246,6 @@ impl Texture {
     pub fn byte_len(&self) -> u64 {
         self.rgba8.len() as u64 + self.mips.iter().map(|m| m.len() as u64).sum::<u64>()
     }
-
-    /// A texture from a decoded `width` × `height` RGBA8 image (rows top to bottom), with its
-    /// full mip chain ([`Texture::mips`]). Each level is a box filter of the one above it:
-    /// texel `(x, y)` averages the texels of the level above that its footprint overlaps (2×2,
-    /// or 3 along an odd dimension, 1 along a dimension of size 1), with equal weights. For an
-    /// `srgb` texture the colour channels are decoded to linear light, averaged and encoded
-    /// again (black and white average to 188, not 128); alpha, and every channel of a linear
-    /// texture, is averaged as stored. Rounds to nearest.
-    ///
-    /// An image wider or taller than `max_size` is stored from its first mip level that fits
-    /// (levels above it are computed and dropped); the second value returned is that level
-    /// (0 when it fits). `rgba8` must hold `width * height * 4` bytes and both sizes must be at
-    /// least 1, else this panics.
-    pub fn with_mips(
-        name: String,
-        width: u32,
-        height: u32,
-        rgba8: Vec<u8>,
-        srgb: bool,
-        max_size: u32,
-    ) -> (Texture, u32) {
-        assert!(width > 0 && height > 0, "an empty image has no mips");
-        assert_eq!(
-            rgba8.len() as u64,
-            width as u64 * height as u64 * 4,
-            "RGBA8 byte count of a {width}x{height} image"
-        );
-        let max_size = max_size.max(1);
-        let (mut w, mut h, mut level0) = (width, height, rgba8);
-        let mut dropped = 0;
-        while w > max_size || h > max_size {
-            let (nw, nh) = Texture::level_size(w, h, 1);
-            level0 = downsample(&level0, w, h, nw, nh, srgb);
-            (w, h) = (nw, nh);
-            dropped += 1;
-        }
-        let mut mips: Vec<Vec<u8>> = Vec::with_capacity(Texture::mip_count(w, h));
-        let (mut lw, mut lh) = (w, h);
-        for _ in 0..Texture::mip_count(w, h) {
-            let (nw, nh) = Texture::level_size(lw, lh, 1);
-            let above = mips.last().unwrap_or(&level0);
-            let next = downsample(above, lw, lh, nw, nh, srgb);
-            mips.push(next);
-            (lw, lh) = (nw, nh);
-        }
-        let texture = Texture {
-            name,
-            width: w,
-            height: h,
-            rgba8: level0,
-            srgb,
-            mips,
-        };
-        (texture, dropped)
-    }
-}
-
-/// sRGB-encoded byte to linear light.
-fn srgb_to_linear(c: u8) -> f32 {
-    let c = c as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Linear light in [0, 1] to the nearest sRGB-encoded byte.
-fn linear_to_srgb(l: f32) -> u8 {
-    let l = l.clamp(0.0, 1.0);
-    let c = if l <= 0.0031308 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
-    (c * 255.0).round() as u8
-}
-
-/// The `[start, end)` texels of a source dimension of `from` texels that dest texel `i` of
-/// `to` overlaps.
-fn footprint(i: u32, from: u32, to: u32) -> (usize, usize) {
-    let start = (i as u64 * from as u64) / to as u64;
-    let end = ((i as u64 + 1) * from as u64).div_ceil(to as u64);
-    (start as usize, end as usize)
-}
-
-/// One box-filtered level (see [`Texture::with_mips`]).
-fn downsample(src: &[u8], w: u32, h: u32, nw: u32, nh: u32, srgb: bool) -> Vec<u8> {
-    let decode: Vec<f32> = (0..=255u8)
-        .map(|c| {
-            if srgb {
-                srgb_to_linear(c)
-            } else {
-                c as f32 / 255.0
-            }
-        })
-        .collect();
-    let mut out = Vec::with_capacity(nw as usize * nh as usize * 4);
-    for y in 0..nh {
-        let (y0, y1) = footprint(y, h, nh);
-        for x in 0..nw {
-            let (x0, x1) = footprint(x, w, nw);
-            let mut sum = [0f32; 4];
-            for sy in y0..y1 {
-                let row = &src[sy * w as usize * 4..];
-                for sx in x0..x1 {
-                    let p = &row[sx * 4..sx * 4 + 4];
-                    for c in 0..3 {
-                        sum[c] += decode[p[c] as usize];
-                    }
-                    sum[3] += p[3] as f32;
-                }
-            }
-            let n = ((y1 - y0) * (x1 - x0)) as f32;
-            for c in sum.iter().take(3) {
-                let v = c / n;
-                out.push(if srgb {
-                    linear_to_srgb(v)
-                } else {
-                    (v * 255.0).round().clamp(0.0, 255.0) as u8
-                });
-            }
-            out.push((sum[3] / n).round().clamp(0.0, 255.0) as u8);
-        }
-    }
-    out
 }
 
 /// A node of the scene hierarchy.
@@ -402,61 +276,6 @@ pub struct Geometry {
     /// Material variants (glTF `KHR_materials_variants`), in file order: what
     /// [`Geometry::variant_materials`] applies at play time. Empty without the extension.
     pub variants: Vec<MaterialVariant>,
-}
-
-/// One material variant: which material each material slot shows under it.
-///
-/// glTF maps variants per primitive; the importer turns that into one table per variant over
-/// [`Geometry::materials`] (giving a primitive a slot of its own where two primitives sharing a
-/// material map it differently), so a variant is applied by rewriting the material table alone:
-/// vertices keep their [`Vertex::material`] slot.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct MaterialVariant {
-    /// Name from the file (`""` when unnamed; names need not be unique).
-    pub name: String,
-    /// Per material slot (same length as [`Geometry::materials`]): the index of the material
-    /// drawn in that slot under this variant (the slot itself where the variant leaves it).
-    pub materials: Vec<u32>,
-}
-
-/// Why a variant cannot be applied to a baked file.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum VariantError {
-    /// No variant has this name.
-    #[error("no material variant {name:?}: {}", list_variants(available))]
-    Unknown {
-        /// The name asked for.
-        name: String,
-        /// The variants the file has.
-        available: Vec<String>,
-    },
-    /// The variant changes what decides visibility, so the baked order would not be exact.
-    #[error(
-        "variant {variant:?} cannot be played on this bake: it replaces material {slot} {from:?} \
-         by material {to:?}, which changes its {field}; that decides visibility, so the baked \
-         order would not be exact (bake a scene whose default materials are this variant's)"
-    )]
-    ChangesVisibility {
-        /// The variant.
-        variant: String,
-        /// The material slot.
-        slot: u32,
-        /// Name of the slot's default material.
-        from: String,
-        /// Name of the material the variant puts there.
-        to: String,
-        /// What differs (alpha mode, alpha cutoff, alpha, transmission, ...).
-        field: &'static str,
-    },
-}
-
-fn list_variants(available: &[String]) -> String {
-    if available.is_empty() {
-        "the file has no variants".to_string()
-    } else {
-        let names: Vec<String> = available.iter().map(|n| format!("{n:?}")).collect();
-        format!("the file's variants are {}", names.join(", "))
-    }
 }
 
 impl Geometry {
@@ -496,6 +315,43 @@ impl Geometry {
                 );
             }
         }
+        self.check_materials()?;
+        self.check_textures()?;
+        for (k, v) in self.variants.iter().enumerate() {
+            if v.materials.len() != self.materials.len() {
+                return Err(crate::Part::Geometry.error(format!(
+                    "material variant {k} maps {} material slots, the geometry has {}",
+                    v.materials.len(),
+                    self.materials.len()
+                )));
+            }
+            if let Some(m) = v
+                .materials
+                .iter()
+                .find(|&&m| m as usize >= self.materials.len())
+            {
+                return Err(crate::Part::Geometry.error(format!(
+                    "material variant {k} refers to missing material {m}"
+                )));
+            }
+        }
+        for (k, n) in self.nodes.iter().enumerate() {
+            if n.parent.is_some_and(|p| p as usize >= k) {
+                return Err(crate::Part::Geometry
+                    .error(format!("node {k} has a parent that does not precede it")));
+            }
+            if !n.rest.iter().all(|x| x.is_finite()) {
+                return Err(
+                    crate::Part::Geometry.error(format!("node {k}'s rest transform is not finite"))
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Geometry::check_structure`] of the materials: finite factors; every texture slot
+    /// naming an existing texture, texture coordinate set 0 or 1 and a finite transform.
+    fn check_materials(&self) -> Result<(), crate::StructureError> {
         for (k, m) in self.materials.iter().enumerate() {
             let factors = (m.base_color.iter().chain(&m.emissive)).chain([
                 &m.alpha_cutoff,
@@ -553,6 +409,12 @@ impl Geometry {
                 )));
             }
         }
+        Ok(())
+    }
+
+    /// [`Geometry::check_structure`] of the textures: non-empty, with the right byte count for
+    /// level 0 and for each level of the full mip chain down to 1×1.
+    fn check_textures(&self) -> Result<(), crate::StructureError> {
         for (t, tex) in self.textures.iter().enumerate() {
             if tex.width == 0 || tex.height == 0 {
                 return Err(crate::Part::Geometry.error(format!(
@@ -587,35 +449,6 @@ impl Geometry {
                 }
             }
         }
-        for (k, v) in self.variants.iter().enumerate() {
-            if v.materials.len() != self.materials.len() {
-                return Err(crate::Part::Geometry.error(format!(
-                    "material variant {k} maps {} material slots, the geometry has {}",
-                    v.materials.len(),
-                    self.materials.len()
-                )));
-            }
-            if let Some(m) = v
-                .materials
-                .iter()
-                .find(|&&m| m as usize >= self.materials.len())
-            {
-                return Err(crate::Part::Geometry.error(format!(
-                    "material variant {k} refers to missing material {m}"
-                )));
-            }
-        }
-        for (k, n) in self.nodes.iter().enumerate() {
-            if n.parent.is_some_and(|p| p as usize >= k) {
-                return Err(crate::Part::Geometry
-                    .error(format!("node {k} has a parent that does not precede it")));
-            }
-            if !n.rest.iter().all(|x| x.is_finite()) {
-                return Err(
-                    crate::Part::Geometry.error(format!("node {k}'s rest transform is not finite"))
-                );
-            }
-        }
         Ok(())
     }
 
@@ -648,340 +481,39 @@ impl Geometry {
             variants: self.variants.clone(),
         }
     }
-
-    /// The material table under variant `name` (`None`: the default materials): entry k is
-    /// what slot k shows. Refused when the variant is unknown, or when it changes anything
-    /// that decides which samples a triangle covers or how opaque it is, for any slot: alpha
-    /// mode, double-sidedness, transmission, and for non-glass `Mask` materials the cutoff,
-    /// and for non-glass `Mask` and `Blend` materials the alpha factor, the base-colour
-    /// texture's alpha channel, and (where that alpha is not 255 everywhere) the base-colour
-    /// texture coordinate set and transform. Colour, emissive and opaque textures may change freely.
-    pub fn variant_materials(&self, name: Option<&str>) -> Result<Vec<Material>, VariantError> {
-        let Some(name) = name else {
-            return Ok(self.materials.clone());
-        };
-        let Some(variant) = self.variants.iter().find(|v| v.name == name) else {
-            return Err(VariantError::Unknown {
-                name: name.to_string(),
-                available: self.variants.iter().map(|v| v.name.clone()).collect(),
-            });
-        };
-        let mut out = Vec::with_capacity(self.materials.len());
-        for (slot, from) in self.materials.iter().enumerate() {
-            let target = variant.materials.get(slot).copied().unwrap_or(slot as u32);
-            let to = self.materials.get(target as usize).unwrap_or(from);
-            if let Some(field) = self.visibility_change(from, to) {
-                return Err(VariantError::ChangesVisibility {
-                    variant: variant.name.clone(),
-                    slot: slot as u32,
-                    from: from.name.clone(),
-                    to: to.name.clone(),
-                    field,
-                });
-            }
-            out.push(to.clone());
-        }
-        Ok(out)
-    }
-
-    /// The first property deciding coverage or opacity that differs between `a` and `b`.
-    fn visibility_change(&self, a: &Material, b: &Material) -> Option<&'static str> {
-        if a.alpha_mode != b.alpha_mode {
-            return Some("alpha mode");
-        }
-        if a.double_sided != b.double_sided {
-            return Some("double-sidedness (back faces are culled or not)");
-        }
-        if a.transmission.to_bits() != b.transmission.to_bits() {
-            return Some("transmission");
-        }
-        // Glass is drawn at the glass opacity whatever its alpha; opaque materials at 1.
-        if a.transmission > 0.0 || a.alpha_mode == AlphaMode::Opaque {
-            return None;
-        }
-        if a.alpha_mode == AlphaMode::Mask && a.alpha_cutoff.to_bits() != b.alpha_cutoff.to_bits() {
-            return Some("alpha cutoff");
-        }
-        if a.base_color[3].to_bits() != b.base_color[3].to_bits() {
-            return Some("alpha");
-        }
-        if !self.same_texture_alpha(a.base_color_texture, b.base_color_texture) {
-            return Some("base-colour texture's alpha");
-        }
-        // Where the alpha varies, the coordinates it is sampled at move it.
-        if self.texture_alpha_varies(a.base_color_texture)
-            || self.texture_alpha_varies(b.base_color_texture)
-        {
-            if a.base_color_tex_coord != b.base_color_tex_coord {
-                return Some("base-colour texture coordinate set (it moves the alpha)");
-            }
-            let bits = |t: &TextureTransform| {
-                [t.offset[0], t.offset[1], t.rotation, t.scale[0], t.scale[1]].map(f32::to_bits)
-            };
-            if bits(&a.base_color_transform) != bits(&b.base_color_transform) {
-                return Some("base-colour texture transform (it moves the alpha)");
-            }
-        }
-        None
-    }
-
-    /// Whether texture `t` exists and has a texel with alpha below 255.
-    fn texture_alpha_varies(&self, t: Option<u32>) -> bool {
-        t.and_then(|t| self.textures.get(t as usize))
-            .is_some_and(|t| t.rgba8.iter().skip(3).step_by(4).any(|&a| a != 255))
-    }
-
-    /// Whether two base-colour textures (or none, alpha 1) give the same alpha everywhere.
-    fn same_texture_alpha(&self, a: Option<u32>, b: Option<u32>) -> bool {
-        if a == b {
-            return true;
-        }
-        let texture = |t: Option<u32>| t.and_then(|t| self.textures.get(t as usize));
-        let alphas = |t: &Texture| {
-            t.rgba8
-                .iter()
-                .skip(3)
-                .step_by(4)
-                .copied()
-                .collect::<Vec<u8>>()
-        };
-        match (texture(a), texture(b)) {
-            (None, None) => true,
-            (Some(t), None) | (None, Some(t)) => alphas(t).iter().all(|&x| x == 255),
-            (Some(s), Some(t)) => {
-                s.width == t.width && s.height == t.height && alphas(s) == alphas(t)
-            }
-        }
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// Slots 0 (opaque red) and 1 (masked, textured), and the materials variants may use:
-    /// 2 opaque blue, 3 blend, 4 masked with another cutoff, 5 masked with a texture of the
-    /// same alpha, 6 masked with a texture of another alpha, 7 single-sided red, 8 glass.
-    fn geometry(variant: Vec<u32>) -> Geometry {
-        let m = |name: &str, rgba: [f32; 4], mode: AlphaMode| Material {
-            name: name.into(),
-            base_color: rgba,
-            alpha_mode: mode,
-            double_sided: true,
-            ..Material::default()
-        };
-        let texture = |alpha: u8, rgb: u8| {
-            let rgba8 = vec![rgb, rgb, rgb, alpha, 0, 0, 0, 255];
-            Texture::with_mips(String::new(), 2, 1, rgba8, true, Texture::MAX_SIZE).0
-        };
-        let masked = |name: &str, t: u32| Material {
-            base_color_texture: Some(t),
-            ..m(name, [1.0; 4], AlphaMode::Mask)
-        };
-        Geometry {
-            materials: vec![
-                m("red", [1.0, 0.0, 0.0, 1.0], AlphaMode::Opaque),
-                masked("leaf", 0),
-                m("blue", [0.0, 0.0, 1.0, 0.5], AlphaMode::Opaque),
-                m("veil", [1.0; 4], AlphaMode::Blend),
-                Material {
-                    alpha_cutoff: 0.25,
-                    ..masked("leaf low", 0)
-                },
-                masked("leaf recoloured", 1),
-                masked("leaf holed", 2),
-                Material {
-                    double_sided: false,
-                    ..m("red one side", [1.0, 0.0, 0.0, 1.0], AlphaMode::Opaque)
-                },
-                Material {
-                    transmission: 1.0,
-                    ..m("glass", [1.0; 4], AlphaMode::Opaque)
-                },
-            ],
-            textures: vec![texture(128, 10), texture(128, 200), texture(0, 10)],
-            variants: vec![MaterialVariant {
-                name: "v".into(),
-                materials: variant,
-            }],
-            ..Geometry::default()
-        }
-    }
-
-    fn with(slot0: u32, slot1: u32) -> Geometry {
-        let mut map: Vec<u32> = (0..9).collect();
-        map[0] = slot0;
-        map[1] = slot1;
-        geometry(map)
-    }
-
-    #[test]
-    fn a_variant_changing_colour_only_applies() {
-        for (slot0, slot1) in [(2, 1), (0, 5), (2, 5), (0, 1)] {
-            let g = with(slot0, slot1);
-            g.check_structure().unwrap();
-            let table = g.variant_materials(Some("v")).unwrap();
-            assert_eq!(table[0], g.materials[slot0 as usize]);
-            assert_eq!(table[1], g.materials[slot1 as usize]);
-            assert_eq!(table[2..], g.materials[2..]);
-            assert_eq!(g.variant_materials(None).unwrap(), g.materials);
-        }
-    }
-
-    #[test]
-    fn a_variant_changing_what_decides_visibility_is_refused_naming_it() {
-        for (slot0, slot1, field, from, to) in [
-            (3, 1, "alpha mode", "red", "veil"),
-            (7, 1, "double-sidedness", "red", "red one side"),
-            (8, 1, "transmission", "red", "glass"),
-            (0, 4, "alpha cutoff", "leaf", "leaf low"),
-            (0, 6, "texture's alpha", "leaf", "leaf holed"),
-        ] {
-            let err = with(slot0, slot1).variant_materials(Some("v")).unwrap_err();
-            let VariantError::ChangesVisibility { field: f, .. } = &err else {
-                panic!("{err:?}");
-            };
-            assert!(f.contains(field), "{err}");
-            let text = err.to_string();
-            for needle in ["\"v\"", &format!("{from:?}"), &format!("{to:?}"), "exact"] {
-                assert!(text.contains(needle), "{text} lacks {needle}");
-            }
-        }
-        // An alpha factor change on a blend material is refused too.
-        let mut g = with(0, 1);
-        g.materials[2] = Material {
-            base_color: [1.0, 1.0, 1.0, 0.5],
-            ..g.materials[3].clone()
-        };
-        g.variants[0].materials[3] = 2;
-        let err = g.variant_materials(Some("v")).unwrap_err();
-        assert!(err.to_string().contains("its alpha;"), "{err}");
-    }
-
-    #[test]
-    fn an_unknown_variant_lists_the_files_variants() {
-        let err = with(0, 1).variant_materials(Some("w")).unwrap_err();
-        assert_eq!(
-            err.to_string(),
-            "no material variant \"w\": the file's variants are \"v\""
-        );
-        let none = Geometry::default()
-            .variant_materials(Some("w"))
-            .unwrap_err();
-        assert!(
-            none.to_string().ends_with("the file has no variants"),
-            "{none}"
-        );
-    }
-
-    #[test]
-    fn check_structure_refuses_variants_that_do_not_map_every_slot() {
-        let mut g = with(0, 1);
-        g.variants[0].materials.pop();
-        assert!(g
-            .check_structure()
-            .unwrap_err()
-            .problem
-            .contains("maps 8 material slots"));
-        let mut g = with(0, 1);
-        g.variants[0].materials[0] = 9;
-        assert!(g
-            .check_structure()
-            .unwrap_err()
-            .problem
-            .contains("missing material 9"));
-    }
-
     fn image(w: u32, h: u32) -> Vec<u8> {
         (0..w * h * 4).map(|i| (i * 37 % 251) as u8).collect()
     }
 
-    #[test]
-    fn mip_chains_halve_each_dimension_down_to_one_texel() {
-        for (w, h, levels) in [
-            (1, 1, 0),
-            (2, 2, 1),
-            (5, 3, 2),
-            (7, 7, 2),
-            (8, 2, 3),
-            (1, 9, 3),
-            (13, 1, 3),
-            (1024, 3, 10),
-        ] {
-            let (t, dropped) = Texture::with_mips("t".into(), w, h, image(w, h), true, 1024);
-            assert_eq!(dropped, 0);
-            assert_eq!((t.width, t.height), (w, h));
-            assert_eq!(t.mips.len(), levels, "{w}x{h}");
-            for (k, mip) in t.mips.iter().enumerate() {
-                let (lw, lh) = Texture::level_size(w, h, k as u32 + 1);
-                assert_eq!((lw, lh), ((w >> (k + 1)).max(1), (h >> (k + 1)).max(1)));
-                assert_eq!(mip.len() as u32, lw * lh * 4, "{w}x{h} level {}", k + 1);
-            }
-            assert_eq!(t.mips.last().map_or(4, |m| m.len()), 4, "ends at 1x1");
-            let g = Geometry {
-                textures: vec![t],
-                ..Geometry::default()
-            };
-            g.check_structure().unwrap();
+    /// A texture of `rgba8` with a full chain of mip levels of the right sizes, each texel a
+    /// copy of level 0's first: `Geometry::check_structure` looks at the sizes only (the
+    /// importer's chains come from `trisort_scene::mips`).
+    pub(super) fn texture_of(name: &str, width: u32, height: u32, rgba8: Vec<u8>) -> Texture {
+        let mips = (1..=Texture::mip_count(width, height) as u32)
+            .map(|k| {
+                let (w, h) = Texture::level_size(width, height, k);
+                rgba8[..4].repeat((w * h) as usize)
+            })
+            .collect();
+        Texture {
+            name: name.into(),
+            width,
+            height,
+            rgba8,
+            srgb: true,
+            mips,
         }
-    }
-
-    #[test]
-    fn srgb_mips_average_light_and_linear_ones_bytes() {
-        // Black and white texels with alpha 0 and 255.
-        let px = vec![0, 0, 0, 0, 255, 255, 255, 255];
-        let (srgb, _) = Texture::with_mips(String::new(), 2, 1, px.clone(), true, 1024);
-        assert_eq!(srgb.mips, vec![vec![188, 188, 188, 128]]);
-        let (linear, _) = Texture::with_mips(String::new(), 2, 1, px, false, 1024);
-        assert_eq!(linear.mips, vec![vec![128, 128, 128, 128]]);
-        // An odd row of three averages all three: 0, 0 and 255 give a third of the light.
-        let (odd, _) = Texture::with_mips(
-            String::new(),
-            3,
-            1,
-            vec![0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255, 255],
-            true,
-            1024,
-        );
-        // linear 1/3 -> sRGB 0.6134 -> 156.4
-        assert_eq!(odd.mips, vec![vec![156, 156, 156, 255]]);
-        // A uniform image stays uniform at every level.
-        let (flat, _) = Texture::with_mips(
-            String::new(),
-            6,
-            5,
-            [90u8, 20, 200, 77].repeat(30),
-            true,
-            1024,
-        );
-        assert!(flat
-            .mips
-            .iter()
-            .flatten()
-            .collect::<Vec<_>>()
-            .chunks(4)
-            .all(|p| *p[0] == 90 && *p[1] == 20 && *p[2] == 200 && *p[3] == 77));
-    }
-
-    #[test]
-    fn images_larger_than_the_cap_are_stored_from_the_first_level_that_fits() {
-        let (t, dropped) = Texture::with_mips("big".into(), 20, 6, image(20, 6), false, 4);
-        assert_eq!(dropped, 3);
-        assert_eq!((t.width, t.height), (2, 1));
-        assert_eq!(t.rgba8.len(), 2 * 4);
-        assert_eq!(t.mips.len(), 1);
-        // Level 0 as stored is what the full chain's level 3 would be.
-        let (chain, _) = Texture::with_mips(String::new(), 20, 6, image(20, 6), false, 1024);
-        assert_eq!(t.rgba8, chain.mips[2]);
-        assert_eq!(t.mips[0], chain.mips[3]);
-        let (fits, dropped) = Texture::with_mips("edge".into(), 4, 4, image(4, 4), false, 4);
-        assert_eq!((dropped, fits.width), (0, 4));
-        assert_eq!(fits.byte_len(), 4 * 4 * 4 + 2 * 2 * 4 + 4);
     }
 
     /// A valid geometry with one textured material using every slot.
     fn textured() -> Geometry {
-        let (t, _) = Texture::with_mips("t".into(), 4, 2, image(4, 2), true, 1024);
+        let t = texture_of("t", 4, 2, image(4, 2));
         let slot = TextureSlot {
             texture: 0,
             tex_coord: 1,
@@ -1111,26 +643,8 @@ mod tests {
             err.contains("texture 0 \"t\" (4x2) has 0 mip levels, a full chain has 2"),
             "{err}"
         );
-        g.textures[0] = Texture::with_mips("dot".into(), 1, 1, vec![9; 4], true, 4).0;
+        g.textures[0] = texture_of("dot", 1, 1, vec![9; 4]);
         assert!(g.textures[0].mips.is_empty());
         g.check_structure().unwrap();
-    }
-
-    #[test]
-    fn a_variant_moving_a_varying_alpha_is_refused() {
-        // Slot 1 ("leaf") is masked with texture 0, whose alpha varies.
-        let mut g = with(0, 5);
-        g.materials[5].base_color_tex_coord = 1;
-        let err = g.variant_materials(Some("v")).unwrap_err();
-        assert!(err.to_string().contains("texture coordinate set"), "{err}");
-        let mut g = with(0, 5);
-        g.materials[5].base_color_transform.rotation = 0.5;
-        let err = g.variant_materials(Some("v")).unwrap_err();
-        assert!(err.to_string().contains("texture transform"), "{err}");
-        // Opaque materials may move their texture freely.
-        let mut g = with(2, 1);
-        g.materials[2].base_color_texture = Some(0);
-        g.materials[2].base_color_transform.offset = [0.5, 0.0];
-        g.variant_materials(Some("v")).unwrap();
     }
 }

@@ -58,13 +58,13 @@ pub(crate) fn flat_texture(rgba: [u8; 4], size: u32, srgb: bool) -> Texture {
 
 /// `t` with the mip chain the importer makes from its level 0 (after a test edits it).
 pub(crate) fn with_chain(t: Texture) -> Texture {
-    Texture::with_mips(
+    trisort_scene::mips::texture_with_mips(
         t.name,
         t.width,
         t.height,
         t.rgba8,
         t.srgb,
-        Texture::MAX_SIZE,
+        trisort_scene::mips::MAX_SIZE,
     )
     .0
 }

@@ -34,7 +34,8 @@ fn demo_car_with_linear_maps() -> Scene {
     let mut scene = trisort_scene::demo_car(20_000);
     let g = &mut scene.geometry;
     let pattern: Vec<u8> = (0..16 * 16 * 4).map(|i| (i * 53 % 251) as u8).collect();
-    let (maps, _) = Texture::with_mips("maps".into(), 16, 16, pattern, false, 1024);
+    let (maps, _) =
+        trisort_scene::mips::texture_with_mips("maps".into(), 16, 16, pattern, false, 1024);
     let slot = Some(TextureSlot {
         texture: g.textures.len() as u32,
         tex_coord: 0,

@@ -1,6 +1,6 @@
 //! Scenes for trisort: glTF 2.0 import, the procedural demo car and glTF export.
 //!
-//! This crate exists apart from `recorder` so that the dependency rules of the design hold:
+//! This crate exists apart from `recorder` so that each stage pulls in only what it uses:
 //! `paths` needs scenes (node names, animations, bounds) but no GPU, and the merger and player
 //! must not depend on `gltf`.
 #![deny(missing_docs)]
@@ -204,6 +204,7 @@ pub mod environment;
 mod error;
 pub mod export;
 pub mod gltf_import;
+pub mod mips;
 
 pub use demo_car::{demo_car, DEFAULT_TRIANGLES, DOOR_NODE, DOOR_WINDOW_NODE};
 pub use environment::{load_hdr, EnvironmentError};

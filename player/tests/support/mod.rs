@@ -239,7 +239,7 @@ pub fn faces() -> Baked {
             },
         ],
         textures: vec![
-            trisort_format::Texture::with_mips(
+            trisort_scene::mips::texture_with_mips(
                 "half".into(),
                 2,
                 1,

@@ -84,13 +84,13 @@ pub(super) fn plate_texture() -> Texture {
             rgba8.extend_from_slice(if border || in_text { &ink } else { &background });
         }
     }
-    let (texture, _) = Texture::with_mips(
+    let (texture, _) = crate::mips::texture_with_mips(
         "licence plate".into(),
         W as u32,
         H as u32,
         rgba8,
         true,
-        Texture::MAX_SIZE,
+        crate::mips::MAX_SIZE,
     );
     texture
 }

@@ -10,6 +10,7 @@ use trisort_format::{
 
 use super::container::read_uri;
 use super::{label, Importer};
+use crate::mips::texture_with_mips;
 use crate::SceneError;
 
 /// What the vertices of a material's primitives must carry.
@@ -143,8 +144,8 @@ fn info<'d>(what: &'static str, info: gltf::texture::Info<'d>, srgb: bool) -> Sl
     }
 }
 
-/// The largest width or height a texture is stored at (see [`Texture::with_mips`]).
-const MAX_TEXTURE_SIZE: u32 = Texture::MAX_SIZE;
+/// The largest width or height a texture is stored at (see [`texture_with_mips`]).
+const MAX_TEXTURE_SIZE: u32 = crate::mips::MAX_SIZE;
 
 /// `KHR_materials_clearcoat`, read from the material's raw extension JSON.
 const CLEARCOAT: &str = "KHR_materials_clearcoat";
@@ -425,7 +426,7 @@ impl Importer<'_> {
         if width == 0 || height == 0 {
             return Err(self.image_error(image, &name, "is empty".to_string()));
         }
-        let (texture, dropped) = Texture::with_mips(
+        let (texture, dropped) = texture_with_mips(
             name,
             width,
             height,

@@ -36,7 +36,7 @@
 //! - **Textures**: every image a material slot uses, decoded (PNG or JPEG) to RGBA8, once per
 //!   colour space it is used in (sRGB for base colour and emissive, linear for the others),
 //!   in order of first use by the materials (slots in the order above), with its mip chain
-//!   ([`Texture::with_mips`](trisort_format::Texture::with_mips)); an image wider or taller
+//!   ([`texture_with_mips`](crate::mips::texture_with_mips)); an image wider or taller
 //!   than 1024 is stored from its first mip level that fits, with a note giving the bytes.
 //! - **Vertex attributes**: [`Vertex::uv`](trisort_format::Vertex::uv) is `TEXCOORD_0` and
 //!   [`Vertex::uv1`](trisort_format::Vertex::uv1) `TEXCOORD_1`, each read where a texture slot
