@@ -8,6 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 use trisort_format::{Edge, RecordSettings};
 
 use crate::capture;
+use crate::cycles::on_cycle;
 use crate::layers::Layers;
 use crate::partial::Graph;
 use crate::tie_rule::{self, GrownList, GrownOrder, TieRule};
@@ -342,15 +343,12 @@ fn merge_grown_edges(edges: &mut HashMap<(u32, u32), u32>, grown: HashMap<(u32, 
     if grown.is_empty() {
         return;
     }
-    let union: Vec<Edge> = edges
-        .iter()
-        .chain(grown.iter().filter(|(k, _)| !edges.contains_key(k)))
-        .map(|(&(from, to), &weight)| Edge { from, to, weight })
+    let union: Vec<(u32, u32)> = edges
+        .keys()
+        .chain(grown.keys().filter(|k| !edges.contains_key(k)))
+        .copied()
         .collect();
-    let on_cycle: std::collections::HashSet<(u32, u32)> = trisort_verify::cycle_edges(&union)
-        .into_iter()
-        .map(|e| (e.from, e.to))
-        .collect();
+    let on_cycle = on_cycle(&union);
     for (key, w) in grown {
         match edges.get_mut(&key) {
             Some(v) => *v += w,

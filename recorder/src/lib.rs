@@ -25,6 +25,7 @@ mod capture;
 mod conservative;
 #[cfg(test)]
 mod coverage_test;
+mod cycles;
 mod envelope;
 mod graph;
 mod layers;
