@@ -8,7 +8,7 @@ use super::shapes::{
     body_point, station_of_z, superellipsoid, theta_at_height, theta_at_width, torus,
 };
 use super::surface::{
-    body_patch, closed_part, curve_length, param_gap, subdivide, Kind, Surface, Uv,
+    body_patch, closed_part, curve_length, param_gap, subdivide, Kind, Placement, Surface, Uv,
 };
 use super::{
     BELT, DASHBOARD, DOOR_NODE_INDEX, DOOR_WINDOW_NODE_INDEX, DOOR_Z, FIRST_WHEEL_NODE, GLASS,
@@ -73,9 +73,11 @@ pub(super) fn plan(r: f64) -> Vec<Surface> {
             [true; 4],
             Kind::Sheet,
             r,
-            GLASS,
-            ROOT_NODE,
-            DVec3::ZERO,
+            Placement {
+                material: GLASS,
+                node: ROOT_NODE,
+                origin: DVec3::ZERO,
+            },
         ));
     }
     door(&o, r, &mut parts);
@@ -172,9 +174,11 @@ fn door(o: &Openings, r: f64, parts: &mut Vec<Surface>) {
         [false, true, true, true],
         Kind::Shell(SHELL),
         r,
-        PAINT,
-        DOOR_NODE_INDEX,
-        hinge,
+        Placement {
+            material: PAINT,
+            node: DOOR_NODE_INDEX,
+            origin: hinge,
+        },
     ));
     parts.push(body_patch(
         (du.0, PI - o.belt),
@@ -182,9 +186,11 @@ fn door(o: &Openings, r: f64, parts: &mut Vec<Surface>) {
         [true; 4],
         Kind::Sheet,
         r,
-        GLASS,
-        DOOR_WINDOW_NODE_INDEX,
-        hinge,
+        Placement {
+            material: GLASS,
+            node: DOOR_WINDOW_NODE_INDEX,
+            origin: hinge,
+        },
     ));
 }
 

@@ -258,19 +258,30 @@ pub(super) fn param_gap(
     GAP / min_speed
 }
 
+/// What a part is drawn with and where it moves: its material, its node, and the origin of
+/// that node's local space in car coordinates ([`Surface`]'s fields of the same names).
+#[derive(Clone, Copy)]
+pub(super) struct Placement {
+    pub(super) material: u32,
+    pub(super) node: u32,
+    pub(super) origin: DVec3,
+}
+
 /// A rectangular patch of the body surface (θ range `u`, station range `v`), shrunk by the
 /// gap on the sides listed in `gaps` (θ low, θ high, s low, s high).
-#[allow(clippy::too_many_arguments)]
 pub(super) fn body_patch(
     u: (f64, f64),
     v: (f64, f64),
     gaps: [bool; 4],
     kind: Kind,
     density: f64,
-    material: u32,
-    node: u32,
-    origin: DVec3,
+    place: Placement,
 ) -> Surface {
+    let Placement {
+        material,
+        node,
+        origin,
+    } = place;
     let inset = if matches!(kind, Kind::Sheet) {
         0.5 * SHELL
     } else {

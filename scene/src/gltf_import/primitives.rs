@@ -19,6 +19,14 @@ use crate::SceneError;
 /// note per kind.
 type Skipped = BTreeMap<&'static str, Vec<String>>;
 
+/// A primitive's normals (`None`: the file has none), its two texture coordinate sets and its
+/// tangents, as [`PrimitiveData`] holds them.
+type Attributes = (
+    Option<Vec<[f32; 3]>>,
+    [Option<Vec<[f32; 2]>>; 2],
+    Option<Vec<[f32; 4]>>,
+);
+
 /// The triangles of one mesh primitive, read once and instanced per node: one vertex per
 /// file vertex, or, for a primitive without normals, three vertices per triangle carrying its
 /// face normal.
@@ -193,6 +201,38 @@ impl Importer<'_> {
             });
         }
         let n = positions.len();
+        let (normals, uvs, tangents) = self.read_attributes(prim, &where_, n, needs)?;
+        let triangles = self.read_triangles(prim, &where_, n)?;
+        let zero_area = triangles
+            .iter()
+            .filter(|t| is_zero_area(&positions, t))
+            .count() as u64;
+        let mut data = match normals {
+            Some(normals) => PrimitiveData {
+                positions,
+                normals,
+                uvs,
+                tangents,
+                triangles,
+                zero_area,
+                material,
+            },
+            None => flat(positions, uvs, tangents, &triangles, zero_area, material),
+        };
+        self.complete_tangents(&mut data, needs, &where_);
+        Ok(Some(data))
+    }
+
+    /// The normals (where the file has them), the texture coordinate sets a material of the
+    /// primitive samples and its tangents (where it has a normal texture and the file has
+    /// them) of a primitive of `n` vertices; each must have `n` elements.
+    fn read_attributes(
+        &mut self,
+        prim: &gltf::Primitive,
+        where_: &str,
+        n: usize,
+        needs: Needs,
+    ) -> Result<Attributes, SceneError> {
         let count_mismatch = |acc: &gltf::Accessor, what: &str, got: usize| SceneError::Accessor {
             file: self.file.clone(),
             accessor: acc.index(),
@@ -244,6 +284,17 @@ impl Importer<'_> {
             }
             _ => None,
         };
+        Ok((normals, uvs, tangents))
+    }
+
+    /// The triangles of a primitive of `n` vertices: its indices (or `0..n`), each in range,
+    /// grouped by its mode (a count not a multiple of 3 drops the rest, with a note).
+    fn read_triangles(
+        &mut self,
+        prim: &gltf::Primitive,
+        where_: &str,
+        n: usize,
+    ) -> Result<Vec<[u32; 3]>, SceneError> {
         let indices: Vec<u32> = match prim.indices() {
             Some(acc) => {
                 let usage = format!("{where_} indices");
@@ -281,28 +332,18 @@ impl Importer<'_> {
             Mode::TriangleFan => fan_triangles(&indices),
             _ => Vec::new(),
         };
-        let zero_area = triangles
-            .iter()
-            .filter(|t| is_zero_area(&positions, t))
-            .count() as u64;
-        let mut data = match normals {
-            Some(normals) => PrimitiveData {
-                positions,
-                normals,
-                uvs,
-                tangents,
-                triangles,
-                zero_area,
-                material,
-            },
-            None => flat(positions, uvs, tangents, &triangles, zero_area, material),
-        };
+        Ok(triangles)
+    }
+
+    /// Generates MikkTSpace tangents where a normal texture needs them and the file has none;
+    /// without the texture coordinates it samples they stay zero, with a note.
+    fn complete_tangents(&mut self, data: &mut PrimitiveData, needs: Needs, where_: &str) {
         if let (Some(set), None) = (needs.tangent_set, &data.tangents) {
             match &data.uvs[set as usize] {
                 Some(uvs) => {
                     let corners =
                         tangents::generate(&data.positions, &data.normals, uvs, &data.triangles);
-                    weld(&mut data, &corners);
+                    weld(data, &corners);
                 }
                 None => self.notes.push(format!(
                     "{where_}: its normal texture samples TEXCOORD_{set}, which it lacks, and it \
@@ -310,7 +351,6 @@ impl Importer<'_> {
                 )),
             }
         }
-        Ok(Some(data))
     }
 }
 
