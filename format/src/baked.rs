@@ -215,9 +215,9 @@ impl Baked {
             }
         }
         // Per-frame work is bounded by what a merge can produce: a merge draws each copy at
-        // most once per frame, in at most one draw per copy (issue 28: a 4 MB file of 200,000
-        // draws of the whole buffer per frame held the player for minutes). Prefix sums keep
-        // this O(draws + frames) however the windows overlap.
+        // most once per frame, in at most one draw per copy (without this bound a 4 MB file of
+        // 200,000 draws of the whole buffer per frame holds the player for minutes). Prefix
+        // sums keep this O(draws + frames) however the windows overlap.
         let mut drawn = Vec::with_capacity(self.draws.len() + 1);
         drawn.push(0u64);
         for d in &self.draws {

@@ -139,9 +139,10 @@ macro_rules! option_enum {
 pub(crate) use option_enum;
 
 option_enum! {
-    /// The order of L = (i, j−1), I = (i, j) and B = (i+1, j) in every window (paper §5.1;
-    /// DESIGN § Merger, Strategies). The default (`Lib`, the first) only fills a
-    /// [`crate::MergeInfo::default`]; the merge's default is [`Choice::Auto`].
+    /// The order of L = (i, j−1), I = (i, j) and B = (i+1, j) in every window (paper §5.1).
+    /// Every order gives a valid index buffer, but of another size, so the merge's default,
+    /// [`Choice::Auto`], tries them all; the default here (`Lib`, the first) only fills a
+    /// [`crate::MergeInfo::default`].
     pub enum Strategy: "strategy" {
         /// L, then I, then B: rows top to bottom, each row left to right.
         #[default]
@@ -177,7 +178,8 @@ option_enum! {
 }
 
 option_enum! {
-    /// Where a copy may span frames in which its triangle is not visible (DESIGN rule 2).
+    /// Where a copy may span frames in which its triangle is not visible (the validator's
+    /// rule 2, `trisort_verify`).
     ///
     /// A copy always starts and ends at frames where its triangle is visible; this decides
     /// what the frames between may be.
@@ -192,9 +194,9 @@ option_enum! {
         Ignored = "ignored", "Copies may span only frames where the triangle has no fragment";
         /// None: a copy spans only frames where its triangle is visible, so every frame draws
         /// exactly its V_f (no drawn-not-visible triangle, the `source` lower bound in
-        /// triangles) at the price of more copies. The default since issue 7's benchmarks: on
-        /// the demo car merged / source frame time fell from 1.31 to 1.06 for 26 % more copies
-        /// (BENCHMARKS.md).
+        /// triangles) at the price of more copies. The default: drawing fewer triangles per frame
+        /// outweighs the extra copies (on the demo car, merged / source frame time 1.06 against
+        /// 1.31 for `hidden`, for 26 % more copies; BENCHMARKS.md).
         #[default]
         Visible = "visible",
             "Copies span only frames where the triangle is visible: every frame draws exactly \

@@ -1,4 +1,4 @@
-//! glTF as real pipelines deliver it (issue 17, part 2): CarConcept packed at test time (never
+//! glTF as real pipelines deliver it: CarConcept packed at test time (never
 //! committed) by gltfpack — quantized (`KHR_mesh_quantization`), meshopt-compressed
 //! (`EXT_meshopt_compression`, `-c`/`-cc`), with named nodes kept (`-kn`) — and by
 //! gltf-pipeline — Draco-compressed (`KHR_draco_mesh_compression`, `-d`) — imports; a file

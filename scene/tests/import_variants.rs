@@ -1,4 +1,4 @@
-//! `KHR_materials_variants` tables (issue 17, part 3): per variant, the material each slot
+//! `KHR_materials_variants` tables: per variant, the material each slot
 //! shows; primitives that share a material but map it differently get slots of their own;
 //! mappings naming what the file lacks are left out with a note, never an error.
 

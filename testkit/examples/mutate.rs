@@ -1,4 +1,4 @@
-//! The mutator of the mutation fuzz (`scripts/mutation-fuzz.sh`, issue 28): writes one mutant
+//! The mutator of the mutation fuzz (`scripts/mutation-fuzz.sh`): writes one mutant
 //! of a recording or baked file, chosen by a seed, for the real binary to be run on.
 //!
 //! `cargo run --release -p trisort-testkit --example mutate -- KIND IN OUT SEED` with KIND

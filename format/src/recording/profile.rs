@@ -67,7 +67,8 @@ option_enum! {
         Snap4 = "snap4",
             "as conformant, but corners snapped to 4 to 8 sub-pixel bits (the API minimum)";
         /// SwiftShader (Chromium's WebGL2 without a GPU): corners snapped to 4 to 8 bits and a
-        /// sample's depth taken anywhere in its pixel, ±1/8 px (the default before profiles).
+        /// sample's depth taken anywhere in its pixel, ±1/8 px (what SwiftShader was measured to
+        /// need: BENCHMARKS.md § Exactness across rasterizers).
         Browser = "browser",
             "SwiftShader's rules (the web build): 4 to 8 bits, depth anywhere in the pixel, 1/8 px";
     }
@@ -205,7 +206,7 @@ impl Robust {
     /// The `snap4` profile's tolerance: the conformant one (a 4-bit snap adds 1/32 px).
     pub const SNAP4_TOLERANCE: f32 = Robust::CONFORMANT_TOLERANCE;
     /// The `browser` profile's tolerance, 3/32 px: with a 4-bit snap (1/32 px) a sample's box
-    /// is ±1/8 px, the default before raster profiles, measured with no hole in SwiftShader
+    /// is ±1/8 px, measured with no hole in SwiftShader
     /// (BENCHMARKS § Exactness across rasterizers).
     pub const BROWSER_TOLERANCE: f32 = 3.0 / 32.0;
 
@@ -326,7 +327,7 @@ mod tests {
             ),
             (4, 8, DepthAt::Pixel)
         );
-        // The browser box is the old default's ±1/8 px: its tolerance and a 4-bit snap.
+        // The browser box is ±1/8 px: its tolerance and a 4-bit snap.
         assert_eq!(b.tolerance + 0.5 / 16.0, 0.125);
         assert_eq!("snap4".parse::<ProfileName>(), Ok(ProfileName::Snap4));
         assert!("swiftshader".parse::<ProfileName>().is_err());
