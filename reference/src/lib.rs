@@ -22,8 +22,10 @@ pub mod compare;
 pub mod default_pipeline;
 pub mod deploy;
 pub mod exact;
+pub mod frames;
 pub mod oit;
 pub mod peeling;
+pub mod report;
 mod target;
 pub mod verify;
 

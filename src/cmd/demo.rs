@@ -113,16 +113,15 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     )?;
     let play_s = t_play.elapsed().as_secs_f64();
     let t_images = Instant::now();
-    let images = crate::cmd::verify::verify_images(
-        &gpu,
-        &baked,
-        &scene.geometry,
-        trisort_reference::ImageCheck::recorded(&baked, trisort_player::Mode::Blend),
-        std::slice::from_ref(&rec),
-        0..baked.frames.len() as u32,
-        crate::cmd::verify::Frames::Play,
-        |_| Ok(()),
-    )?;
+    let what = trisort_reference::frames::FramesToVerify {
+        baked: &baked,
+        geometry: &scene.geometry,
+        check: trisort_reference::ImageCheck::recorded(&baked, trisort_player::Mode::Blend),
+        recordings: std::slice::from_ref(&rec),
+        frames: 0..baked.frames.len() as u32,
+        source: trisort_reference::frames::Frames::Play,
+    };
+    let images = trisort_reference::frames::verify_images(&gpu, what, |_| Ok(()))?;
     let images_s = t_images.elapsed().as_secs_f64();
     let s = &baked.stats;
     let gpu_ms: Vec<f64> = played.iter().filter_map(|f| f.gpu_ms).collect();

@@ -162,18 +162,9 @@ pub struct PlayedPath {
 
 /// Writes a frame as PNG atomically.
 pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
-    let mut bytes = Vec::new();
-    image::write_buffer_with_format(
-        &mut std::io::Cursor::new(&mut bytes),
-        rgba8,
-        width,
-        height,
-        image::ExtendedColorType::Rgba8,
-        image::ImageFormat::Png,
-    )
-    .with_context(|| format!("encoding {}", path.display()))?;
-    trisort_format::container::write_bytes_atomic(path, &bytes)?;
-    Ok(())
+    Ok(trisort_reference::frames::write_png(
+        path, width, height, rgba8,
+    )?)
 }
 
 /// Renders frames of a baked file, optionally writing PNGs; prints the player's warnings.

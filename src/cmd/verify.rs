@@ -14,22 +14,21 @@
 //! was verified and exits 4 unless `--allow-unverified` is given. The error of an 8-bit sRGB
 //! deployment target is reported separately (`srgb8`) and never gated on.
 
-use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::{json, Value};
-use trisort_format::{Baked, Geometry, RecordSettings, Recording};
+use trisort_format::{Baked, RecordSettings, Recording};
 use trisort_gpu::{Gpu, GpuOptions};
 use trisort_player::headless::{HeadlessConfig, HeadlessRenderer};
 use trisort_player::Mode;
-use trisort_reference::compare::{difference_image, mask_image};
-use trisort_reference::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
+use trisort_reference::frames::{verify_images, write_diff, Frames, FramesToVerify, ImageReport};
+use trisort_reference::report::{json_report, text_report};
+use trisort_reference::ImageCheck;
 
 use crate::cmd::merge::read_recordings;
-use crate::cmd::play::write_png;
 use crate::common::{load_scene, parse_range, parse_size, print_json, FrameRange};
 use trisort_bake::working_scene;
 
@@ -119,19 +118,6 @@ pub struct VerifyArgs {
     device: crate::cmd::play::DeviceArgs,
 }
 
-/// Image verification of a range of frames.
-pub struct ImageReport {
-    /// Whether every frame passed.
-    pub ok: bool,
-    /// Whether the check ran at the recorded pattern.
-    pub at_recorded_pattern: bool,
-    /// Whether the frames were played here on a device other than the one the recording (or
-    /// the file) names (checked all the same at the recorded pattern).
-    pub on_other_device: bool,
-    /// Per frame.
-    pub frames: Vec<FrameImageReport>,
-}
-
 /// Checks the scene against the file's scene hash: the reference must render the scene the
 /// file was baked from.
 pub fn check_scene(baked: &Baked, scene: &trisort_scene::Scene, spec: &str) -> Result<()> {
@@ -144,82 +130,6 @@ pub fn check_scene(baked: &Baked, scene: &trisort_scene::Scene, spec: &str) -> R
         );
     }
     Ok(())
-}
-
-/// Verifies `frames` of `baked` against the exact reference of `geometry`, calling `each`
-/// with every verified frame (for difference images and progress). `recordings` (may be
-/// empty) decide which pixels may be unordered and give the reference its path and pattern;
-/// `captured` is a directory of frames drawn elsewhere to check instead of playing them
-/// (`check.captured` must then be set).
-#[allow(clippy::too_many_arguments)]
-pub fn verify_images(
-    gpu: &Gpu,
-    baked: &Baked,
-    geometry: &Geometry,
-    check: ImageCheck,
-    recordings: &[Recording],
-    frames: Range<u32>,
-    captured: Frames<'_>,
-    mut each: impl FnMut(&VerifiedFrame) -> Result<()>,
-) -> Result<ImageReport> {
-    let verifier = ImageVerifier::new(gpu, baked, geometry, check, recordings)?;
-    let mut report = ImageReport {
-        ok: true,
-        at_recorded_pattern: verifier.at_recorded_pattern(),
-        on_other_device: verifier.on_other_device(),
-        frames: Vec::with_capacity(frames.len()),
-    };
-    for f in frames {
-        let v = match captured {
-            Frames::Play => verifier.verify(f),
-            Frames::Dir(dir) => verifier.verify_captured(f, read_captured(dir, f, check.size)?),
-            Frames::Elsewhere(player) => verifier.verify_captured(f, player.render(f)?.rgba8),
-        }
-        .with_context(|| format!("verifying frame {f}"))?;
-        each(&v)?;
-        report.ok &= v.report.ok;
-        report.frames.push(v.report);
-    }
-    Ok(report)
-}
-
-/// Frame `f` as drawn elsewhere: `DIR/frame-NNNNN.png` (the name `play --out-dir` gives it),
-/// which must be `size`, as RGBA8. A missing, unreadable or wrong-size file is an error
-/// naming it.
-fn read_captured(dir: &Path, f: u32, size: (u32, u32)) -> Result<Vec<u8>> {
-    let path = dir.join(format!("frame-{f:05}.png"));
-    if !path.is_file() {
-        bail!(
-            "{}: frame {f} is missing (--frames-dir holds one PNG per checked frame, named frame-NNNNN.png as play --out-dir writes them)",
-            path.display()
-        );
-    }
-    let image = image::open(&path)
-        .with_context(|| format!("{}: not a readable image", path.display()))?
-        .to_rgba8();
-    if image.dimensions() != size {
-        bail!(
-            "{}: the image is {}x{}, the frames are checked at {}x{} (the recorded size, or --size)",
-            path.display(),
-            image.width(),
-            image.height(),
-            size.0,
-            size.1
-        );
-    }
-    Ok(image.into_raw())
-}
-
-/// Where the checked frames come from.
-#[derive(Clone, Copy)]
-pub enum Frames<'a> {
-    /// Played here by the player on the verifying device.
-    Play,
-    /// Drawn elsewhere: PNGs in a directory (`--frames-dir`).
-    Dir(&'a Path),
-    /// Played on another device (`--backend`/`--limits`), one frame at a time as it is
-    /// checked.
-    Elsewhere(&'a HeadlessRenderer<'a>),
 }
 
 /// `--backend`/`--limits` other than the defaults: the device the frames are played on before
@@ -261,28 +171,6 @@ fn elsewhere_player<'g>(
         );
     }
     Ok(player)
-}
-
-fn write_diff(dir: &Path, v: &VerifiedFrame, size: (u32, u32)) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let f = v.report.frame;
-    let (w, h) = size;
-    let r = &v.reference;
-    write_png(&dir.join(format!("{f:05}-player.png")), w, h, &v.player)?;
-    write_png(&dir.join(format!("{f:05}-reference.png")), w, h, &r.rgba8)?;
-    write_png(
-        &dir.join(format!("{f:05}-diff.png")),
-        w,
-        h,
-        &difference_image(&v.player, &r.rgba8, &r.unordered),
-    )?;
-    write_png(
-        &dir.join(format!("{f:05}-unordered.png")),
-        w,
-        h,
-        &mask_image(&r.unordered),
-    )?;
-    Ok(())
 }
 
 pub fn run(a: VerifyArgs) -> Result<ExitCode> {
@@ -364,7 +252,10 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         }
         print_json(&v);
     } else {
-        print_report(&a.baked, graph.as_ref(), images.as_ref(), a.measure_only);
+        print!(
+            "{}",
+            text_report(&a.baked, graph.as_ref(), images.as_ref(), a.measure_only)
+        );
         let name = &baked.environment.name;
         match (&environment, &a.environment) {
             (Some(Some(what)), Some(spec)) => {
@@ -499,182 +390,17 @@ fn image_check(
         (None, Some(player)) => Frames::Elsewhere(player),
         (None, None) => Frames::Play,
     };
-    let report = verify_images(&gpu, baked, geometry, check, recs, range, captured, |v| {
-        if let Some(dir) = &a.diff_dir {
-            if a.diff_all || !v.report.ok {
-                write_diff(dir, v, size)?;
-            }
-        }
-        Ok(())
+    let what = FramesToVerify {
+        baked,
+        geometry,
+        check,
+        recordings: recs,
+        frames: range,
+        source: captured,
+    };
+    let report = verify_images(&gpu, what, |v| match &a.diff_dir {
+        Some(dir) if a.diff_all || !v.report.ok => write_diff(dir, v, size),
+        _ => Ok(()),
     })?;
     Ok((report, check))
-}
-
-fn json_report(
-    ok: bool,
-    graph: Option<&trisort_verify::GraphReport>,
-    images: Option<&(ImageReport, ImageCheck)>,
-) -> Value {
-    let graph_frame = |f: u32| graph.and_then(|g| g.frames.iter().find(|r| r.frame == f));
-    let frames: Vec<Value> = match images {
-        Some((report, _)) => report
-            .frames
-            .iter()
-            .map(|fr| {
-                let mut v = serde_json::to_value(fr).expect("report serializes");
-                if let Some(g) = graph_frame(fr.frame) {
-                    v["graph_violations"] = json!(g.graph_violations);
-                    v["graph"] = serde_json::to_value(g).expect("report serializes");
-                }
-                v
-            })
-            .collect(),
-        None => graph
-            .map(|g| {
-                g.frames
-                    .iter()
-                    .map(|f| serde_json::to_value(f).expect("report serializes"))
-                    .collect()
-            })
-            .unwrap_or_default(),
-    };
-    let mut out = json!({ "ok": ok, "frames": frames });
-    if let Some(g) = graph {
-        out["graph_ok"] = json!(g.ok);
-        out["problems"] = json!(g.problems);
-        out["bad_copies"] = json!(g.bad_copies);
-        out["depth_only"] = json!(g.depth_only);
-        out["bridge"] = json!({ "claimed": g.bridge_claimed, "derived": g.bridge_derived });
-    }
-    if let Some((report, check)) = images {
-        out["images_ok"] = json!(report.ok);
-        out["mode"] = json!(check.mode.name());
-        out["shading"] = json!(check.shading.name());
-        out["tonemap"] = json!(check.tone_map.name());
-        out["size"] = json!([check.size.0, check.size.1]);
-        out["samples"] = json!(check.samples);
-        out["at_recorded_pattern"] = json!(report.at_recorded_pattern);
-        out["played_on_recording_device"] = json!(!report.on_other_device);
-        out["max_error"] = json!(check.max_error);
-        out["captured"] = json!(check.captured);
-        out["subpixel_offset"] = json!(check.subpixel_offset);
-        out["unordered_from_recording"] = json!(graph.is_some());
-    }
-    out
-}
-
-fn print_report(
-    baked: &Path,
-    graph: Option<&trisort_verify::GraphReport>,
-    images: Option<&(ImageReport, ImageCheck)>,
-    measure_only: bool,
-) {
-    if let Some(report) = graph {
-        let bad: Vec<_> = report.frames.iter().filter(|f| !f.ok()).collect();
-        println!(
-            "graph rules: {} ({} frames checked, {} with problems, {} unordered samples)",
-            if report.ok { "OK" } else { "FAILED" },
-            report.frames.len(),
-            bad.len(),
-            report
-                .frames
-                .iter()
-                .map(|f| f.unordered_samples)
-                .sum::<u64>()
-        );
-        println!(
-            "  order checked against: {}",
-            match (report.checked, report.depth_only) {
-                ("depth", _) => "the edges depth mode needs (a depth-only file, checked for --mode depth: ties, and edges behind translucent fragments)",
-                (_, true) => "every edge of E_f (a depth-only file checked for blend: it plays right only in depth mode; --mode depth checks it for that)",
-                _ => "every edge of E_f",
-            }
-        );
-        println!(
-            "  bridge: the file claims {}, its draws need {}",
-            report.bridge_claimed, report.bridge_derived
-        );
-        for p in &report.problems {
-            println!("  {p}");
-        }
-        for f in bad.iter().take(20) {
-            println!("  frame {}: {:?}", f.frame, f);
-        }
-    }
-    if let Some((report, check)) = images {
-        let bad = report.frames.iter().filter(|f| !f.ok).count();
-        println!(
-            "{} of {} ({} mode, {}x{}, {}x MSAA, {}): {} ({} frames checked, {} failing)",
-            if check.captured {
-                "captured frames"
-            } else {
-                "images"
-            },
-            baked.display(),
-            check.mode,
-            check.size.0,
-            check.size.1,
-            check.samples,
-            if measure_only {
-                "measured only: NOTHING VERIFIED, no frame can fail".to_string()
-            } else if report.at_recorded_pattern && report.on_other_device {
-                "recorded pattern, played on another device than recorded: checked all the same"
-                    .to_string()
-            } else if report.at_recorded_pattern {
-                "recorded pattern".to_string()
-            } else {
-                format!(
-                    "off the recorded pattern, max error {}/255",
-                    check.max_error.unwrap_or(0)
-                )
-            },
-            if measure_only {
-                "measured"
-            } else if report.ok {
-                "OK"
-            } else {
-                "FAILED"
-            },
-            report.frames.len(),
-            if measure_only { 0 } else { bad }
-        );
-        println!(
-            "  holes: differing pixels where the reference's nearest fragment is of a triangle the file does not draw; order: other differing ordered pixels"
-        );
-        println!(
-            "  unordered (excused) pixels: {}",
-            if graph.is_some() {
-                "those with a sample on a cycle of the recording's E_f"
-            } else {
-                "none (no --recording)"
-            }
-        );
-        println!(
-            "  frame  ok  differing  ordered  max  max_ord  psnr   flip     unordered  holes  order  srgb8_max"
-        );
-        for f in &report.frames {
-            let c = &f.comparison;
-            println!(
-                "  {:5}  {:3} {:9}  {:7}  {:3}  {:7}  {:5.1}  {:.5}  {:9}  {:5}  {:5}  {}",
-                f.frame,
-                match (measure_only, f.ok) {
-                    (true, _) => "-",
-                    (false, true) => "yes",
-                    (false, false) => "NO",
-                },
-                c.pixels_differing,
-                c.pixels_differing_ordered,
-                c.max_channel_diff,
-                c.max_channel_diff_ordered,
-                c.psnr,
-                c.flip_mean,
-                f.unordered_samples,
-                f.hole_pixels,
-                f.order_error_pixels,
-                f.srgb8
-                    .map(|s| s.max_channel_diff.to_string())
-                    .unwrap_or_else(|| "-".into())
-            );
-        }
-    }
 }

@@ -1,0 +1,191 @@
+//! Image verification of a range of frames: each frame played here, read from PNGs drawn
+//! elsewhere, or played on another device, checked against the exact reference
+//! ([`ImageVerifier`]), with difference images for the frames that fail.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use trisort_format::{Baked, Geometry, Recording};
+use trisort_gpu::Gpu;
+use trisort_player::headless::HeadlessRenderer;
+
+use crate::compare::{difference_image, mask_image};
+use crate::{FrameImageReport, ImageCheck, ImageVerifier, ReferenceError, VerifiedFrame};
+
+/// Why a range of frames could not be verified (a frame that is wrong is not an error: its
+/// report says so).
+#[derive(Debug, thiserror::Error)]
+pub enum FramesError {
+    /// The verifier could not be built.
+    #[error(transparent)]
+    Reference(#[from] ReferenceError),
+    /// A frame could not be played, rendered or compared.
+    #[error("verifying frame {frame}: {source}")]
+    Frame {
+        /// The frame.
+        frame: u32,
+        /// Why.
+        source: ReferenceError,
+    },
+    /// A frame drawn elsewhere is missing, unreadable or of the wrong size.
+    #[error("{}: {problem}", .path.display())]
+    Captured {
+        /// The PNG.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// The other device's player failed.
+    #[error(transparent)]
+    Player(#[from] trisort_player::PlayerError),
+    /// Writing an image failed.
+    #[error("{}: {problem}", .path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// What failed.
+        problem: String,
+    },
+}
+
+/// Image verification of a range of frames.
+pub struct ImageReport {
+    /// Whether every frame passed.
+    pub ok: bool,
+    /// Whether the check ran at the recorded pattern.
+    pub at_recorded_pattern: bool,
+    /// Whether the frames were played here on a device other than the one the recording (or
+    /// the file) names (checked all the same at the recorded pattern).
+    pub on_other_device: bool,
+    /// Per frame.
+    pub frames: Vec<FrameImageReport>,
+}
+
+/// Where the checked frames come from.
+#[derive(Clone, Copy)]
+pub enum Frames<'a> {
+    /// Played here by the player on the verifying device.
+    Play,
+    /// Drawn elsewhere: PNGs in a directory (`--frames-dir`).
+    Dir(&'a Path),
+    /// Played on another device (`--backend`/`--limits`), one frame at a time as it is
+    /// checked.
+    Elsewhere(&'a HeadlessRenderer<'a>),
+}
+
+/// What [`verify_images`] checks: the file, the full scene's geometry its reference renders,
+/// the recordings that decide which pixels may be unordered (may be empty: then none), the
+/// frames and where they come from.
+pub struct FramesToVerify<'a> {
+    /// The baked file.
+    pub baked: &'a Baked,
+    /// The scene as recorded (split where the recording split it).
+    pub geometry: &'a Geometry,
+    /// Size, samples, mode, tolerance.
+    pub check: ImageCheck,
+    /// The recordings: their cycles excuse pixels, and they give the reference its path.
+    pub recordings: &'a [Recording],
+    /// The frames checked.
+    pub frames: Range<u32>,
+    /// Where they come from (`check.captured` must be set unless [`Frames::Play`]).
+    pub source: Frames<'a>,
+}
+
+/// Verifies the frames `what` names against the exact reference, calling `each` with every
+/// verified frame (for difference images and progress).
+pub fn verify_images(
+    gpu: &Gpu,
+    what: FramesToVerify<'_>,
+    mut each: impl FnMut(&VerifiedFrame) -> Result<(), FramesError>,
+) -> Result<ImageReport, FramesError> {
+    let check = what.check;
+    let verifier = ImageVerifier::new(gpu, what.baked, what.geometry, check, what.recordings)?;
+    let mut report = ImageReport {
+        ok: true,
+        at_recorded_pattern: verifier.at_recorded_pattern(),
+        on_other_device: verifier.on_other_device(),
+        frames: Vec::with_capacity(what.frames.len()),
+    };
+    for f in what.frames {
+        let v = match what.source {
+            Frames::Play => verifier.verify(f),
+            Frames::Dir(dir) => verifier.verify_captured(f, read_captured(dir, f, check.size)?),
+            Frames::Elsewhere(player) => player
+                .render(f)
+                .map_err(ReferenceError::from)
+                .and_then(|r| verifier.verify_captured(f, r.rgba8)),
+        }
+        .map_err(|source| FramesError::Frame { frame: f, source })?;
+        each(&v)?;
+        report.ok &= v.report.ok;
+        report.frames.push(v.report);
+    }
+    Ok(report)
+}
+
+/// Frame `f` as drawn elsewhere: `DIR/frame-NNNNN.png` (the name `play --out-dir` gives it),
+/// which must be `size`, as RGBA8. A missing, unreadable or wrong-size file is an error
+/// naming it.
+fn read_captured(dir: &Path, f: u32, size: (u32, u32)) -> Result<Vec<u8>, FramesError> {
+    let path = dir.join(format!("frame-{f:05}.png"));
+    let captured = |problem: String| FramesError::Captured {
+        path: path.clone(),
+        problem,
+    };
+    if !path.is_file() {
+        return Err(captured(format!(
+            "frame {f} is missing (--frames-dir holds one PNG per checked frame, named \
+             frame-NNNNN.png as play --out-dir writes them)"
+        )));
+    }
+    let image = image::open(&path)
+        .map_err(|e| captured(format!("not a readable image: {e}")))?
+        .to_rgba8();
+    if image.dimensions() != size {
+        return Err(captured(format!(
+            "the image is {}x{}, the frames are checked at {}x{} (the recorded size, or --size)",
+            image.width(),
+            image.height(),
+            size.0,
+            size.1
+        )));
+    }
+    Ok(image.into_raw())
+}
+
+/// Writes an RGBA8 image as PNG atomically.
+pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<(), FramesError> {
+    let write = |problem: String| FramesError::Write {
+        path: path.to_path_buf(),
+        problem,
+    };
+    let mut bytes = Vec::new();
+    image::write_buffer_with_format(
+        &mut std::io::Cursor::new(&mut bytes),
+        rgba8,
+        width,
+        height,
+        image::ExtendedColorType::Rgba8,
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| write(format!("encoding: {e}")))?;
+    trisort_format::container::write_bytes_atomic(path, &bytes).map_err(|e| write(e.to_string()))
+}
+
+/// Writes frame `v`'s player image, reference image, difference and unordered mask as
+/// `NNNNN-player.png`, `-reference.png`, `-diff.png` and `-unordered.png` into `dir`.
+pub fn write_diff(dir: &Path, v: &VerifiedFrame, size: (u32, u32)) -> Result<(), FramesError> {
+    std::fs::create_dir_all(dir).map_err(|e| FramesError::Write {
+        path: dir.to_path_buf(),
+        problem: format!("creating: {e}"),
+    })?;
+    let f = v.report.frame;
+    let (w, h) = size;
+    let r = &v.reference;
+    write_png(&dir.join(format!("{f:05}-player.png")), w, h, &v.player)?;
+    write_png(&dir.join(format!("{f:05}-reference.png")), w, h, &r.rgba8)?;
+    let diff = difference_image(&v.player, &r.rgba8, &r.unordered);
+    write_png(&dir.join(format!("{f:05}-diff.png")), w, h, &diff)?;
+    let mask = mask_image(&r.unordered);
+    write_png(&dir.join(format!("{f:05}-unordered.png")), w, h, &mask)
+}
