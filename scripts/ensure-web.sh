@@ -1,15 +1,20 @@
 #!/usr/bin/env bash
 # Makes sure the web player can be built and tested: the wasm32 target, the wasm-bindgen CLI
 # of the version web/Cargo.toml pins (from crates.io), and, with --browser, Debian's Chromium
-# and Node.js/npm (for playwright-core). Installs what is missing.
+# and Node.js/npm (for playwright-core). Installs what is missing. `--browser-only` installs
+# just the browser side (no compiling: .ci/run runs it beside the lint).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 want=$(sed -n 's/^wasm-bindgen = "=\([0-9.]*\)".*/\1/p' web/Cargo.toml)
-if ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown; then
+browser_only=0
+if [ "${1:-}" = "--browser-only" ]; then
+  browser_only=1
+  set -- --browser
+elif ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown; then
   echo "trisort: installing the wasm32-unknown-unknown target" >&2
   rustup target add wasm32-unknown-unknown
 fi
-if [ "$(wasm-bindgen --version 2>/dev/null | awk '{print $2}')" != "$want" ]; then
+if [ "$browser_only" = 0 ] && [ "$(wasm-bindgen --version 2>/dev/null | awk '{print $2}')" != "$want" ]; then
   echo "trisort: installing wasm-bindgen-cli $want from crates.io (a few minutes, once)" >&2
   cargo install --quiet wasm-bindgen-cli --version "=$want"
 fi
