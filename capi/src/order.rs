@@ -1,97 +1,28 @@
-//! The ORDER file: trisort's sorted triangle list named by glTF source triangles.
+//! Building the ORDER file of a baked file (docs/FORMAT.md § ORDER).
 //!
-//! Layout (little endian, no compression; docs/FORMAT.md § ORDER is the specification):
-//!
-//! | bytes | field |
-//! |---|---|
-//! | 8 | magic `TRISORD\0` |
-//! | 4 | version ([`ORDER_VERSION`]) |
-//! | 4 | flags: bit 0 set when the bake split intersecting triangles ([`Order::split`]) |
-//! | 32 | the baked file's scene hash |
-//! | 4 | frame count F |
-//! | 4 | range count R |
-//! | 4 | triangle count T |
-//! | 4 | reserved, 0 |
-//! | 8·F | per frame: first range, range count |
-//! | 8·R | per range, front to back: first triangle, triangle count |
-//! | 16·T | per index-buffer triangle, front to back: mesh, primitive, triangle, node |
-//!
-//! The file is exactly that long; readers refuse anything else.
+//! The file format itself (types, reading, writing, checking) is
+//! [`trisort_format::order`], re-exported here. Building an order needs the glTF importer:
+//! the baked file names its triangles by scene id, and which glTF triangle a scene id is
+//! follows from the importer's documented id order, so the scene file is read again.
 
 use std::path::{Path, PathBuf};
 
-use trisort_format::{Baked, Hash};
+use trisort_format::{Baked, FormatError, Hash};
 use trisort_scene::TriangleSource;
 
-/// The ORDER file's magic bytes.
-pub const ORDER_MAGIC: &[u8; 8] = b"TRISORD\0";
-/// The ORDER file version this build writes and reads.
-pub const ORDER_VERSION: u32 = 1;
-const HEADER_LEN: usize = 8 + 4 + 4 + 32 + 4 * 4;
+pub use trisort_format::order::{
+    Order, OrderError, OrderRange, OrderSource, ORDER_MAGIC, ORDER_VERSION,
+};
 
-/// One run of consecutive index-buffer triangles drawn by one call.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct OrderRange {
-    /// First triangle (multiply by 3 for the first index).
-    pub first: u32,
-    /// Number of triangles.
-    pub count: u32,
-}
-
-/// Where one index-buffer triangle comes from in the glTF file (all indices of the file).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct OrderSource {
-    /// Mesh index.
-    pub mesh: u32,
-    /// Primitive index within the mesh.
-    pub primitive: u32,
-    /// Triangle index within the primitive (its indices `3t, 3t+1, 3t+2` for a triangle
-    /// list; strips and fans as the glTF specification derives them).
-    pub triangle: u32,
-    /// Node index (the instance of the mesh: its world transform moves the triangle).
-    pub node: u32,
-}
-
-/// An order-only export of a baked file.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Order {
-    /// Whether the bake split intersecting triangles: consecutive entries of a range can then
-    /// name the same source triangle (its pieces), see docs/FORMAT.md § ORDER.
-    pub split: bool,
-    /// The baked file's scene hash.
-    pub scene_hash: Hash,
-    /// Per frame, its window in `ranges`.
-    pub frames: Vec<OrderRange>,
-    /// Draw ranges over `triangles`, front to back within each frame.
-    pub ranges: Vec<OrderRange>,
-    /// Per index-buffer triangle, front to back, its source.
-    pub triangles: Vec<OrderSource>,
-}
-
-/// Why an order could not be built, read or written. Every variant names the file.
+/// Why an order could not be built or written. Every variant names the file.
 #[derive(Debug, thiserror::Error)]
-pub enum OrderError {
-    /// Reading or writing failed.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
-    /// The file is not a valid ORDER file.
-    #[error("{path}: not a valid trisort ORDER file: {problem}")]
-    Malformed {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        problem: String,
-    },
+pub enum ExportError {
+    /// Writing the ORDER file failed.
+    #[error(transparent)]
+    Order(#[from] OrderError),
     /// The baked file could not be read.
     #[error(transparent)]
-    Format(#[from] trisort_format::FormatError),
+    Format(#[from] FormatError),
     /// The baked file decodes but its parts do not fit together.
     #[error("{path}: malformed baked file: {problem}")]
     MalformedBaked {
@@ -120,225 +51,92 @@ pub enum OrderError {
     },
 }
 
-impl Order {
-    /// Reads the baked file at `baked_path`, checks its structure, builds its order over the
-    /// glTF file `scene` ([`Order::from_baked`]) and writes it to `out` atomically: what
-    /// `trisort export-order` and the C API's `trisort_export_order` both do.
-    pub fn export(baked_path: &Path, scene: &Path, out: &Path) -> Result<Order, OrderError> {
-        let baked: Baked = trisort_format::read_file(trisort_format::FileKind::Baked, baked_path)?;
-        baked
-            .check_structure()
-            .map_err(|problem| OrderError::MalformedBaked {
-                path: baked_path.to_path_buf(),
-                problem,
-            })?;
-        let order = Order::from_baked(&baked, baked_path, scene)?;
-        order.write(out)?;
-        Ok(order)
-    }
-
-    /// The order of `baked`, whose scene is the glTF file `scene`: imports it with the source
-    /// of every triangle, splits it as the recording did when the bake split intersections,
-    /// checks its hash against the baked file's, and names each index-buffer triangle by the
-    /// source of the scene triangle it is (or is a piece of).
-    pub fn from_baked(baked: &Baked, baked_path: &Path, scene: &Path) -> Result<Order, OrderError> {
-        let (mut imported, sources) = trisort_scene::load_with_sources(scene)?;
-        let hex = |h: &Hash| trisort_format::hash_hex(h)[..16].to_string();
-        let wrong = |found: &Hash| OrderError::WrongScene {
-            scene: scene.to_path_buf(),
-            baked: baked_path.to_path_buf(),
-            found: hex(found),
-            expected: hex(&baked.scene_hash),
-        };
-        // The split needs the baked poses to name the scene's nodes: another scene may have
-        // fewer.
-        let nodes = imported.geometry.nodes.len();
-        if (baked.frame_states.iter().enumerate())
-            .any(|(f, s)| trisort_format::camera::check_frame_state(f, s, Some(nodes)).is_err())
-        {
-            return Err(wrong(&imported.hash()));
-        }
-        let mut origin: Option<Vec<u32>> = None;
-        if let Some(split) = trisort_intersect::working_geometry(
-            &imported.geometry,
-            &baked.frame_states,
-            &baked.settings,
-        ) {
-            *imported.geometry_mut() = split.geometry;
-            origin = Some(split.origin);
-        }
-        let hash = imported.hash();
-        if hash != baked.scene_hash {
-            return Err(wrong(&hash));
-        }
-        let source_of = |scene_id: u32| -> TriangleSource {
-            let id = origin.as_ref().map_or(scene_id, |o| o[scene_id as usize]);
-            sources[id as usize]
-        };
-        let triangles = baked
-            .copies
-            .iter()
-            .map(|&c| {
-                let s = source_of(baked.scene_ids[c as usize]);
-                OrderSource {
-                    mesh: s.mesh,
-                    primitive: s.primitive,
-                    triangle: s.triangle,
-                    node: s.node,
-                }
-            })
-            .collect();
-        Ok(Order {
-            split: baked.settings.split_intersections,
-            scene_hash: baked.scene_hash,
-            frames: baked
-                .frames
-                .iter()
-                .map(|w| OrderRange {
-                    first: w.first,
-                    count: w.count,
-                })
-                .collect(),
-            ranges: baked
-                .draws
-                .iter()
-                .map(|d| OrderRange {
-                    first: d.first_index / 3,
-                    count: d.index_count / 3,
-                })
-                .collect(),
-            triangles,
-        })
-    }
-
-    /// The ranges of frame `f`, front to back.
-    pub fn frame_ranges(&self, f: usize) -> &[OrderRange] {
-        let w = self.frames[f];
-        &self.ranges[w.first as usize..(w.first + w.count) as usize]
-    }
-
-    /// The file's bytes.
-    pub fn encode(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(
-            HEADER_LEN + 8 * (self.frames.len() + self.ranges.len()) + 16 * self.triangles.len(),
-        );
-        out.extend_from_slice(ORDER_MAGIC);
-        let words = |out: &mut Vec<u8>, xs: &[u32]| {
-            for x in xs {
-                out.extend_from_slice(&x.to_le_bytes());
-            }
-        };
-        words(&mut out, &[ORDER_VERSION, self.split as u32]);
-        out.extend_from_slice(&self.scene_hash);
-        words(
-            &mut out,
-            &[
-                self.frames.len() as u32,
-                self.ranges.len() as u32,
-                self.triangles.len() as u32,
-                0,
-            ],
-        );
-        for r in self.frames.iter().chain(&self.ranges) {
-            words(&mut out, &[r.first, r.count]);
-        }
-        for s in &self.triangles {
-            words(&mut out, &[s.mesh, s.primitive, s.triangle, s.node]);
-        }
-        out
-    }
-
-    /// Parses and checks an ORDER file read from `path` (used in messages): magic, version,
-    /// exact length, frames inside the range list, ranges inside the triangle list.
-    pub fn decode(bytes: &[u8], path: &Path) -> Result<Order, OrderError> {
-        let bad = |problem: String| OrderError::Malformed {
-            path: path.to_path_buf(),
+/// Reads the baked file at `baked_path`, checks its structure, builds its order over the glTF
+/// file `scene` ([`from_baked`]) and writes it to `out` atomically: what
+/// `trisort export-order` and the C API's `trisort_export_order` both do.
+pub fn export(baked_path: &Path, scene: &Path, out: &Path) -> Result<Order, ExportError> {
+    let baked: Baked = trisort_format::read_file(trisort_format::FileKind::Baked, baked_path)?;
+    baked
+        .check_structure()
+        .map_err(|problem| ExportError::MalformedBaked {
+            path: baked_path.to_path_buf(),
             problem,
-        };
-        if bytes.len() < 8 || &bytes[..8] != ORDER_MAGIC {
-            return Err(bad("wrong magic bytes".into()));
-        }
-        if bytes.len() < HEADER_LEN {
-            return Err(bad(format!(
-                "{} bytes, shorter than the {HEADER_LEN}-byte header",
-                bytes.len()
-            )));
-        }
-        let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
-        let version = word(8);
-        if version != ORDER_VERSION {
-            return Err(bad(format!(
-                "version {version} is not supported (this trisort reads {ORDER_VERSION})"
-            )));
-        }
-        let flags = word(12);
-        if flags & !1 != 0 {
-            return Err(bad(format!("unknown flags {flags:#x}")));
-        }
-        let scene_hash: Hash = bytes[16..48].try_into().unwrap();
-        let (nf, nr, nt) = (word(48) as u64, word(52) as u64, word(56) as u64);
-        let expected = HEADER_LEN as u64 + 8 * (nf + nr) + 16 * nt;
-        if bytes.len() as u64 != expected {
-            return Err(bad(format!(
-                "{} bytes, the header's counts ({nf} frames, {nr} ranges, {nt} triangles) \
-                 need {expected}",
-                bytes.len()
-            )));
-        }
-        let pairs = |at: usize, n: u64| -> Vec<OrderRange> {
-            (0..n as usize)
-                .map(|k| OrderRange {
-                    first: word(at + 8 * k),
-                    count: word(at + 8 * k + 4),
-                })
-                .collect()
-        };
-        let frames = pairs(HEADER_LEN, nf);
-        let ranges = pairs(HEADER_LEN + 8 * nf as usize, nr);
-        let at = HEADER_LEN + 8 * (nf + nr) as usize;
-        let triangles = (0..nt as usize)
-            .map(|k| OrderSource {
-                mesh: word(at + 16 * k),
-                primitive: word(at + 16 * k + 4),
-                triangle: word(at + 16 * k + 8),
-                node: word(at + 16 * k + 12),
-            })
-            .collect();
-        for (f, w) in frames.iter().enumerate() {
-            if w.first as u64 + w.count as u64 > nr {
-                return Err(bad(format!(
-                    "frame {f}'s ranges lie outside the range list"
-                )));
-            }
-        }
-        for (k, r) in ranges.iter().enumerate() {
-            if r.first as u64 + r.count as u64 > nt {
-                return Err(bad(format!("range {k} lies outside the triangle list")));
-            }
-        }
-        Ok(Order {
-            split: flags & 1 != 0,
-            scene_hash,
-            frames,
-            ranges,
-            triangles,
-        })
-    }
-
-    /// Reads and checks an ORDER file.
-    pub fn read(path: &Path) -> Result<Order, OrderError> {
-        let bytes = std::fs::read(path).map_err(|source| OrderError::Io {
-            path: path.to_path_buf(),
-            source,
         })?;
-        Order::decode(&bytes, path)
-    }
+    let order = from_baked(&baked, baked_path, scene)?;
+    order.write(out)?;
+    Ok(order)
+}
 
-    /// Writes the file atomically (a temporary file renamed into place).
-    pub fn write(&self, path: &Path) -> Result<(), OrderError> {
-        trisort_format::container::write_bytes_atomic(path, &self.encode()).map_err(|e| match e {
-            trisort_format::FormatError::Io { path, source } => OrderError::Io { path, source },
-            other => OrderError::Format(other),
-        })
+/// The order of `baked`, whose scene is the glTF file `scene`: imports it with the source of
+/// every triangle, splits it as the recording did when the bake split intersections, checks
+/// its hash against the baked file's, and names each index-buffer triangle by the source of
+/// the scene triangle it is (or is a piece of).
+pub fn from_baked(baked: &Baked, baked_path: &Path, scene: &Path) -> Result<Order, ExportError> {
+    let (mut imported, sources) = trisort_scene::load_with_sources(scene)?;
+    let hex = |h: &Hash| trisort_format::hash_hex(h)[..16].to_string();
+    let wrong = |found: &Hash| ExportError::WrongScene {
+        scene: scene.to_path_buf(),
+        baked: baked_path.to_path_buf(),
+        found: hex(found),
+        expected: hex(&baked.scene_hash),
+    };
+    // The split needs the baked poses to name the scene's nodes: another scene may have
+    // fewer.
+    let nodes = imported.geometry.nodes.len();
+    if (baked.frame_states.iter().enumerate())
+        .any(|(f, s)| trisort_format::camera::check_frame_state(f, s, Some(nodes)).is_err())
+    {
+        return Err(wrong(&imported.hash()));
     }
+    let mut origin: Option<Vec<u32>> = None;
+    if let Some(split) = trisort_intersect::working_geometry(
+        &imported.geometry,
+        &baked.frame_states,
+        &baked.settings,
+    ) {
+        *imported.geometry_mut() = split.geometry;
+        origin = Some(split.origin);
+    }
+    let hash = imported.hash();
+    if hash != baked.scene_hash {
+        return Err(wrong(&hash));
+    }
+    let source_of = |scene_id: u32| -> TriangleSource {
+        let id = origin.as_ref().map_or(scene_id, |o| o[scene_id as usize]);
+        sources[id as usize]
+    };
+    let triangles = baked
+        .copies
+        .iter()
+        .map(|&c| {
+            let s = source_of(baked.scene_ids[c as usize]);
+            OrderSource {
+                mesh: s.mesh,
+                primitive: s.primitive,
+                triangle: s.triangle,
+                node: s.node,
+            }
+        })
+        .collect();
+    Ok(Order {
+        split: baked.settings.split_intersections,
+        scene_hash: baked.scene_hash,
+        frames: baked
+            .frames
+            .iter()
+            .map(|w| OrderRange {
+                first: w.first,
+                count: w.count,
+            })
+            .collect(),
+        ranges: baked
+            .draws
+            .iter()
+            .map(|d| OrderRange {
+                first: d.first_index / 3,
+                count: d.index_count / 3,
+            })
+            .collect(),
+        triangles,
+    })
 }

@@ -17,7 +17,8 @@ fn generate() -> String {
         .with_src(dir.join("src/ffi/playback.rs"))
         .with_src(dir.join("src/ffi/environment.rs"))
         .with_src(dir.join("src/ffi/order.rs"))
-        .with_src(dir.join("src/order.rs"))
+        // The ORDER file's types (`TrisortOrderRange`, `TrisortOrderSource`).
+        .with_src(dir.join("../format/src/order.rs"))
         .generate()
         .expect("cbindgen generates the header")
         .write(&mut out);

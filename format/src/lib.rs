@@ -18,6 +18,7 @@ pub mod container;
 pub mod environment;
 pub mod geometry;
 pub mod options;
+pub mod order;
 pub mod recording;
 pub mod structure;
 

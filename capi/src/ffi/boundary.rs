@@ -27,9 +27,19 @@ impl From<crate::OrderError> for Failure {
         use crate::OrderError as E;
         let status = match &e {
             E::Io { .. } | E::Format(trisort_format::FormatError::Io { .. }) => TrisortStatus::Io,
-            E::Malformed { .. } | E::MalformedBaked { .. } | E::Format(_) | E::Scene(_) => {
-                TrisortStatus::Format
-            }
+            E::Malformed { .. } | E::Format(_) => TrisortStatus::Format,
+        };
+        Failure(status, e.to_string())
+    }
+}
+
+impl From<crate::ExportError> for Failure {
+    fn from(e: crate::ExportError) -> Self {
+        use crate::ExportError as E;
+        let status = match e {
+            E::Order(e) => return e.into(),
+            E::Format(e) => return e.into(),
+            E::MalformedBaked { .. } | E::Scene(_) => TrisortStatus::Format,
             E::WrongScene { .. } => TrisortStatus::Unsupported,
         };
         Failure(status, e.to_string())

@@ -24,7 +24,7 @@ pub unsafe extern "C" fn trisort_export_order(
         let baked_path = c_path(baked_path, "baked_path")?;
         let scene_path = c_path(scene_path, "scene_path")?;
         let out_path = c_path(out_path, "out_path")?;
-        Order::export(&baked_path, &scene_path, &out_path)?;
+        crate::order::export(&baked_path, &scene_path, &out_path)?;
         Ok(())
     })
 }
