@@ -118,19 +118,31 @@ struct Rendered {
     truncated: bool,
 }
 
+/// How both renderers render in [`same_as_reference`]: square images of `size` pixels at
+/// `samples`, in `mode`, peeling at most `max_layers`.
+#[derive(Clone, Copy)]
+struct Setup {
+    size: u32,
+    samples: u32,
+    mode: Mode,
+    max_layers: u32,
+}
+
 /// Renders every frame with both renderers, asserts the images are identical and the layer
 /// counts agree, and returns the peeling renderer's counts.
-#[allow(clippy::too_many_arguments)]
 fn same_as_reference(
     gpu: &Gpu,
     name: &str,
     geometry: &Geometry,
     frames: &[FrameState],
-    size: u32,
-    samples: u32,
-    mode: Mode,
-    max_layers: u32,
+    setup: Setup,
 ) -> Vec<Rendered> {
+    let Setup {
+        size,
+        samples,
+        mode,
+        max_layers,
+    } = setup;
     let reference = ExactReference::new(
         gpu,
         geometry,
@@ -197,10 +209,12 @@ fn one_frame_stack(gpu: &Gpu, g: &Geometry, samples: u32, max_layers: u32) -> Ve
         "stack",
         g,
         &frame,
-        48,
-        samples,
-        Mode::Blend,
-        max_layers,
+        Setup {
+            size: 48,
+            samples,
+            mode: Mode::Blend,
+            max_layers,
+        },
     )
 }
 
@@ -238,7 +252,18 @@ fn coplanar_ties_resolve_by_id_as_in_the_reference() {
     quad(&mut g, 0.6, -0.6, -0.9, 0.2, -2.5, -2.5, 2);
     for samples in [1, 4] {
         for mode in [Mode::Blend, Mode::Depth] {
-            let r = same_as_reference(&gpu, "coplanar", &g, &frames(), 64, samples, mode, 64);
+            let r = same_as_reference(
+                &gpu,
+                "coplanar",
+                &g,
+                &frames(),
+                Setup {
+                    size: 64,
+                    samples,
+                    mode,
+                    max_layers: 64,
+                },
+            );
             if mode == Mode::Blend {
                 assert_eq!(r[0].layers, 6, "{samples}x");
             }
@@ -255,7 +280,18 @@ fn an_opaque_occluder_is_peeled_through_like_the_reference() {
     quad(&mut g, -2.0, 0.0, -2.0, 2.0, -3.5, -3.5, 4);
     for samples in [1, 4] {
         for mode in [Mode::Blend, Mode::Depth] {
-            let r = same_as_reference(&gpu, "occluder", &g, &frames(), 64, samples, mode, 64);
+            let r = same_as_reference(
+                &gpu,
+                "occluder",
+                &g,
+                &frames(),
+                Setup {
+                    size: 64,
+                    samples,
+                    mode,
+                    max_layers: 64,
+                },
+            );
             let want = if mode == Mode::Depth { 1 } else { 5 };
             assert_eq!(r[0].layers, want, "{samples}x {mode:?}");
         }
@@ -268,7 +304,18 @@ fn a_soup_of_interpenetrating_triangles_matches_the_reference() {
     let g = soup(300, 7);
     for samples in [1, 4] {
         for mode in [Mode::Blend, Mode::Depth] {
-            let r = same_as_reference(&gpu, "soup", &g, &frames(), 96, samples, mode, 256);
+            let r = same_as_reference(
+                &gpu,
+                "soup",
+                &g,
+                &frames(),
+                Setup {
+                    size: 96,
+                    samples,
+                    mode,
+                    max_layers: 256,
+                },
+            );
             assert!(r.iter().all(|r| !r.truncated));
             if mode == Mode::Blend {
                 assert!(r[0].layers > 5, "a deep soup: {} layers", r[0].layers);
@@ -282,7 +329,18 @@ fn depth_mode_draws_the_first_layer_only() {
     let Some(gpu) = gpu() else { return };
     let g = stack(5);
     for samples in [1, 4] {
-        let r = same_as_reference(&gpu, "stack", &g, &frames(), 48, samples, Mode::Depth, 64);
+        let r = same_as_reference(
+            &gpu,
+            "stack",
+            &g,
+            &frames(),
+            Setup {
+                size: 48,
+                samples,
+                mode: Mode::Depth,
+                max_layers: 64,
+            },
+        );
         assert!(r.iter().all(|r| r.layers == 1 && !r.truncated));
     }
 }
@@ -312,11 +370,33 @@ fn an_empty_view_has_no_layer_and_shows_the_background() {
         v.position[2] = -v.position[2];
     }
     for mode in [Mode::Blend, Mode::Depth] {
-        let r = same_as_reference(&gpu, "behind", &g, &frames(), 32, 4, mode, 8);
+        let r = same_as_reference(
+            &gpu,
+            "behind",
+            &g,
+            &frames(),
+            Setup {
+                size: 32,
+                samples: 4,
+                mode,
+                max_layers: 8,
+            },
+        );
         assert!(r.iter().all(|r| r.layers == 0 && !r.truncated));
     }
     let empty = scene(vec![]);
-    let r = same_as_reference(&gpu, "empty", &empty, &frames(), 32, 1, Mode::Blend, 8);
+    let r = same_as_reference(
+        &gpu,
+        "empty",
+        &empty,
+        &frames(),
+        Setup {
+            size: 32,
+            samples: 1,
+            mode: Mode::Blend,
+            max_layers: 8,
+        },
+    );
     assert_eq!(r[0].layers, 0);
 }
 
