@@ -208,80 +208,12 @@ impl Rng {
 /// by rays. Depth complexity is that of a few objects (2 per object), as in real scenes.
 /// Deterministic in its parameters.
 pub fn turntable(p: &Turntable) -> Recording {
-    struct Object {
-        x: f64,
-        z: f64,
-        radius: f64,
-        phase: f64,
-        opacity: f64,
-    }
-    let mut rng = Rng(p.seed);
-    let objects: Vec<Object> = (0..p.objects)
-        .map(|_| {
-            let r = 0.9 * rng.unit().sqrt();
-            let a = rng.unit() * std::f64::consts::TAU;
-            Object {
-                x: r * a.cos(),
-                z: r * a.sin(),
-                radius: (0.08 + 0.2 * rng.unit()) * p.size,
-                phase: rng.unit(),
-                opacity: if rng.unit() < p.transparent { 0.5 } else { 1.0 },
-            }
-        })
-        .collect();
+    let objects = place_objects(p);
     let n = p.objects * p.sides;
     let opacity = |t: u32| objects[(t / p.sides) as usize].opacity;
-    let focal = 2.0;
-    // Per frame and sample: the peel of the segments the ray hits, by (depth, id).
-    let peel = |f: u32| -> Vec<Vec<u32>> {
-        let theta = (p.degrees * f as f64 / (p.frames.max(2) - 1) as f64).to_radians();
-        let (sn, cs) = theta.sin_cos();
-        let to_camera = |x: f64, z: f64| (x * cs - z * sn, 3.0 + x * sn + z * cs);
-        let mut per_sample: Vec<Vec<(f64, u32)>> = vec![Vec::new(); p.samples as usize];
-        for (o, ob) in objects.iter().enumerate() {
-            let (cx, cz) = to_camera(ob.x, ob.z);
-            // Screen interval of the object's bounding circle.
-            let s_of =
-                |u: f64| ((u + 1.0) / 2.0 * p.samples as f64 - 0.5).clamp(-1.0, p.samples as f64);
-            let lo = s_of(focal * (cx - ob.radius) / (cz - ob.radius))
-                .floor()
-                .max(0.0) as u32;
-            let hi = s_of(focal * (cx + ob.radius) / (cz - ob.radius))
-                .ceil()
-                .min(p.samples as f64 - 1.0) as u32;
-            let corner = |k: u32| {
-                let a = (k as f64 / p.sides as f64 + ob.phase) * std::f64::consts::TAU;
-                to_camera(ob.x + ob.radius * a.cos(), ob.z + ob.radius * a.sin())
-            };
-            for k in 0..p.sides {
-                let (ax, az) = corner(k);
-                let (bx, bz) = corner(k + 1);
-                let t = o as u32 * p.sides + k;
-                for smp in lo..=hi {
-                    let kk = ((smp as f64 + 0.5) / p.samples as f64 * 2.0 - 1.0) / focal;
-                    let den = (bx - ax) - kk * (bz - az);
-                    if den.abs() < 1e-12 {
-                        continue;
-                    }
-                    let sp = (kk * az - ax) / den;
-                    if (0.0..1.0).contains(&sp) {
-                        let depth = az + sp * (bz - az);
-                        if depth > 0.1 {
-                            per_sample[smp as usize].push((depth, t));
-                        }
-                    }
-                }
-            }
-        }
-        per_sample
-            .into_iter()
-            .map(|mut v| {
-                v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                v.into_iter().map(|(_, t)| t).collect()
-            })
-            .collect()
-    };
-    let peels: Vec<Vec<Vec<u32>>> = (0..p.frames).map(peel).collect();
+    let peels: Vec<Vec<Vec<u32>>> = (0..p.frames)
+        .map(|f| turntable_peel(p, &objects, f))
+        .collect();
     let visible_of = |samples: &Vec<Vec<u32>>| {
         let mut vis = Vec::new();
         for order in samples {
@@ -305,33 +237,7 @@ pub fn turntable(p: &Turntable) -> Recording {
     let specs: Vec<FrameSpec> = peels
         .iter()
         .zip(&visible)
-        .map(|(samples, vis)| {
-            let mut counts: std::collections::BTreeMap<(u32, u32), u32> = Default::default();
-            let mut covered = Vec::new();
-            for order in samples {
-                let in_g: Vec<u32> = order
-                    .iter()
-                    .copied()
-                    .filter(|t| g.binary_search(t).is_ok())
-                    .collect();
-                covered.extend_from_slice(&in_g);
-                for w in in_g.windows(2) {
-                    *counts.entry((w[0], w[1])).or_default() += 1;
-                }
-            }
-            covered.sort_unstable();
-            covered.dedup();
-            let hidden = covered
-                .into_iter()
-                .filter(|t| vis.binary_search(t).is_err())
-                .collect();
-            FrameSpec {
-                visible: vis.clone(),
-                hidden,
-                edges: counts.into_iter().map(|((a, b), w)| (a, b, w)).collect(),
-                ties: vec![],
-            }
-        })
+        .map(|(samples, vis)| turntable_frame(samples, vis, &g))
         .collect();
     let mut rec = recording_from_frames(n, &specs);
     let mut id = Vec::new();
@@ -349,6 +255,117 @@ pub fn turntable(p: &Turntable) -> Recording {
     }
     rec.scene_hash = trisort_format::hash_bytes(&id);
     rec
+}
+
+/// One object of the [`turntable`]: a closed polygon around (x, z) of `radius`, turned by
+/// `phase` of a turn, at `opacity`.
+struct TurntableObject {
+    x: f64,
+    z: f64,
+    radius: f64,
+    phase: f64,
+    opacity: f64,
+}
+
+/// The [`turntable`]'s objects at random places on the disc (drawn from `p.seed`).
+fn place_objects(p: &Turntable) -> Vec<TurntableObject> {
+    let mut rng = Rng(p.seed);
+    (0..p.objects)
+        .map(|_| {
+            let r = 0.9 * rng.unit().sqrt();
+            let a = rng.unit() * std::f64::consts::TAU;
+            TurntableObject {
+                x: r * a.cos(),
+                z: r * a.sin(),
+                radius: (0.08 + 0.2 * rng.unit()) * p.size,
+                phase: rng.unit(),
+                opacity: if rng.unit() < p.transparent { 0.5 } else { 1.0 },
+            }
+        })
+        .collect()
+}
+
+/// Frame `f` of the [`turntable`]: per sample, the peel of the segments the ray hits, by
+/// (depth, id).
+fn turntable_peel(p: &Turntable, objects: &[TurntableObject], f: u32) -> Vec<Vec<u32>> {
+    let focal = 2.0;
+    let theta = (p.degrees * f as f64 / (p.frames.max(2) - 1) as f64).to_radians();
+    let (sn, cs) = theta.sin_cos();
+    let to_camera = |x: f64, z: f64| (x * cs - z * sn, 3.0 + x * sn + z * cs);
+    let mut per_sample: Vec<Vec<(f64, u32)>> = vec![Vec::new(); p.samples as usize];
+    for (o, ob) in objects.iter().enumerate() {
+        let (cx, cz) = to_camera(ob.x, ob.z);
+        // Screen interval of the object's bounding circle.
+        let s_of =
+            |u: f64| ((u + 1.0) / 2.0 * p.samples as f64 - 0.5).clamp(-1.0, p.samples as f64);
+        let lo = s_of(focal * (cx - ob.radius) / (cz - ob.radius))
+            .floor()
+            .max(0.0) as u32;
+        let hi = s_of(focal * (cx + ob.radius) / (cz - ob.radius))
+            .ceil()
+            .min(p.samples as f64 - 1.0) as u32;
+        let corner = |k: u32| {
+            let a = (k as f64 / p.sides as f64 + ob.phase) * std::f64::consts::TAU;
+            to_camera(ob.x + ob.radius * a.cos(), ob.z + ob.radius * a.sin())
+        };
+        for k in 0..p.sides {
+            let (ax, az) = corner(k);
+            let (bx, bz) = corner(k + 1);
+            let t = o as u32 * p.sides + k;
+            for smp in lo..=hi {
+                let kk = ((smp as f64 + 0.5) / p.samples as f64 * 2.0 - 1.0) / focal;
+                let den = (bx - ax) - kk * (bz - az);
+                if den.abs() < 1e-12 {
+                    continue;
+                }
+                let sp = (kk * az - ax) / den;
+                if (0.0..1.0).contains(&sp) {
+                    let depth = az + sp * (bz - az);
+                    if depth > 0.1 {
+                        per_sample[smp as usize].push((depth, t));
+                    }
+                }
+            }
+        }
+    }
+    per_sample
+        .into_iter()
+        .map(|mut v| {
+            v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            v.into_iter().map(|(_, t)| t).collect()
+        })
+        .collect()
+}
+
+/// One [`turntable`] frame's graph from its peels (`samples`) and visible set `vis`: covered
+/// triangles of G (`g`) not visible are hidden, neighbours in the peel of G are edges weighted
+/// by rays.
+fn turntable_frame(samples: &[Vec<u32>], vis: &[u32], g: &[u32]) -> FrameSpec {
+    let mut counts: std::collections::BTreeMap<(u32, u32), u32> = Default::default();
+    let mut covered = Vec::new();
+    for order in samples {
+        let in_g: Vec<u32> = order
+            .iter()
+            .copied()
+            .filter(|t| g.binary_search(t).is_ok())
+            .collect();
+        covered.extend_from_slice(&in_g);
+        for w in in_g.windows(2) {
+            *counts.entry((w[0], w[1])).or_default() += 1;
+        }
+    }
+    covered.sort_unstable();
+    covered.dedup();
+    let hidden = covered
+        .into_iter()
+        .filter(|t| vis.binary_search(t).is_err())
+        .collect();
+    FrameSpec {
+        visible: vis.to_vec(),
+        hidden,
+        edges: counts.into_iter().map(|((a, b), w)| (a, b, w)).collect(),
+        ties: vec![],
+    }
 }
 
 /// Cuts a recording into frame ranges starting at each of `starts` (ascending, first 0), as

@@ -4,7 +4,7 @@
 
 use glam::{DMat4, DQuat, DVec3, DVec4};
 use trisort_format::{world_transforms, Camera, FrameState};
-use trisort_scene::{Channel, Interpolation, Property, Scene};
+use trisort_scene::{Channel, Interpolation, Property, Scene, SceneCamera};
 
 use crate::error::{Location, PathError, Problem};
 use crate::keyframes::MAX_FRAMES;
@@ -77,49 +77,7 @@ pub(crate) fn sample(scene: &Scene, fps: f64, select: &Selection) -> Result<Time
     let err = |problem| PathError::Invalid { at: at(), problem };
     check_fps(fps).map_err(err)?;
     let nodes = &scene.geometry.nodes;
-    let plays = |name: &str| {
-        select
-            .animation
-            .as_deref()
-            .is_none_or(|wanted| wanted == name)
-    };
-    if let Some(wanted) = &select.animation {
-        if !scene.animations.iter().any(|a| a.name == *wanted) {
-            return Err(err(Problem::BadParameter {
-                name: "animation".into(),
-                reason: format!(
-                    "the scene has no animation named {wanted:?} (its animations: {})",
-                    listed(scene.animations.iter().map(|a| a.name.as_str()))
-                ),
-            }));
-        }
-    }
-
-    // The channel that drives each (node, property); later animations and channels override
-    // earlier ones.
-    let mut driver: Vec<[Option<&Channel>; 3]> = vec![[None; 3]; nodes.len()];
-    let mut duration: f64 = 0.0;
-    for (a, anim) in scene.animations.iter().enumerate() {
-        if !plays(&anim.name) {
-            continue;
-        }
-        for (c, ch) in anim.channels.iter().enumerate() {
-            check_channel(ch, nodes.len()).map_err(|reason| {
-                err(Problem::Inconsistent(format!(
-                    "animation {a} ({:?}) channel {c}: {reason}",
-                    anim.name
-                )))
-            })?;
-            driver[ch.node as usize][property_slot(ch.property)] = Some(ch);
-            duration = duration.max(*ch.times.last().expect("checked non-empty") as f64);
-        }
-    }
-    let animated: Vec<(u32, [Option<&Channel>; 3])> = driver
-        .into_iter()
-        .enumerate()
-        .filter(|(_, d)| d.iter().any(Option::is_some))
-        .map(|(n, d)| (n as u32, d))
-        .collect();
+    let (animated, duration) = animated_nodes(scene, select, &err)?;
 
     let frame_count = if animated.is_empty() {
         1
@@ -133,32 +91,7 @@ pub(crate) fn sample(scene: &Scene, fps: f64, select: &Selection) -> Result<Time
         (last + 1e-9).floor() as usize + 1
     };
 
-    let scene_camera = match &select.camera {
-        None => scene.cameras.first(),
-        Some(wanted) => Some(
-            (scene.cameras.iter())
-                .find(|c| c.name == *wanted)
-                .ok_or_else(|| {
-                    err(Problem::BadParameter {
-                        name: "camera".into(),
-                        reason: format!(
-                            "the scene has no camera named {wanted:?} (its cameras: {})",
-                            listed(scene.cameras.iter().map(|c| c.name.as_str()))
-                        ),
-                    })
-                })?,
-        ),
-    };
-    if let Some(c) = scene_camera {
-        if c.node as usize >= nodes.len() {
-            return Err(err(Problem::Inconsistent(format!(
-                "camera {:?} is on node {}, which does not exist",
-                c.name, c.node
-            ))));
-        }
-        check_fov_degrees(c.yfov.to_degrees()).map_err(err)?;
-        check_clip(c.znear, c.zfar).map_err(err)?;
-    }
+    let scene_camera = chosen_camera(scene, select, &err)?;
     let fixed_camera = match scene_camera {
         Some(_) => None,
         None => Some(framing_camera(&Bounds::of_scene(scene).map_err(err)?)),
@@ -207,6 +140,102 @@ pub(crate) fn sample(scene: &Scene, fps: f64, select: &Selection) -> Result<Time
     }
     check_frames(&frames).map_err(err)?;
     Ok(Timeline { fps, frames })
+}
+
+/// The channels that drive a node's translation, rotation and scale (`None`: its rest value).
+type Drivers<'s> = [Option<&'s Channel>; 3];
+
+/// The animated nodes of the animations `select` plays, each with the channel that drives
+/// its translation, rotation and scale (later animations and channels override earlier ones),
+/// and the longest channel's duration in seconds. Errors (through `err`) where `select` names
+/// an animation the scene lacks or a channel is malformed.
+fn animated_nodes<'s>(
+    scene: &'s Scene,
+    select: &Selection,
+    err: &dyn Fn(Problem) -> PathError,
+) -> Result<(Vec<(u32, Drivers<'s>)>, f64), PathError> {
+    let nodes = &scene.geometry.nodes;
+    let plays = |name: &str| {
+        select
+            .animation
+            .as_deref()
+            .is_none_or(|wanted| wanted == name)
+    };
+    if let Some(wanted) = &select.animation {
+        if !scene.animations.iter().any(|a| a.name == *wanted) {
+            return Err(err(Problem::BadParameter {
+                name: "animation".into(),
+                reason: format!(
+                    "the scene has no animation named {wanted:?} (its animations: {})",
+                    listed(scene.animations.iter().map(|a| a.name.as_str()))
+                ),
+            }));
+        }
+    }
+
+    // The channel that drives each (node, property); later animations and channels override
+    // earlier ones.
+    let mut driver: Vec<[Option<&Channel>; 3]> = vec![[None; 3]; nodes.len()];
+    let mut duration: f64 = 0.0;
+    for (a, anim) in scene.animations.iter().enumerate() {
+        if !plays(&anim.name) {
+            continue;
+        }
+        for (c, ch) in anim.channels.iter().enumerate() {
+            check_channel(ch, nodes.len()).map_err(|reason| {
+                err(Problem::Inconsistent(format!(
+                    "animation {a} ({:?}) channel {c}: {reason}",
+                    anim.name
+                )))
+            })?;
+            driver[ch.node as usize][property_slot(ch.property)] = Some(ch);
+            duration = duration.max(*ch.times.last().expect("checked non-empty") as f64);
+        }
+    }
+    let animated = driver
+        .into_iter()
+        .enumerate()
+        .filter(|(_, d)| d.iter().any(Option::is_some))
+        .map(|(n, d)| (n as u32, d))
+        .collect();
+    Ok((animated, duration))
+}
+
+/// The scene camera `select` names (by default the first, `None` where the scene has none),
+/// checked: on an existing node, with a valid field of view and clip range. Errors go
+/// through `err`.
+fn chosen_camera<'s>(
+    scene: &'s Scene,
+    select: &Selection,
+    err: &dyn Fn(Problem) -> PathError,
+) -> Result<Option<&'s SceneCamera>, PathError> {
+    let scene_camera = match &select.camera {
+        None => scene.cameras.first(),
+        Some(wanted) => Some(
+            (scene.cameras.iter())
+                .find(|c| c.name == *wanted)
+                .ok_or_else(|| {
+                    err(Problem::BadParameter {
+                        name: "camera".into(),
+                        reason: format!(
+                            "the scene has no camera named {wanted:?} (its cameras: {})",
+                            listed(scene.cameras.iter().map(|c| c.name.as_str()))
+                        ),
+                    })
+                })?,
+        ),
+    };
+    if let Some(c) = scene_camera {
+        if c.node as usize >= scene.geometry.nodes.len() {
+            return Err(err(Problem::Inconsistent(format!(
+                "camera {:?} is on node {}, which does not exist",
+                c.name, c.node
+            ))));
+        }
+        check_fov_degrees(c.yfov.to_degrees()).map_err(err)?;
+        check_clip(c.znear, c.zfar).map_err(err)?;
+    }
+    Ok(scene_camera)
 }
 
 /// Checks a sampling rate.

@@ -458,6 +458,30 @@ impl<'g> ExactReference<'g> {
         &self.config
     }
 
+    /// The tie rule of frame `frame` over the whole scene, moving only the triangles
+    /// `unordered` says the frame draws.
+    fn tie_rule(
+        &self,
+        frame: u32,
+        unordered: Option<&UnorderedEdges>,
+    ) -> Result<TieRule, ReferenceError> {
+        let state = self
+            .frames
+            .get(frame as usize)
+            .ok_or_else(|| ReferenceError::Invalid(format!("frame {frame} is beyond the path")))?;
+        let all: Vec<u32> = (0..self.triangles.len() as u32).collect();
+        // Without a recording (or a file's draws) the rule moves nothing: the rasterizer's order.
+        let mut moves = vec![false; all.len()];
+        if let Some(d) = unordered.and_then(|r| r.drawn.get(frame as usize)) {
+            for &t in d {
+                if let Some(m) = moves.get_mut(t as usize) {
+                    *m = true;
+                }
+            }
+        }
+        Ok(TieRule::new(&self.shape, &all, state).moving_only(moves))
+    }
+
     /// Renders frame `frame`. With `unordered`, also finds the unordered samples of the frame.
     pub fn render(
         &self,
@@ -480,21 +504,7 @@ impl<'g> ExactReference<'g> {
         // order, which the recorder followed (`trisort_recorder::tie_rule`): they go through a
         // window as they come, and the k-th to leave it goes to composited layer k (in `depth`,
         // the k-th that the depth test lets through).
-        let state = self
-            .frames
-            .get(frame as usize)
-            .ok_or_else(|| ReferenceError::Invalid(format!("frame {frame} is beyond the path")))?;
-        let all: Vec<u32> = (0..self.triangles.len() as u32).collect();
-        // Without a recording (or a file's draws) the rule moves nothing: the rasterizer's order.
-        let mut moves = vec![false; all.len()];
-        if let Some(d) = unordered.and_then(|r| r.drawn.get(frame as usize)) {
-            for &t in d {
-                if let Some(m) = moves.get_mut(t as usize) {
-                    *m = true;
-                }
-            }
-        }
-        let rule = TieRule::new(&self.shape, &all, state).moving_only(moves);
+        let rule = self.tie_rule(frame, unordered)?;
         let mut windows = vec![Window::default(); slots];
         let mut placed = vec![0u32; slots];
         // `depth`: the player draws a sample's fragments in that order with the depth test
