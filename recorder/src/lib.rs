@@ -12,7 +12,7 @@
 //! primitive ids and writable storage in fragment shaders (`capture::supported`; lavapipe and
 //! most desktop Vulkan drivers have both, neither is required by Vulkan), one render pass
 //! captures every fragment of the frame on per-sample lists and the host sorts each list
-//! (`capture.rs`, `shaders/record/capture.wgsl`; conservative recording's grown peel likewise,
+//! (`capture/`, `shaders/record/capture.wgsl`; conservative recording's grown peel likewise,
 //! `capture_grown.wgsl`). Elsewhere each layer is one depth-peeling render pass: triangles in
 //! ascending id order, depth test `Less`, the depth written explicitly, and fragments whose
 //! (depth, id) key is not greater than the previous layer's at that sample discarded (see

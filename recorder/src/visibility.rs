@@ -56,8 +56,9 @@ impl<'g> PhaseOneConservative<'g> {
 }
 
 /// Phase 1 of one frame: the visible set, layers used, and whether `max_layers` truncated it.
-/// With robust settings, the union over the sample patterns of [`Robust::offsets`](trisort_format::Robust::offsets) (layers
-/// add up) and the conservative pass's triangles.
+/// With robust settings, the union over the sample patterns of
+/// [`Robust::offsets`](trisort_format::Robust::offsets) (layers add up) and the conservative
+/// pass's triangles.
 pub(crate) fn visibility_frame(
     source: &Layers,
     conservative: Option<&PhaseOneConservative>,

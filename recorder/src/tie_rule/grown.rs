@@ -27,7 +27,7 @@ const TOUCH: f64 = 1e-9;
 const DEPTH_SLACK: f32 = 1e-6;
 
 /// The order of the conservative recording's grown fragments (phase 2's grown capture and
-/// grown peel, `graph_frame` in the crate root), as edges.
+/// grown peel, `graph_frame` in `graph.rs`), as edges.
 ///
 /// A grown fragment may come from a triangle that does not cover the sample, at its plane's
 /// depth extended to the sample. Two such depths order the pair where both cover only if the
