@@ -49,6 +49,19 @@ pub struct View {
     pub glass_opacity: f32,
 }
 
+/// What [`SceneGpu::upload`] puts on the GPU, and how: the scene and its frames at a view, the
+/// binding tier and the light.
+struct Upload<'a> {
+    geometry: &'a Geometry,
+    frames: &'a [FrameState],
+    view: View,
+    bindings: Bindings,
+    lighting: Lighting<'a>,
+    /// Only what decides visibility is read ([`SceneGpu::for_visibility`]): the linear texture
+    /// array can stay one white texel.
+    visibility_only: bool,
+}
+
 /// Scene resources on the GPU.
 pub struct SceneGpu {
     /// Vertex buffer.
@@ -132,16 +145,15 @@ impl SceneGpu {
         frames: &[FrameState],
         view: View,
     ) -> SceneGpu {
-        SceneGpu::upload(
-            device,
-            queue,
+        let upload = Upload {
             geometry,
             frames,
             view,
-            Bindings::Storage,
-            Lighting::default(),
-            true,
-        )
+            bindings: Bindings::Storage,
+            lighting: Lighting::default(),
+            visibility_only: true,
+        };
+        SceneGpu::upload(device, queue, upload)
     }
 
     /// [`SceneGpu::with_bindings`] lit as `lighting` says (the player and the reference pass
@@ -155,24 +167,28 @@ impl SceneGpu {
         bindings: Bindings,
         lighting: Lighting<'_>,
     ) -> SceneGpu {
-        SceneGpu::upload(
-            device, queue, geometry, frames, view, bindings, lighting, false,
-        )
+        let upload = Upload {
+            geometry,
+            frames,
+            view,
+            bindings,
+            lighting,
+            visibility_only: false,
+        };
+        SceneGpu::upload(device, queue, upload)
     }
 
-    /// [`SceneGpu::with_lighting`], or with `visibility_only` [`SceneGpu::for_visibility`]'s
-    /// smaller texture upload.
-    #[allow(clippy::too_many_arguments)]
-    fn upload(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        geometry: &Geometry,
-        frames: &[FrameState],
-        view: View,
-        bindings: Bindings,
-        lighting: Lighting<'_>,
-        visibility_only: bool,
-    ) -> SceneGpu {
+    /// [`SceneGpu::with_lighting`], or with [`Upload::visibility_only`]
+    /// [`SceneGpu::for_visibility`]'s smaller texture upload.
+    fn upload(device: &wgpu::Device, queue: &wgpu::Queue, upload: Upload<'_>) -> SceneGpu {
+        let Upload {
+            geometry,
+            frames,
+            view,
+            bindings,
+            lighting,
+            visibility_only,
+        } = upload;
         let limits = device.limits();
         let vertex_bytes: &[u8] = if geometry.vertices.is_empty() {
             &[0u8; std::mem::size_of::<Vertex>()]
@@ -185,25 +201,10 @@ impl SceneGpu {
             usage: wgpu::BufferUsages::VERTEX,
         });
         let textures = upload_textures(device, queue, geometry, visibility_only);
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("material textures"),
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
+        let sampler = linear_sampler(device, "material textures", wgpu::AddressMode::ClampToEdge);
         let env = upload_environment(device, queue, lighting.environment);
-        let environment_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("environment"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
+        // The environment wraps around in longitude (u) and stops at the poles (v).
+        let environment_sampler = linear_sampler(device, "environment", wgpu::AddressMode::Repeat);
         let lighting_uniform = LightingUniform::new(&lighting, env.levels);
         let lighting_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("lighting"),
@@ -362,4 +363,21 @@ impl SceneGpu {
             (f as u64 * self.node_stride) as u32,
         ]
     }
+}
+
+/// A trilinear sampler that clamps v to the edge and addresses u with `address_mode_u`.
+fn linear_sampler(
+    device: &wgpu::Device,
+    label: &str,
+    address_mode_u: wgpu::AddressMode,
+) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some(label),
+        address_mode_u,
+        address_mode_v: wgpu::AddressMode::ClampToEdge,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    })
 }
