@@ -167,6 +167,15 @@ fn counts_index_buffers_and_ranges_match_the_file() {
 fn matrices_materials_and_textures() {
     let b = sample();
     let h = open(&b);
+    check_vertices(h, &b);
+    check_matrices(h, &b);
+    check_materials(h);
+    check_textures(h);
+    unsafe { trisort_close(h) };
+}
+
+/// The vertices are the file's, byte for byte.
+fn check_vertices(h: *mut TrisortBaked, b: &Baked) {
     let vertices: Vec<TrisortVertex> = get(|o, c, l| unsafe { trisort_vertices(h, o, c, l) });
     assert_eq!(vertices.len(), b.geometry.vertices.len());
     assert_eq!(vertices[5].position, b.geometry.vertices[5].position);
@@ -182,7 +191,10 @@ fn matrices_materials_and_textures() {
         bytes((&b.geometry.vertices[5] as *const trisort_format::Vertex).cast()),
         bytes((&vertices[5] as *const TrisortVertex).cast())
     );
+}
 
+/// The view, projection (both depth conventions) and node matrices of `b`'s frames.
+fn check_matrices(h: *mut TrisortBaked, b: &Baked) {
     let mut view = [0f32; 16];
     assert_eq!(
         unsafe { trisort_frame_view(h, 1, view.as_mut_ptr()) },
@@ -220,8 +232,15 @@ fn matrices_materials_and_textures() {
     let nodes: Vec<f32> =
         get(|o, c, l| unsafe { trisort_frame_node_matrices(h, 0, true, o, c, l) });
     assert_eq!(nodes.len(), 16);
-    assert_eq!(&nodes[..], &view_of(&b, 0)[..]);
+    assert_eq!(&nodes[..], &view_of(b, 0)[..]);
+    assert_eq!(
+        unsafe { trisort_frame_view(h, 0, null_mut()) },
+        TrisortStatus::NullArgument
+    );
+}
 
+/// The materials of [`sample`], with their texture slots.
+fn check_materials(h: *mut TrisortBaked) {
     let materials: Vec<TrisortMaterial> = get(|o, c, l| unsafe { trisort_materials(h, o, c, l) });
     assert_eq!(materials[1].alpha_mode, TrisortAlphaMode::Blend);
     assert_eq!(
@@ -255,7 +274,11 @@ fn matrices_materials_and_textures() {
         ),
         (-1, -1)
     );
+}
 
+/// The textures of [`sample`] with every mip level, and the refusals of a level, a texture or
+/// an output that is not there.
+fn check_textures(h: *mut TrisortBaked) {
     let (mut w, mut ht) = (0, 0);
     let texels: Vec<u8> = get(|o, c, l| unsafe { trisort_texture(h, 0, &mut w, &mut ht, o, c, l) });
     assert_eq!((w, ht, texels), (2, 1, vec![1, 2, 3, 4, 5, 6, 7, 8]));
@@ -301,11 +324,6 @@ fn matrices_materials_and_textures() {
         unsafe { trisort_texture_info(h, 0, null_mut()) },
         TrisortStatus::NullArgument
     );
-    assert_eq!(
-        unsafe { trisort_frame_view(h, 0, null_mut()) },
-        TrisortStatus::NullArgument
-    );
-    unsafe { trisort_close(h) };
 }
 
 /// The camera-relative node matrix of the sample's one node (identity world) at frame `f`.

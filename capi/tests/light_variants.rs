@@ -192,112 +192,129 @@ fn the_environment_and_frame_rate_of_a_demo_bake_are_what_the_rust_reader_reads(
     ] {
         let path = d.join(file);
         let b: Baked = read_file(FileKind::Baked, &path).unwrap();
-        let e = &b.environment;
         let h = open(&path);
 
-        let mut info = TrisortEnvironmentInfo::default();
-        assert_eq!(
-            unsafe { trisort_environment_info(h, &mut info) },
-            TrisortStatus::Ok
-        );
-        assert_eq!((info.width, info.height), (e.width, e.height));
-        assert_eq!(info.level_count as usize, e.levels.len());
-        assert!(info.level_count > 1, "{file}: prefiltered levels");
-        assert_eq!(info.sh, e.sh);
-        assert_ne!(info.sh[0], [0.0; 3], "{file}: some light");
-        assert_eq!(info.exposure, e.exposure);
-        assert_eq!(info.has_sun, sun, "{file}");
-        assert_eq!(e.sun.is_some(), sun, "{file}");
-        match e.sun {
-            Some(s) => {
-                assert_eq!((info.sun_direction, info.sun_color), (s.direction, s.color));
-                assert_ne!(info.sun_color, [0.0; 3]);
-            }
-            None => assert_eq!((info.sun_direction, info.sun_color), ([0.0; 3], [0.0; 3])),
-        }
-        let got = string(|o, c, l| unsafe { trisort_environment_name(h, o, c, l) });
-        assert_eq!((got.as_str(), e.name.as_str()), (name, name));
-
-        for (k, level) in e.levels.iter().enumerate() {
-            let (mut w, mut ht, mut len) = (0, 0, 0);
-            let s = unsafe {
-                trisort_environment_level(h, k as u32, &mut w, &mut ht, null_mut(), 0, &mut len)
-            };
-            assert_eq!(s, TrisortStatus::Ok);
-            let want = ((e.width >> k).max(1), (e.height >> k).max(1));
-            assert_eq!((w, ht), want, "{file} level {k}");
-            assert_eq!(len, 4 * (w * ht) as usize);
-            assert_eq!(len, level.len());
-            let mut texels = vec![0xbeefu16; len];
-            let s = unsafe {
-                trisort_environment_level(
-                    h,
-                    k as u32,
-                    null_mut(),
-                    null_mut(),
-                    texels.as_mut_ptr(),
-                    len - 1,
-                    &mut len,
-                )
-            };
-            assert_eq!(s, TrisortStatus::BufferTooSmall);
-            assert!(texels.iter().all(|&t| t == 0xbeef), "nothing copied");
-            let s = unsafe {
-                trisort_environment_level(
-                    h,
-                    k as u32,
-                    null_mut(),
-                    null_mut(),
-                    texels.as_mut_ptr(),
-                    len,
-                    null_mut(),
-                )
-            };
-            assert_eq!(s, TrisortStatus::Ok);
-            assert_eq!(&texels, level, "{file} level {k}");
-        }
-        let past = info.level_count;
-        let mut len = 0;
-        let s = unsafe {
-            trisort_environment_level(h, past, null_mut(), null_mut(), null_mut(), 0, &mut len)
-        };
-        assert_eq!(s, TrisortStatus::OutOfRange);
-        let msg = last_error();
-        assert!(
-            msg.contains(file) && msg.contains(&format!("level {past}")),
-            "{msg}"
-        );
-
-        let mut fps = -1.0;
-        assert_eq!(unsafe { trisort_fps(h, &mut fps) }, TrisortStatus::Ok);
-        assert_eq!(Some(fps), b.fps);
-        assert_eq!(fps, 24.0);
-        assert_eq!(last_error(), "");
-
-        // No variants in the demo: the count is 0, the default table is the materials', and
-        // any name is unknown, naming the file and the name.
-        let mut count = 9;
-        assert_eq!(
-            unsafe { trisort_variant_count(h, &mut count) },
-            TrisortStatus::Ok
-        );
-        assert_eq!(count, 0);
-        assert_eq!(variant_table(h, None).unwrap(), materials(h));
-        assert_eq!(variant_table(h, Some("Gold")), Err(TrisortStatus::Absent));
-        let msg = last_error();
-        assert!(
-            msg.contains(file) && msg.contains("\"Gold\"") && msg.contains("no variants"),
-            "{msg}"
-        );
-        let mut len = 0;
-        let s = unsafe { trisort_variant_name(h, 0, null_mut(), 0, &mut len) };
-        assert_eq!(s, TrisortStatus::OutOfRange);
-        assert!(last_error().contains("variant 0"), "{}", last_error());
+        check_environment(h, file, name, sun, &b);
+        check_fps_and_no_variants(h, file, &b);
         unsafe { trisort_close(h) };
     }
 
-    // The same file without a stored frame rate (as from recordings that did not know it):
-    // the distinct status, 0 in `*out`, and a message naming the file.
+    let (h, b) = open_without_fps(d);
+    check_raster_profile(h, &b);
+    check_null_pointers(h);
+}
+
+/// The environment of the file `file` (handle `h`, read as `b`) as the C API copies it: its
+/// figures, `name`, a sun exactly when `sun`, and every prefiltered level.
+fn check_environment(h: *mut TrisortBaked, file: &str, name: &str, sun: bool, b: &Baked) {
+    let e = &b.environment;
+    let mut info = TrisortEnvironmentInfo::default();
+    assert_eq!(
+        unsafe { trisort_environment_info(h, &mut info) },
+        TrisortStatus::Ok
+    );
+    assert_eq!((info.width, info.height), (e.width, e.height));
+    assert_eq!(info.level_count as usize, e.levels.len());
+    assert!(info.level_count > 1, "{file}: prefiltered levels");
+    assert_eq!(info.sh, e.sh);
+    assert_ne!(info.sh[0], [0.0; 3], "{file}: some light");
+    assert_eq!(info.exposure, e.exposure);
+    assert_eq!(info.has_sun, sun, "{file}");
+    assert_eq!(e.sun.is_some(), sun, "{file}");
+    match e.sun {
+        Some(s) => {
+            assert_eq!((info.sun_direction, info.sun_color), (s.direction, s.color));
+            assert_ne!(info.sun_color, [0.0; 3]);
+        }
+        None => assert_eq!((info.sun_direction, info.sun_color), ([0.0; 3], [0.0; 3])),
+    }
+    let got = string(|o, c, l| unsafe { trisort_environment_name(h, o, c, l) });
+    assert_eq!((got.as_str(), e.name.as_str()), (name, name));
+
+    for (k, level) in e.levels.iter().enumerate() {
+        let (mut w, mut ht, mut len) = (0, 0, 0);
+        let s = unsafe {
+            trisort_environment_level(h, k as u32, &mut w, &mut ht, null_mut(), 0, &mut len)
+        };
+        assert_eq!(s, TrisortStatus::Ok);
+        let want = ((e.width >> k).max(1), (e.height >> k).max(1));
+        assert_eq!((w, ht), want, "{file} level {k}");
+        assert_eq!(len, 4 * (w * ht) as usize);
+        assert_eq!(len, level.len());
+        let mut texels = vec![0xbeefu16; len];
+        let s = unsafe {
+            trisort_environment_level(
+                h,
+                k as u32,
+                null_mut(),
+                null_mut(),
+                texels.as_mut_ptr(),
+                len - 1,
+                &mut len,
+            )
+        };
+        assert_eq!(s, TrisortStatus::BufferTooSmall);
+        assert!(texels.iter().all(|&t| t == 0xbeef), "nothing copied");
+        let s = unsafe {
+            trisort_environment_level(
+                h,
+                k as u32,
+                null_mut(),
+                null_mut(),
+                texels.as_mut_ptr(),
+                len,
+                null_mut(),
+            )
+        };
+        assert_eq!(s, TrisortStatus::Ok);
+        assert_eq!(&texels, level, "{file} level {k}");
+    }
+    let past = info.level_count;
+    let mut len = 0;
+    let s = unsafe {
+        trisort_environment_level(h, past, null_mut(), null_mut(), null_mut(), 0, &mut len)
+    };
+    assert_eq!(s, TrisortStatus::OutOfRange);
+    let msg = last_error();
+    assert!(
+        msg.contains(file) && msg.contains(&format!("level {past}")),
+        "{msg}"
+    );
+}
+
+/// The frame rate (24) and, the demo having none, the variants of the file `file`.
+fn check_fps_and_no_variants(h: *mut TrisortBaked, file: &str, b: &Baked) {
+    let mut fps = -1.0;
+    assert_eq!(unsafe { trisort_fps(h, &mut fps) }, TrisortStatus::Ok);
+    assert_eq!(Some(fps), b.fps);
+    assert_eq!(fps, 24.0);
+    assert_eq!(last_error(), "");
+
+    // No variants in the demo: the count is 0, the default table is the materials', and
+    // any name is unknown, naming the file and the name.
+    let mut count = 9;
+    assert_eq!(
+        unsafe { trisort_variant_count(h, &mut count) },
+        TrisortStatus::Ok
+    );
+    assert_eq!(count, 0);
+    assert_eq!(variant_table(h, None).unwrap(), materials(h));
+    assert_eq!(variant_table(h, Some("Gold")), Err(TrisortStatus::Absent));
+    let msg = last_error();
+    assert!(
+        msg.contains(file) && msg.contains("\"Gold\"") && msg.contains("no variants"),
+        "{msg}"
+    );
+    let mut len = 0;
+    let s = unsafe { trisort_variant_name(h, 0, null_mut(), 0, &mut len) };
+    assert_eq!(s, TrisortStatus::OutOfRange);
+    assert!(last_error().contains("variant 0"), "{}", last_error());
+}
+
+/// Opens `studio.baked` of `d` without its stored frame rate (as from recordings that did not
+/// know it) and checks the frame rate's refusal; returns the handle and the file.
+fn open_without_fps(d: &Path) -> (*mut TrisortBaked, Baked) {
+    // The distinct status, 0 in `*out`, and a message naming the file.
     let mut b: Baked = read_file(FileKind::Baked, &d.join("studio.baked")).unwrap();
     b.fps = None;
     let bytes = container::encode(FileKind::Baked, &b);
@@ -312,10 +329,13 @@ fn the_environment_and_frame_rate_of_a_demo_bake_are_what_the_rust_reader_reads(
         msg.contains("<bytes>") && msg.contains("frame rate"),
         "{msg}"
     );
+    (h, b)
+}
 
-    // The raster profile the file was baked for (the default: conformant), and a host's
-    // device checked against it: lavapipe-like figures pass; 4 sub-pixel bits, non-standard
-    // locations or another sample count each give the mismatch status, named in the message.
+/// The raster profile the file was baked for (the default: conformant), and a host's device
+/// checked against it: lavapipe-like figures pass; 4 sub-pixel bits, non-standard locations or
+/// another sample count each give the mismatch status, named in the message.
+fn check_raster_profile(h: *mut TrisortBaked, b: &Baked) {
     let mut p = TrisortRasterProfile::default();
     assert_eq!(
         unsafe { trisort_raster_profile(h, &mut p) },
@@ -359,8 +379,11 @@ fn the_environment_and_frame_rate_of_a_demo_bake_are_what_the_rust_reader_reads(
         unsafe { trisort_raster_profile(h, null_mut()) },
         TrisortStatus::NullArgument
     );
+}
 
-    // Null pointers.
+/// Null handles and outputs are refused; closes `h`.
+fn check_null_pointers(h: *mut TrisortBaked) {
+    let mut fps = -1.0;
     let mut info = TrisortEnvironmentInfo::default();
     let mut n = 0u32;
     let mut len = 0usize;

@@ -235,38 +235,7 @@ pub fn probe(gpu: &Gpu, samples: u32, offset: [f64; 2]) -> Result<ProbeResult, G
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         )
     });
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("raster probe"),
-        source: wgpu::ShaderSource::Wgsl(PROBE_WGSL.into()),
-    });
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("raster probe"),
-        layout: None,
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs"),
-            compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: 8,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x2],
-            })],
-        },
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: None,
-        multisample: wgpu::MultisampleState {
-            count: samples,
-            ..Default::default()
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs"),
-            compilation_options: Default::default(),
-            targets: &[Some(format.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
+    let pipeline = probe_pipeline(device, samples, format);
     let vertices = probe_vertices(offset);
     let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("raster probe quads"),
@@ -334,6 +303,48 @@ pub fn probe(gpu: &Gpu, samples: u32, offset: [f64; 2]) -> Result<ProbeResult, G
         drops: [drops(&counts[0]), drops(&counts[1])],
         consistent_bits: consistent_bits(samples, &counts),
         counts,
+    })
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+/// The probe's pipeline: [`PROBE_WGSL`]'s white quads, position-only vertices, no depth, at
+/// `samples` into `format`.
+fn probe_pipeline(
+    device: &wgpu::Device,
+    samples: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("raster probe"),
+        source: wgpu::ShaderSource::Wgsl(PROBE_WGSL.into()),
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("raster probe"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: 8,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x2],
+            })],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: None,
+        multisample: wgpu::MultisampleState {
+            count: samples,
+            ..Default::default()
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
     })
 }
 

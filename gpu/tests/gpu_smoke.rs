@@ -18,10 +18,8 @@ fn vertex(x: f32, y: f32) -> Vertex {
     }
 }
 
-#[test]
-fn one_triangle_renders_and_reads_back() {
-    let Some(gpu) = gpu() else { return };
-    eprintln!("adapter: {}", gpu.describe());
+/// One red triangle over the left half of the view, and a camera that frames y ∈ [-1, 1].
+fn left_half_triangle() -> (Geometry, FrameState) {
     let geometry = Geometry {
         // Covers the left half of the view; the right half stays clear.
         vertices: vec![vertex(-1.0, -1.0), vertex(0.0, -1.0), vertex(-1.0, 1.0)],
@@ -50,6 +48,54 @@ fn one_triangle_renders_and_reads_back() {
         },
         poses: vec![],
     };
+    (geometry, frame)
+}
+
+/// The smoke pipeline: the plain vertex stage and `fs_smoke`, over `scene`'s group 0, into
+/// `format` without depth.
+fn smoke_pipeline(
+    device: &wgpu::Device,
+    scene: &SceneGpu,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    let source = trisort_gpu::smoke_shader();
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("smoke"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: None,
+        bind_group_layouts: &[Some(&scene.layout)],
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("smoke"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_plain"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vertex_layout())],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_smoke"),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+#[test]
+fn one_triangle_renders_and_reads_back() {
+    let Some(gpu) = gpu() else { return };
+    eprintln!("adapter: {}", gpu.describe());
+    let (geometry, frame) = left_half_triangle();
     let size = 16;
     let v = View {
         width: size,
@@ -58,44 +104,8 @@ fn one_triangle_renders_and_reads_back() {
         glass_opacity: 0.0,
     };
     let scene = SceneGpu::new(&gpu.device, &gpu.queue, &geometry, &[frame], v);
-    let source = trisort_gpu::smoke_shader();
-    let module = gpu
-        .device
-        .create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("smoke"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-    let layout = gpu
-        .device
-        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: None,
-            bind_group_layouts: &[Some(&scene.layout)],
-            immediate_size: 0,
-        });
     let format = wgpu::TextureFormat::Rgba8Unorm;
-    let pipeline = gpu
-        .device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("smoke"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_plain"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vertex_layout())],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_smoke"),
-                compilation_options: Default::default(),
-                targets: &[Some(format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+    let pipeline = smoke_pipeline(&gpu.device, &scene, format);
     let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("target"),
         size: wgpu::Extent3d {

@@ -131,6 +131,20 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .map_async(wgpu::MapMode::Read, |r| r.expect("map"));
     device.poll(wgpu::PollType::wait_indefinitely())?;
     let data = staging.slice(..).get_mapped_range()?.to_vec();
+    let (covered, checksum) = coverage_and_checksum(&data, row, width, height);
+    println!(
+        "frame {frame} of {}: {} triangles in {} draw(s); {covered} of {} pixels covered; checksum {checksum:016x}",
+        player.frame_count(),
+        player.frame_triangles(frame),
+        player.frame_commands(frame).len(),
+        width as u64 * height as u64,
+    );
+    Ok(())
+}
+
+/// How many pixels of a read-back RGBA8 image (`height` rows of `width` pixels, each row
+/// `row` bytes apart) are not black, and an FNV-1a checksum over its pixels.
+fn coverage_and_checksum(data: &[u8], row: u32, width: u32, height: u32) -> (u64, u64) {
     let mut covered = 0u64;
     let mut checksum = 0xcbf2_9ce4_8422_2325u64; // FNV-1a over the pixels
     for y in 0..height as usize {
@@ -143,12 +157,5 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
-    println!(
-        "frame {frame} of {}: {} triangles in {} draw(s); {covered} of {} pixels covered; checksum {checksum:016x}",
-        player.frame_count(),
-        player.frame_triangles(frame),
-        player.frame_commands(frame).len(),
-        width as u64 * height as u64,
-    );
-    Ok(())
+    (covered, checksum)
 }
