@@ -1,35 +1,13 @@
-//! `trisort play BAKED --window`: a winit viewer that plays a baked file through the real
-//! [`trisort_player::Player`] into a window.
-//!
-//! Each frame, the player draws into an offscreen `Rgba16Float` target (multisampled at the
-//! chosen sample count and resolved, with a depth buffer in `depth` mode), exactly as the
-//! headless `play --out-dir` renders; a full-screen pass then copies that target to the
-//! window's surface, composites the background under it in `saturate` mode and applies the
-//! sRGB transfer function, quantized once by the store. The window therefore shows the pixels
-//! of the PNG frames (within rounding of the GPU's `pow`), whatever format the surface has.
-//!
-//! The window opens at the recorded size (or `--size`) and can be resized: the player is then
-//! rebuilt at the new size (its projection follows the window's aspect ratio) once the size
-//! has settled, and its warnings say that the sorted order is exact only at the recorded size.
-//!
-//! Controls: Space play/pause; Right/Left step one frame; Home/End first/last frame; drag with
-//! the left mouse button, or the keys 0–9, to scrub (0–9 jump to tenths of the range);
-//! Escape or Q quit. Playback loops over the frame range at `--fps`, by default the path's
-//! rate stored in the baked file (30 for a file that stores none). `--variant` plays a
-//! material variant, applied again whenever the player is rebuilt. The title shows the frame
-//! index.
+//! The viewer's event loop: playback state, input and timing. What to show is decided here;
+//! [`crate::gfx`] draws it.
 
 use std::collections::HashSet;
 use std::ops::Range;
-use std::path::{Path, PathBuf};
-use std::process::ExitCode;
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use anyhow::{anyhow, bail, Context, Result};
-use serde_json::json;
 use trisort_format::Baked;
-use trisort_player::Mode;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, KeyEvent, MouseButton, WindowEvent};
@@ -37,109 +15,53 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
-use crate::common::{print_json, FrameRange};
+use crate::gfx::{Gfx, PlaySettings};
+use crate::{Played, Session, ViewerError, ViewerHost};
 
-mod gfx;
-use gfx::{Gfx, PlaySettings};
-
-use super::play::ShadingArgs;
-
-/// The error when no window can be opened.
-pub const NO_DISPLAY: &str =
-    "no display: --window needs X11 or Wayland; use --out-dir for PNG frames";
+type Result<T> = std::result::Result<T, ViewerError>;
 
 /// How long a new window size must stay unchanged before the player is rebuilt at it (a
 /// resize by dragging sends many sizes; in between, the last frame is stretched).
 const RESIZE_SETTLE: Duration = Duration::from_millis(150);
 
-/// What `play --window` was asked for.
-pub struct WindowArgs<'a> {
-    /// The baked file.
-    pub baked: &'a Path,
-    /// Frames to play (default: all); playback loops over them.
-    pub frames: Option<FrameRange>,
-    /// Initial window size (default: the recorded size).
-    pub size: Option<(u32, u32)>,
-    /// MSAA samples (default: the recorded count).
-    pub samples: Option<u32>,
-    /// Compositing mode.
-    pub mode: Mode,
-    /// Glass opacity (default: the recorded one).
-    pub glass_opacity: Option<f32>,
-    /// Playback rate in frames per second (default: the file's, else 30).
-    pub fps: Option<f64>,
-    /// Material variant to play (default: the file's default materials).
-    pub variant: Option<String>,
-    /// Surface model and tone map.
-    pub shading: ShadingArgs,
-    /// For tests and automation: quit after presenting this many frames.
-    pub exit_after: Option<u64>,
-    /// Print the summary as JSON.
-    pub json: bool,
-    /// Refuse a device outside the bake's raster profile (`play --strict-profile`); without
-    /// it, warn.
-    pub strict_profile: bool,
-}
+/// The controls, told to the user once the event loop exists.
+const CONTROLS: &str = "window controls: Space play/pause, Right/Left step, Home/End \
+                        first/last, drag or 0-9 to scrub, Escape/Q quit";
 
-/// Whether the environment names a display server. Only Linux and the BSDs need one named;
-/// elsewhere the platform always has a window system.
-fn display_named() -> bool {
-    if cfg!(all(
-        unix,
-        not(any(
-            target_os = "macos",
-            target_os = "ios",
-            target_os = "android"
-        ))
-    )) {
-        ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
-            .iter()
-            .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
-    } else {
-        true
-    }
-}
-
-/// Opens the viewer and plays until the window is closed (or `exit_after` frames were
-/// presented). Errors with [`NO_DISPLAY`] when there is no display, before reading the file.
-pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
-    if !display_named() {
-        bail!("{NO_DISPLAY}");
-    }
-    if let Some(fps) = a.fps.filter(|f| !(f.is_finite() && *f > 0.0)) {
-        bail!("--fps must be a positive number, not {fps}");
-    }
-    let baked = trisort_player::open_baked(a.baked)?;
-    // Checked once here (the file's structure check holds its fps finite and positive).
-    let fps = a.fps.or(baked.fps).unwrap_or(30.0);
-    baked
-        .geometry
-        .variant_materials(a.variant.as_deref())
-        .with_context(|| format!("playing {}", a.baked.display()))?;
-    let n = baked.frames.len() as u32;
-    let range = match &a.frames {
-        Some(r) => r.resolve(n)?,
-        None if n == 0 => bail!("{}: the baked file has no frames", a.baked.display()),
-        None => 0..n,
-    };
-    let event_loop = EventLoop::new().map_err(|e| anyhow!("{NO_DISPLAY} ({e})"))?;
-    let name = a.baked.file_name().map_or_else(
-        || a.baked.display().to_string(),
+/// Runs the event loop of `session` over `range` until the window closes.
+pub(crate) fn run(
+    session: Session,
+    range: Range<u32>,
+    host: &mut dyn ViewerHost,
+) -> Result<Played> {
+    let event_loop = EventLoop::new().map_err(|e| ViewerError::NoDisplay {
+        detail: Some(e.to_string()),
+    })?;
+    let Session {
+        path,
+        baked,
+        options,
+        fps,
+    } = session;
+    let name = path.file_name().map_or_else(
+        || path.display().to_string(),
         |s| s.to_string_lossy().into_owned(),
     );
     let mut viewer = Viewer {
-        size: a
+        size: options
             .size
             .unwrap_or((baked.settings.width.max(1), baked.settings.height.max(1))),
-        samples: a.samples.unwrap_or(baked.settings.samples).max(1),
-        mode: a.mode,
-        glass_opacity: a.glass_opacity,
-        shading: a.shading,
+        play: PlaySettings {
+            samples: options.samples.unwrap_or(baked.settings.samples).max(1),
+            mode: options.mode,
+            glass_opacity: options.glass_opacity,
+            shading: options.shading,
+            tone_map: options.tone_map,
+        },
         period: Duration::from_secs_f64(1.0 / fps),
-        variant: a.variant,
-        exit_after: a.exit_after,
-        strict_profile: a.strict_profile,
-        path: a.baked.to_path_buf(),
+        variant: options.variant,
+        exit_after: options.exit_after,
+        path,
         name,
         baked,
         frame: range.start,
@@ -154,53 +76,37 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
         printed_warnings: HashSet::new(),
         gfx: None,
         error: None,
+        host,
     };
-    eprintln!(
-        "trisort: window controls: Space play/pause, Right/Left step, Home/End first/last, \
-         drag or 0-9 to scrub, Escape/Q quit"
-    );
+    viewer.host.note(CONTROLS);
     let run = event_loop.run_app(&mut viewer);
     if let Some(e) = viewer.error.take() {
         return Err(e);
     }
-    run.context("window event loop")?;
-    let device = viewer
-        .gfx
-        .as_ref()
-        .map_or_else(String::new, |g| g.gpu.info.name.clone());
-    if a.json {
-        print_json(&json!({
-            "device": device,
-            "mode": viewer.mode.name(),
-            "variant": viewer.variant,
-            "fps": fps,
-            "presented_frames": viewer.presented,
-            "last_frame": viewer.frame,
-        }));
-    } else {
-        println!(
-            "presented {} frames ({} mode) on {device}; last frame {}",
-            viewer.presented,
-            viewer.mode.name(),
-            viewer.frame
-        );
-    }
-    Ok(ExitCode::SUCCESS)
+    run.map_err(ViewerError::EventLoop)?;
+    Ok(Played {
+        device: viewer
+            .gfx
+            .as_ref()
+            .map_or_else(String::new, |g| g.gpu.info.name.clone()),
+        mode: viewer.play.mode,
+        variant: viewer.variant,
+        fps,
+        presented: viewer.presented,
+        last_frame: viewer.frame,
+    })
 }
 
 /// Playback state and, once the window exists, its GPU objects.
-struct Viewer {
+struct Viewer<'h> {
     /// Initial window size.
     size: (u32, u32),
-    samples: u32,
-    mode: Mode,
-    glass_opacity: Option<f32>,
-    shading: ShadingArgs,
+    /// Samples, mode, glass opacity and shading of every player built.
+    play: PlaySettings,
     period: Duration,
     /// Material variant, applied to every player built.
     variant: Option<String>,
     exit_after: Option<u64>,
-    strict_profile: bool,
     path: PathBuf,
     name: String,
     baked: Baked,
@@ -218,10 +124,12 @@ struct Viewer {
     title: String,
     printed_warnings: HashSet<String>,
     gfx: Option<Gfx>,
-    error: Option<anyhow::Error>,
+    error: Option<ViewerError>,
+    /// Checks the device and hears the lines for the user.
+    host: &'h mut dyn ViewerHost,
 }
 
-impl ApplicationHandler for Viewer {
+impl ApplicationHandler for Viewer<'_> {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
         if self.gfx.is_some() {
             return;
@@ -330,9 +238,9 @@ impl ApplicationHandler for Viewer {
     }
 }
 
-impl Viewer {
+impl Viewer<'_> {
     /// Records the first error and stops the event loop.
-    fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: ViewerError) {
         if self.error.is_none() {
             self.error = Some(e);
         }
@@ -409,7 +317,7 @@ impl Viewer {
             self.range.start,
             self.range.end - 1,
             if self.playing { "playing" } else { "paused" },
-            self.mode.name(),
+            self.play.mode.name(),
         );
         if title != self.title {
             g.window.set_title(&title);
@@ -423,29 +331,29 @@ impl Viewer {
             .with_title(format!("{} · trisort", self.name))
             .with_inner_size(PhysicalSize::new(self.size.0, self.size.1))
             .with_resizable(true);
-        let window = Arc::new(
-            event_loop
-                .create_window(attributes)
-                .map_err(|e| anyhow!("{NO_DISPLAY} (opening a window: {e})"))?,
-        );
-        let play = PlaySettings {
-            samples: self.samples,
-            mode: self.mode,
-            glass_opacity: self.glass_opacity,
-            shading: self.shading.shading,
-            tone_map: self.shading.tonemap,
-        };
-        let gfx = Gfx::open(window, event_loop.owned_display_handle(), &self.baked, play)
-            .with_context(|| format!("playing {}", self.path.display()))?;
-        // The window's device against the bake's raster profile: a warning, or a refusal.
-        crate::cmd::play::check_profile(
-            &gfx.gpu,
+        let window =
+            Arc::new(
+                event_loop
+                    .create_window(attributes)
+                    .map_err(|e| ViewerError::NoDisplay {
+                        detail: Some(format!("opening a window: {e}")),
+                    })?,
+            );
+        let gfx = Gfx::open(
+            window,
+            event_loop.owned_display_handle(),
             &self.baked,
-            self.samples,
-            [0.0, 0.0],
-            &self.path,
-            self.strict_profile,
-        )?;
+            self.play,
+        )
+        .map_err(|e| ViewerError::Open {
+            file: self.path.clone(),
+            source: Box::new(e),
+        })?;
+        self.host.note(&gfx.describe());
+        // The window's device against the bake's raster profile: a warning, or a refusal.
+        (self.host)
+            .check_device(&gfx.gpu, &self.baked, self.play.samples)
+            .map_err(ViewerError::Device)?;
         (gfx.targets.player()).set_variant(&gfx.gpu.queue, self.variant.as_deref())?;
         self.print_warnings(gfx.targets.player().warnings());
         Ok(gfx)
@@ -461,11 +369,11 @@ impl Viewer {
         Ok(())
     }
 
-    /// Prints the player's warnings that were not printed before.
+    /// Passes on the player's warnings that were not passed on before.
     fn print_warnings(&mut self, warnings: &[String]) {
         for w in warnings {
             if self.printed_warnings.insert(w.clone()) {
-                eprintln!("trisort: warning: {w}");
+                self.host.warning(w);
             }
         }
     }

@@ -1,10 +1,9 @@
 //! The viewer's GPU side: the window's surface and device, the player and its offscreen
 //! target ([`trisort_player::OnScreen`]), and the blit that presents the target
-//! ([`trisort_gpu::present`]). The event loop (`mod.rs`) decides what to show; this draws it.
+//! ([`trisort_gpu::present`]). The event loop (`app.rs`) decides what to show; this draws it.
 
 use std::sync::Arc;
 
-use anyhow::{anyhow, bail, Context, Result};
 use trisort_format::Baked;
 use trisort_gpu::present::{configure_surface, Blit};
 use trisort_gpu::{Gpu, UncapturedError};
@@ -12,11 +11,15 @@ use trisort_player::{OnScreen, OnScreenSettings};
 use winit::event_loop::OwnedDisplayHandle;
 use winit::window::Window;
 
+use crate::ViewerError;
+
+type Result<T> = std::result::Result<T, ViewerError>;
+
 /// How the viewer plays: sample count, mode and glass opacity (`None`: as recorded).
-pub(super) type PlaySettings = OnScreenSettings;
+pub(crate) type PlaySettings = OnScreenSettings;
 
 /// The window, its surface and device, the copy-to-surface pipeline and the player's targets.
-pub(super) struct Gfx {
+pub(crate) struct Gfx {
     pub window: Arc<Window>,
     surface: wgpu::Surface<'static>,
     pub gpu: Gpu,
@@ -45,25 +48,14 @@ impl Gfx {
         let instance = wgpu::Instance::new(desc);
         let surface = instance
             .create_surface(window.clone())
-            .context("creating a wgpu surface for the window")?;
-        let gpu = Gpu::for_surface(&instance, &surface)
-            .context("opening a GPU device that can present to this window")?;
+            .map_err(ViewerError::Surface)?;
+        let gpu = Gpu::for_surface(&instance, &surface).map_err(ViewerError::Adapter)?;
         let uncaptured = UncapturedError::install(&gpu.device);
         let inner = window.inner_size();
         let (width, height) = (inner.width.max(1), inner.height.max(1));
         let setup = configure_surface(&gpu, &surface, (width, height))?;
         let blit = Blit::new(&gpu.device, setup.view_format, play.mode);
         let targets = OnScreen::new(&gpu, baked, &blit, (width, height), play)?;
-        eprintln!(
-            "trisort: window {width}x{height} on {} ({:?}), surface {:?} written as {:?}, \
-             {} sample(s), {} mode",
-            gpu.info.name,
-            gpu.info.backend,
-            setup.config.format,
-            setup.view_format,
-            play.samples,
-            play.mode
-        );
         Ok(Gfx {
             window,
             surface,
@@ -93,7 +85,7 @@ impl Gfx {
         self.gpu
             .device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
+            .map_err(ViewerError::Poll)?;
         self.targets = OnScreen::new(&self.gpu, baked, &self.blit, size, self.play)?;
         Ok(())
     }
@@ -121,9 +113,10 @@ impl Gfx {
                 self.window.request_redraw();
                 return Ok(false);
             }
-            wgpu::CurrentSurfaceTexture::Lost => bail!("the window's surface was lost"),
+            wgpu::CurrentSurfaceTexture::Lost => return Err(ViewerError::SurfaceLost),
             wgpu::CurrentSurfaceTexture::Validation => {
-                bail!("wgpu: {}", self.uncaptured.take().unwrap_or_default())
+                let e = self.uncaptured.take().unwrap_or_default();
+                return Err(ViewerError::Wgpu(e));
             }
         };
         self.targets.submit(
@@ -134,10 +127,26 @@ impl Gfx {
             frame,
         )?;
         if let Some(e) = self.uncaptured.take() {
-            bail!("wgpu: {e}");
+            return Err(ViewerError::Wgpu(e));
         }
         self.window.pre_present_notify();
         self.gpu.queue.present(surface_texture);
         Ok(true)
+    }
+
+    /// The line that tells the user what the window plays on: size, device and backend,
+    /// surface format and the format written through, samples and mode.
+    pub fn describe(&self) -> String {
+        format!(
+            "window {}x{} on {} ({:?}), surface {:?} written as {:?}, {} sample(s), {} mode",
+            self.surface_config.width,
+            self.surface_config.height,
+            self.gpu.info.name,
+            self.gpu.info.backend,
+            self.surface_config.format,
+            self.view_format,
+            self.play.samples,
+            self.play.mode
+        )
     }
 }

@@ -1,0 +1,178 @@
+//! The interactive viewer: a winit window that plays a baked file through the real
+//! [`trisort_player::Player`].
+//!
+//! Each frame, the player draws into an offscreen `Rgba16Float` target (multisampled at the
+//! chosen sample count and resolved, with a depth buffer in `depth` mode), exactly as headless
+//! playback renders; a full-screen pass then copies that target to the window's surface,
+//! composites the background under it in `saturate` mode and applies the sRGB transfer
+//! function, quantized once by the store. The window therefore shows the pixels of the PNG
+//! frames (within rounding of the GPU's `pow`), whatever format the surface has.
+//!
+//! The window opens at the recorded size (or [`ViewerOptions::size`]) and can be resized: the
+//! player is then rebuilt at the new size (its projection follows the window's aspect ratio)
+//! once the size has settled, and its warnings say that the sorted order is exact only at the
+//! recorded size.
+//!
+//! Controls: Space play/pause; Right/Left step one frame; Home/End first/last frame; drag with
+//! the left mouse button, or the keys 0–9, to scrub (0–9 jump to tenths of the range);
+//! Escape or Q quit. Playback loops over the frame range at [`ViewerOptions::fps`], by default
+//! the path's rate stored in the baked file (30 for a file that stores none). A material
+//! variant ([`ViewerOptions::variant`]) is applied again whenever the player is rebuilt. The
+//! title shows the frame index.
+//!
+//! Use: [`Session::open`] checks the display and reads the file, [`Session::play`] runs the
+//! event loop until the window is closed and returns what was [`Played`]. The library prints
+//! nothing: what the user should read (the controls, the device, the player's warnings) goes
+//! to the caller's [`ViewerHost`], which also decides whether the window's device may play the
+//! bake.
+#![warn(missing_docs)]
+
+mod app;
+mod error;
+mod gfx;
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+pub use error::{BoxError, ViewerError};
+use trisort_format::{Baked, Mode};
+use trisort_gpu::{Gpu, Shading, ToneMap};
+
+/// How to play: window size, sample count, mode, shading, rate and material variant.
+#[derive(Clone, Debug)]
+pub struct ViewerOptions {
+    /// Initial window size (`None`: the recorded size).
+    pub size: Option<(u32, u32)>,
+    /// MSAA samples (`None`: the recorded count).
+    pub samples: Option<u32>,
+    /// Compositing mode.
+    pub mode: Mode,
+    /// Glass opacity (`None`: the recorded one).
+    pub glass_opacity: Option<f32>,
+    /// Surface model.
+    pub shading: Shading,
+    /// Tone map of the `pbr` surface model.
+    pub tone_map: ToneMap,
+    /// Playback rate in frames per second (`None`: the file's, else 30); must be positive.
+    pub fps: Option<f64>,
+    /// Material variant to play (`None`: the file's default materials).
+    pub variant: Option<String>,
+    /// For tests and automation: quit after presenting this many frames.
+    pub exit_after: Option<u64>,
+}
+
+/// What the caller of [`Session::play`] provides: the check of the window's device, and where
+/// the lines for the user go.
+pub trait ViewerHost {
+    /// Checks the window's device against the bake's raster profile before anything plays; an
+    /// error refuses to play (and is returned as [`ViewerError::Device`]).
+    fn check_device(&mut self, gpu: &Gpu, baked: &Baked, samples: u32) -> Result<(), BoxError>;
+    /// A line for the user: the controls, once the event loop exists, then the window's size,
+    /// device and surface format.
+    fn note(&mut self, line: &str);
+    /// A warning of the player (each distinct text once per session), e.g. that the window's
+    /// size differs from the recorded one.
+    fn warning(&mut self, warning: &str);
+}
+
+/// What a session played, once the window closed.
+#[derive(Clone, Debug)]
+pub struct Played {
+    /// The window's GPU (empty if the window never opened).
+    pub device: String,
+    /// Compositing mode.
+    pub mode: Mode,
+    /// The material variant played.
+    pub variant: Option<String>,
+    /// Playback rate in frames per second.
+    pub fps: f64,
+    /// Frames presented to the window.
+    pub presented: u64,
+    /// The frame shown last.
+    pub last_frame: u32,
+}
+
+/// A baked file opened for the viewer, with its options checked; not yet a window.
+pub struct Session {
+    path: PathBuf,
+    baked: Baked,
+    options: ViewerOptions,
+    fps: f64,
+}
+
+/// Whether the environment names a display server. Only Linux and the BSDs need one named;
+/// elsewhere the platform always has a window system.
+pub fn display_named() -> bool {
+    if cfg!(all(
+        unix,
+        not(any(
+            target_os = "macos",
+            target_os = "ios",
+            target_os = "android"
+        ))
+    )) {
+        ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
+            .iter()
+            .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
+    } else {
+        true
+    }
+}
+
+impl Session {
+    /// Checks that a display is named ([`ViewerError::NoDisplay`], before reading the file, so
+    /// a headless machine gets that error first) and that the rate is positive, then reads
+    /// `path` and checks that it has the material variant asked for.
+    pub fn open(path: &Path, options: ViewerOptions) -> Result<Session, ViewerError> {
+        if !display_named() {
+            return Err(ViewerError::NoDisplay { detail: None });
+        }
+        if let Some(fps) = options.fps.filter(|f| !(f.is_finite() && *f > 0.0)) {
+            return Err(ViewerError::Fps(fps));
+        }
+        let baked = trisort_player::open_baked(path)?;
+        // Checked once here (the file's structure check holds its fps finite and positive).
+        let fps = options.fps.or(baked.fps).unwrap_or(30.0);
+        baked
+            .geometry
+            .variant_materials(options.variant.as_deref())
+            .map_err(|source| ViewerError::Variant {
+                file: path.to_path_buf(),
+                source,
+            })?;
+        Ok(Session {
+            path: path.to_path_buf(),
+            baked,
+            options,
+            fps,
+        })
+    }
+
+    /// Frames in the file (for resolving the range to play).
+    pub fn frame_count(&self) -> u32 {
+        self.baked.frames.len() as u32
+    }
+
+    /// Opens the window and plays `frames` (`None`: all; playback loops over them) until the
+    /// window is closed or [`ViewerOptions::exit_after`] frames were presented.
+    pub fn play(
+        self,
+        frames: Option<Range<u32>>,
+        host: &mut dyn ViewerHost,
+    ) -> Result<Played, ViewerError> {
+        let n = self.frame_count();
+        let range = match frames {
+            Some(r) if r.start >= r.end || r.end > n => {
+                return Err(ViewerError::FrameRange {
+                    start: r.start,
+                    end: r.end,
+                    frames: n,
+                })
+            }
+            Some(r) => r,
+            None if n == 0 => return Err(ViewerError::NoFrames { file: self.path }),
+            None => 0..n,
+        };
+        app::run(self, range, host)
+    }
+}
