@@ -68,7 +68,8 @@ pub struct PlayerConfig {
     /// `None` skips that check.
     pub device: Option<DeviceInfo>,
     /// Surface model: [`Shading::Pbr`] lit by the file's environment (the default), or
-    /// [`Shading::Basic`], the one light plus ambient trisort drew before.
+    /// [`Shading::Basic`]: one view-space light plus ambient, ignoring every map (cheap, and
+    /// independent of the environment).
     pub shading: Shading,
     /// Tone map of [`Shading::Pbr`].
     pub tone_map: ToneMap,

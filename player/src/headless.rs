@@ -1,6 +1,7 @@
 //! Headless rendering for the CLI (`trisort play`) and the tests: frames drawn by a [`Player`]
 //! into an `Rgba16Float` target (MSAA resolved to one sample), read back and quantized once to
-//! 8-bit sRGB, the way the exact reference renders (DESIGN § Frame accuracy).
+//! 8-bit sRGB, the way the exact reference renders: one rounding, at the end, so the player's
+//! frames and the reference's are quantized alike and differ only where their colours do.
 
 use trisort_format::Baked;
 use trisort_gpu::{Gpu, Shading, ToneMap};

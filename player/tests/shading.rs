@@ -1,6 +1,6 @@
 //! What the surface function draws (real renders on the test GPU): each map of the PBR model
 //! changes pixels, the environment, exposure and tone map are used, and `--shading basic`
-//! draws the one light plus ambient of before, ignoring every map.
+//! draws one view-space light plus ambient, ignoring every map.
 
 use trisort_format::{Baked, Environment, Material, Sun, Texture, TextureSlot};
 use trisort_gpu::{Gpu, Shading, ToneMap};
@@ -259,7 +259,7 @@ fn basic_shading_draws_the_old_model_and_ignores_the_maps() {
         old,
         "basic shading has no tone map"
     );
-    // One light plus ambient, as before physically based shading.
+    // One view-space light plus ambient.
     let want = srgb8(lit([0.5, 0.5, 0.5, 1.0])[..3].try_into().unwrap());
     for (x, y) in [(2, 2), (SIZE / 2, SIZE / 2), (SIZE - 3, SIZE - 3)] {
         let got = pixel(&old, x, y);

@@ -1,4 +1,4 @@
-//! The GLES 3.0 / WebGL2 path (issue 14): WebGL2 limits pick the data-texture bindings and the
+//! The GLES 3.0 / WebGL2 path (the web player's fallback): WebGL2 limits pick the data-texture bindings and the
 //! direct draws, and draw the same bytes as the storage tier with the multi-draw; on GL
 //! (EGL, Mesa's llvmpipe) both tiers draw the same bytes too. The bake read back with the
 //! pure-Rust decoder the wasm32 build uses is the bake written.

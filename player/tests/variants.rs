@@ -1,4 +1,4 @@
-//! Material variants at play time (issue 17, part 3): `set_variant` draws exactly what a file
+//! Material variants at play time (`KHR_materials_variants`): `set_variant` draws exactly what a file
 //! whose materials are the variant's draws, switches back, and refuses (leaving the table as it
 //! was) a variant that is unknown or that changes what decides visibility.
 

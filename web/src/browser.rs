@@ -53,7 +53,10 @@ impl WebPlayer {
     ///
     /// `shading` (`pbr`, the default, or `basic`) and `tonemap` (`neutral`, the default, or
     /// `aces`) light it as `trisort play --shading --tonemap` does.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the signature is the page's JavaScript API (`WebPlayer.open`)"
+    )]
     pub async fn open(
         canvas: web_sys::HtmlCanvasElement,
         bytes: Vec<u8>,

@@ -138,7 +138,10 @@ pub unsafe extern "C" fn trisort_texture_info(
 /// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
 /// `len` as in the module conventions.
 #[no_mangle]
-#[allow(clippy::too_many_arguments)]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "the signature is the C ABI of include/trisort.h"
+)]
 pub unsafe extern "C" fn trisort_texture_level(
     h: *const TrisortBaked,
     texture: u32,

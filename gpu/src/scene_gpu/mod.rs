@@ -201,10 +201,12 @@ impl SceneGpu {
             usage: wgpu::BufferUsages::VERTEX,
         });
         let textures = upload_textures(device, queue, geometry, visibility_only);
-        let sampler = linear_sampler(device, "material textures", wgpu::AddressMode::ClampToEdge);
+        let sampler =
+            trilinear_sampler(device, "material textures", wgpu::AddressMode::ClampToEdge);
         let env = upload_environment(device, queue, lighting.environment);
         // The environment wraps around in longitude (u) and stops at the poles (v).
-        let environment_sampler = linear_sampler(device, "environment", wgpu::AddressMode::Repeat);
+        let environment_sampler =
+            trilinear_sampler(device, "environment", wgpu::AddressMode::Repeat);
         let lighting_uniform = LightingUniform::new(&lighting, env.levels);
         let lighting_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("lighting"),
@@ -323,7 +325,7 @@ impl SceneGpu {
 
     /// [`SceneGpu::set_subpixel_offset`] for the frames of `frames` only (the recorder's
     /// jittered patterns move one frame at a time: rewriting every frame's uniforms for each
-    /// pattern of each frame grew with the square of the path's length).
+    /// pattern of each frame would cost time quadratic in the path's length).
     pub fn set_subpixel_offset_of(
         &self,
         queue: &wgpu::Queue,
@@ -366,7 +368,7 @@ impl SceneGpu {
 }
 
 /// A trilinear sampler that clamps v to the edge and addresses u with `address_mode_u`.
-fn linear_sampler(
+fn trilinear_sampler(
     device: &wgpu::Device,
     label: &str,
     address_mode_u: wgpu::AddressMode,
