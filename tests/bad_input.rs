@@ -84,7 +84,7 @@ fn good_files(dir: &Path) -> (Recording, Baked) {
     let rec = small_turntable(7);
     let baked = merge(std::slice::from_ref(&rec), &MergeOptions::default())
         .unwrap()
-        .lit(trisort_format::Environment::studio());
+        .lit(trisort_light::studio());
     write_rec(dir, "good.rec", &rec);
     trisort_format::write_file_atomic(FileKind::Baked, &dir.join("good.baked"), &baked).unwrap();
     (rec, baked)

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use trisort_format::{Baked, Environment, FileKind, Recording};
+use trisort_format::{Baked, FileKind, Recording};
 use trisort_merger::{Choice, Layout, MergeOptions, Strategy};
 
 use crate::support::*;
@@ -55,7 +55,7 @@ fn car_concept_orbit_merges_validly_with_every_strategy_and_layout() {
             };
             let baked = trisort_merger::merge(recs, &opts)
                 .unwrap()
-                .lit(Environment::studio());
+                .lit(trisort_light::studio());
             let report = trisort_verify::check_graph(recs, &baked);
             assert!(report.ok, "{strategy:?} {layout:?}: {:?}", report.problems);
             let s = &baked.stats;

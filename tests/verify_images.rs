@@ -53,7 +53,7 @@ fn bake(
     let rec = record(gpu, &job, None, |_| {}).expect("recording succeeds");
     let baked = trisort_merger::merge(std::slice::from_ref(&rec), &Default::default())
         .expect("merge succeeds")
-        .lit(trisort_format::Environment::studio());
+        .lit(trisort_light::studio());
     let graph = trisort_verify::check_graph(std::slice::from_ref(&rec), &baked);
     assert!(graph.ok, "graph rules: {:?}", graph.problems);
     (rec, baked)

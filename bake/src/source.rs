@@ -161,7 +161,7 @@ impl Light {
     /// the file when it cannot be).
     pub fn load(&self) -> Result<Environment, BakeError> {
         match self {
-            Light::Studio => Ok(Environment::studio()),
+            Light::Studio => Ok(trisort_light::studio()),
             Light::Hdr(path) => Ok(trisort_scene::load_hdr(path)?),
         }
     }

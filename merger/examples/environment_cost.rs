@@ -15,7 +15,7 @@ use trisort_merger::{merge, MergeOptions};
 
 fn main() {
     let t = Instant::now();
-    let studio = Environment::studio();
+    let studio = trisort_light::studio();
     let seconds = t.elapsed().as_secs_f64();
     let rec = turntable(&Turntable {
         objects: 2,

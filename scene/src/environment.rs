@@ -64,7 +64,7 @@ pub enum EnvironmentError {
 
 /// Loads an equirectangular Radiance `.hdr` image (row 0 at the zenith, column 0 looking along
 /// +X, the image's middle column along −X; [`Environment`] describes the mapping) and
-/// prefilters it ([`Environment::from_equirect`]). The environment is named after the file
+/// prefilters it ([`trisort_light::from_equirect`]). The environment is named after the file
 /// (its name without folders), has no sun and exposure 1.
 ///
 /// Files starting `#?RADIANCE` are read strictly, other `#?` signatures (`#?RGBE`) leniently.
@@ -121,7 +121,7 @@ pub fn load_hdr(path: &Path) -> Result<Environment, EnvironmentError> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string());
-    Environment::from_equirect(&name, width, height, &rgb).map_err(|problem| {
+    trisort_light::from_equirect(&name, width, height, &rgb).map_err(|problem| {
         EnvironmentError::Unusable {
             file: file(),
             problem,

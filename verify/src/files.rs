@@ -33,10 +33,7 @@ pub(crate) fn collect_frames<'a>(
     // The light the file claims: the built-in studio is made anew and compared (a file
     // light from an .hdr file is checked by `trisort verify --environment FILE.hdr`).
     if baked.environment.name == "studio" {
-        if let Some(what) = baked
-            .environment
-            .difference(&trisort_format::Environment::studio())
-        {
+        if let Some(what) = baked.environment.difference(&trisort_light::studio()) {
             report.problem(format!(
                 "the file's environment claims to be the built-in studio but differs: {what}"
             ));
