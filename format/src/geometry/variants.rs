@@ -10,7 +10,7 @@ use super::{AlphaMode, Geometry, Material, Texture, TextureTransform};
 /// glTF maps variants per primitive; the importer turns that into one table per variant over
 /// [`Geometry::materials`] (giving a primitive a slot of its own where two primitives sharing a
 /// material map it differently), so a variant is applied by rewriting the material table alone:
-/// vertices keep their [`Vertex::material`] slot.
+/// vertices keep their [`Vertex::material`](super::Vertex::material) slot.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MaterialVariant {
     /// Name from the file (`""` when unnamed; names need not be unique).
