@@ -26,7 +26,7 @@ const BLUE: [f32; 3] = [0.1, 0.1, 0.9];
 fn quads(materials: &[([f32; 3], f32)], quads: &[([f32; 6], u32)]) -> Geometry {
     let mut g = scene(materials.iter().map(|&(rgb, a)| material(rgb, a)).collect());
     for &([x0, x1, y0, y1, z0, z1], m) in quads {
-        quad(&mut g, x0, x1, y0, y1, z0, z1, m);
+        quad(&mut g, [x0, x1], [y0, y1], [z0, z1], m);
     }
     g
 }
@@ -424,9 +424,9 @@ fn sub_pixel_texture_alpha_verifies_in_every_mode() {
         material([0.6, 0.6, 0.6], 1.0),
     ]);
     g.textures.push(texture);
-    quad(&mut g, -1.0, 1.0, -1.0, 1.0, -6.0, -6.0, 2);
-    quad(&mut g, -0.8, 0.5, -0.7, 0.6, -2.0, -3.0, 0);
-    quad(&mut g, -0.4, 0.9, -0.5, 0.8, -2.5, -3.5, 1);
+    quad(&mut g, [-1.0, 1.0], [-1.0, 1.0], [-6.0, -6.0], 2);
+    quad(&mut g, [-0.8, 0.5], [-0.7, 0.6], [-2.0, -3.0], 0);
+    quad(&mut g, [-0.4, 0.9], [-0.5, 0.8], [-2.5, -3.5], 1);
     // uv: four texels per pixel or so across the quads.
     for (k, v) in g.vertices.iter_mut().enumerate() {
         let corner = k % 4;
@@ -451,7 +451,7 @@ fn saturated_stack(front: f32) -> Geometry {
     for k in 0..10 {
         let m = if k < 7 { 0 } else { 1 };
         let z = -2.0 - k as f32 * 0.3;
-        quad(&mut g, -0.7, 0.7, -0.7, 0.7, z, z, m);
+        quad(&mut g, [-0.7, 0.7], [-0.7, 0.7], [z, z], m);
     }
     g
 }

@@ -24,7 +24,7 @@ fn sample() -> Baked {
     ]);
     for k in 0..4 {
         let z = -1.0 - k as f32;
-        quad(&mut g, -1.0, 1.0, -1.0, 1.0, z, z, (k % 2) as u32);
+        quad(&mut g, [-1.0, 1.0], [-1.0, 1.0], [z, z], (k % 2) as u32);
     }
     g.materials[1].base_color_texture = Some(0);
     g.materials[1].base_color_tex_coord = 1;

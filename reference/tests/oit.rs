@@ -113,9 +113,9 @@ fn stacked() -> Geometry {
         material([0.1, 0.8, 0.3], 0.35),
         material([0.2, 0.3, 0.95], 0.7),
     ]);
-    split_quad(&mut g, -1.5, 0.9, -1.2, 0.8, -3.0, -3.0, 0);
-    split_quad(&mut g, -0.7, 1.6, -0.6, 1.4, -2.2, -4.1, 1);
-    split_quad(&mut g, -1.1, 1.2, -1.5, 0.3, -4.0, -2.0, 2);
+    split_quad(&mut g, [-1.5, 0.9], [-1.2, 0.8], [-3.0, -3.0], 0);
+    split_quad(&mut g, [-0.7, 1.6], [-0.6, 1.4], [-2.2, -4.1], 1);
+    split_quad(&mut g, [-1.1, 1.2], [-1.5, 0.3], [-4.0, -2.0], 2);
     tri(
         &mut g,
         [[-1.8, -1.7, -2.5], [1.7, -1.1, -3.5], [0.2, 1.9, -3.2]],
@@ -137,8 +137,8 @@ fn coplanar_triangles_break_ties_by_id() {
             material([0.95, 0.1, 0.1], 0.6),
             material([0.1, 0.1, 0.95], 0.6),
         ]);
-        split_quad(&mut g, -1.0, 1.0, -1.0, 1.0, -2.5, -3.0, first);
-        split_quad(&mut g, -1.4, 0.6, -0.7, 1.3, -2.5, -3.0, 1 - first);
+        split_quad(&mut g, [-1.0, 1.0], [-1.0, 1.0], [-2.5, -3.0], first);
+        split_quad(&mut g, [-1.4, 0.6], [-0.7, 1.3], [-2.5, -3.0], 1 - first);
         g
     };
     let a = assert_matches("coplanar red first", &build(0), &frames(), 40);
@@ -156,10 +156,10 @@ fn opaque_in_front_matches_the_reference() {
         material([0.2, 0.7, 0.9], 0.4),
         material([0.6, 0.1, 0.6], 1.0),
     ]);
-    split_quad(&mut g, -1.5, 1.5, -1.5, 1.5, -5.0, -5.0, 2);
-    split_quad(&mut g, -1.0, 0.5, -1.0, 1.0, -3.0, -3.0, 1);
-    split_quad(&mut g, -0.2, 1.2, -0.8, 0.6, -2.0, -2.6, 0);
-    split_quad(&mut g, -1.3, 0.0, 0.2, 1.2, -1.5, -1.5, 1);
+    split_quad(&mut g, [-1.5, 1.5], [-1.5, 1.5], [-5.0, -5.0], 2);
+    split_quad(&mut g, [-1.0, 0.5], [-1.0, 1.0], [-3.0, -3.0], 1);
+    split_quad(&mut g, [-0.2, 1.2], [-0.8, 0.6], [-2.0, -2.6], 0);
+    split_quad(&mut g, [-1.3, 0.0], [0.2, 1.2], [-1.5, -1.5], 1);
     let oit = assert_matches("opaque", &g, &frames(), 40);
     for o in &oit {
         assert_eq!(o.dropped, 0);
@@ -171,7 +171,7 @@ fn full_screen_layers(layers: u32) -> Geometry {
     let mut g = scene(vec![material([0.5, 0.6, 0.7], 0.3)]);
     for k in 0..layers {
         let z = -2.0 - k as f32 * 0.25;
-        split_quad(&mut g, -5.0, 5.0, -5.0, 5.0, z, z, 0);
+        split_quad(&mut g, [-5.0, 5.0], [-5.0, 5.0], [z, z], 0);
     }
     g
 }

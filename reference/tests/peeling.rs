@@ -31,7 +31,7 @@ fn stack(n: u32) -> Geometry {
     for k in 0..n {
         let z = -2.0 - k as f32;
         let r = 0.5 + 0.3 * k as f32;
-        quad(&mut g, -r, r, -r, r * 0.8, z, z, k);
+        quad(&mut g, [-r, r], [-r, r * 0.8], [z, z], k);
     }
     g
 }
@@ -244,12 +244,12 @@ fn coplanar_ties_resolve_by_id_as_in_the_reference() {
         material([0.0, 0.0, 1.0], 0.4),
         material([1.0, 1.0, 0.0], 0.7),
     ]);
-    quad(&mut g, -1.0, 0.6, -1.0, 0.6, -3.0, -3.0, 0);
-    quad(&mut g, -0.6, 1.0, -0.6, 1.0, -3.0, -3.0, 1);
-    quad(&mut g, -0.8, 0.8, -0.3, 0.3, -3.0, -3.0, 2);
-    quad(&mut g, -1.2, 1.2, -1.2, 1.2, -2.0, -4.0, 3);
-    quad(&mut g, 0.6, -0.6, -0.9, 0.2, -2.5, -2.5, 0);
-    quad(&mut g, 0.6, -0.6, -0.9, 0.2, -2.5, -2.5, 2);
+    quad(&mut g, [-1.0, 0.6], [-1.0, 0.6], [-3.0, -3.0], 0);
+    quad(&mut g, [-0.6, 1.0], [-0.6, 1.0], [-3.0, -3.0], 1);
+    quad(&mut g, [-0.8, 0.8], [-0.3, 0.3], [-3.0, -3.0], 2);
+    quad(&mut g, [-1.2, 1.2], [-1.2, 1.2], [-2.0, -4.0], 3);
+    quad(&mut g, [0.6, -0.6], [-0.9, 0.2], [-2.5, -2.5], 0);
+    quad(&mut g, [0.6, -0.6], [-0.9, 0.2], [-2.5, -2.5], 2);
     for samples in [1, 4] {
         for mode in [Mode::Blend, Mode::Depth] {
             let r = same_as_reference(
@@ -277,7 +277,7 @@ fn an_opaque_occluder_is_peeled_through_like_the_reference() {
     let mut g = stack(4);
     g.materials.push(material([0.9, 0.9, 0.9], 1.0));
     // Opaque, between the second and third quad, covering the left half.
-    quad(&mut g, -2.0, 0.0, -2.0, 2.0, -3.5, -3.5, 4);
+    quad(&mut g, [-2.0, 0.0], [-2.0, 2.0], [-3.5, -3.5], 4);
     for samples in [1, 4] {
         for mode in [Mode::Blend, Mode::Depth] {
             let r = same_as_reference(

@@ -16,8 +16,8 @@
 //!
 //! // A red half-transparent quad in front of an opaque grey one.
 //! let mut g = scene(vec![material([0.9, 0.1, 0.1], 0.5), material([0.5; 3], 1.0)]);
-//! quad(&mut g, -0.5, 0.5, -0.5, 0.5, -2.0, -2.0, 0);
-//! quad(&mut g, -1.0, 1.0, -1.0, 1.0, -3.0, -3.0, 1);
+//! quad(&mut g, [-0.5, 0.5], [-0.5, 0.5], [-2.0, -2.0], 0);
+//! quad(&mut g, [-1.0, 1.0], [-1.0, 1.0], [-3.0, -3.0], 1);
 //! assert_eq!(g.triangles.len(), 4);
 //! let frame = frame_at(DVec3::ZERO);
 //! assert!(frame.camera.eye().length() < 1e-12);
@@ -29,14 +29,16 @@ use trisort_format::{
     AlphaMode, Camera, FrameState, Geometry, Material, Node, RecordSettings, Vertex,
 };
 
-/// Adds a quad with corners (x0, y0, z0), (x1, y0, z1), (x1, y1, z1), (x0, y1, z0), facing +Z:
-/// four shared vertices (normal +Z, uv 0, node 0) and two triangles, (0, 1, 2) and (0, 2, 3),
-/// counter-clockwise seen from +Z. With `z0 ≠ z1` the quad is tilted about the y axis.
+/// Adds a quad spanning `x = [x0, x1]` and `y = [y0, y1]`, at depth z0 along x = x0 and z1
+/// along x = x1 (`z = [z0, z1]`): corners (x0, y0, z0), (x1, y0, z1), (x1, y1, z1), (x0, y1,
+/// z0), facing +Z, as four shared vertices (normal +Z, uv 0, node 0) and two triangles,
+/// (0, 1, 2) and (0, 2, 3), counter-clockwise seen from +Z. With `z0 ≠ z1` the quad is tilted
+/// about the y axis.
 ///
 /// The triangles get the next two scene ids (2k and 2k + 1 for the k-th quad of a scene built
 /// from quads alone).
-#[allow(clippy::too_many_arguments)]
-pub fn quad(g: &mut Geometry, x0: f32, x1: f32, y0: f32, y1: f32, z0: f32, z1: f32, material: u32) {
+pub fn quad(g: &mut Geometry, x: [f32; 2], y: [f32; 2], z: [f32; 2], material: u32) {
+    let ([x0, x1], [y0, y1], [z0, z1]) = (x, y, z);
     let base = g.vertices.len() as u32;
     for (x, y, z) in [(x0, y0, z0), (x1, y0, z1), (x1, y1, z1), (x0, y1, z0)] {
         g.vertices.push(Vertex {
@@ -55,7 +57,7 @@ pub fn quad(g: &mut Geometry, x0: f32, x1: f32, y0: f32, y1: f32, z0: f32, z1: f
 
 /// [`quad`] in the plane z: spans [x0, x1] × [y0, y1] at depth `z`, facing +Z.
 pub fn flat_quad(g: &mut Geometry, x0: f32, x1: f32, y0: f32, y1: f32, z: f32, material: u32) {
-    quad(g, x0, x1, y0, y1, z, z, material);
+    quad(g, [x0, x1], [y0, y1], [z, z], material);
 }
 
 /// The corners of [`quad`]'s two triangles, in the same order and winding:
@@ -87,17 +89,8 @@ pub fn tri(g: &mut Geometry, corners: [[f32; 3]; 3], material: u32) {
 
 /// [`quad`]'s two triangles added with [`tri`]: the same corners, winding and ids, but six
 /// vertices, none shared.
-#[allow(clippy::too_many_arguments)]
-pub fn split_quad(
-    g: &mut Geometry,
-    x0: f32,
-    x1: f32,
-    y0: f32,
-    y1: f32,
-    z0: f32,
-    z1: f32,
-    material: u32,
-) {
+pub fn split_quad(g: &mut Geometry, x: [f32; 2], y: [f32; 2], z: [f32; 2], material: u32) {
+    let ([x0, x1], [y0, y1], [z0, z1]) = (x, y, z);
     for corners in quad_triangles(x0, x1, y0, y1, z0, z1) {
         tri(g, corners, material);
     }
@@ -169,8 +162,8 @@ mod tests {
     fn split_quad_has_the_corners_and_winding_of_quad() {
         let mut shared = scene(vec![material([1.0; 3], 0.5)]);
         let mut split = shared.clone();
-        quad(&mut shared, -1.0, 2.0, -3.0, 4.0, -5.0, -6.0, 0);
-        split_quad(&mut split, -1.0, 2.0, -3.0, 4.0, -5.0, -6.0, 0);
+        quad(&mut shared, [-1.0, 2.0], [-3.0, 4.0], [-5.0, -6.0], 0);
+        split_quad(&mut split, [-1.0, 2.0], [-3.0, 4.0], [-5.0, -6.0], 0);
         assert_eq!(shared.vertices.len(), 4);
         assert_eq!(split.vertices.len(), 6);
         let corners = |g: &Geometry| -> Vec<[f32; 3]> {
@@ -188,7 +181,7 @@ mod tests {
         let mut a = scene(vec![]);
         let mut b = scene(vec![]);
         flat_quad(&mut a, -0.5, 0.5, -0.25, 0.75, -2.0, 3);
-        quad(&mut b, -0.5, 0.5, -0.25, 0.75, -2.0, -2.0, 3);
+        quad(&mut b, [-0.5, 0.5], [-0.25, 0.75], [-2.0, -2.0], 3);
         assert_eq!(a, b);
     }
 
