@@ -1,8 +1,8 @@
 //! The player on an 8-bit sRGB target (`Srgb8Player`) against the exact reference at 4× on a
-//! bright emissive scene: colours far above 1 used to be clamped per sample before the MSAA
-//! resolve on the 8-bit target but not in the reference (118/255 apart at edges); PBR shading
-//! tone maps each fragment into [0, 1] before blending and resolve, so the two agree within
-//! 1/255.
+//! bright emissive scene: colours far above 1, if not tone mapped, would be clamped per sample
+//! before the MSAA resolve on the 8-bit target but not in the reference (118/255 apart at
+//! edges); PBR shading tone maps each fragment into [0, 1] before blending and resolve, so the
+//! two agree within 1/255.
 
 use glam::DVec3;
 use trisort_format::{AlphaMode, Environment, Geometry, Material};
