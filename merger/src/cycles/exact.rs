@@ -235,7 +235,7 @@ impl Branch<'_> {
     }
 }
 
-/// The sums of every subset of `w`: entry S is Σ w[k] over the bits k of S.
+/// The sums of every subset of `w`: entry S is Σ `w[k]` over the bits k of S.
 fn subset_sums(w: &[u64]) -> Vec<u64> {
     let mut sums = vec![0u64; 1 << w.len()];
     for s in 1..sums.len() {

@@ -61,8 +61,9 @@ pub(crate) struct Capture<'g> {
     /// general one; or the grown capture's one pipeline.
     pipelines: Vec<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
-    /// The drawn triangles, those whose opacity needs no texture first ([`draw_order`]);
-    /// `None` for the grown capture, which pulls its triangles from storage in drawn order.
+    /// The drawn triangles, those whose opacity needs no texture first (`draw_order` in
+    /// `build.rs`); `None` for the grown capture, which pulls its triangles from storage in
+    /// drawn order.
     index: Option<wgpu::Buffer>,
     /// The grown capture's triangle storage (group 2).
     grown: Option<wgpu::BindGroup>,
