@@ -23,6 +23,10 @@
 //! The probe draws with the same shift the player applies (`--subpixel-offset`), so a shifted
 //! pattern shows up as a device off the profile.
 
+// The probe draws only where wgpu runs natively (the web player checks its device with the
+// page's self-check instead); on wasm32 its drawing helpers go unused.
+#![cfg_attr(target_arch = "wasm32", allow(dead_code, unused_imports))]
+
 use trisort_format::{RasterProfile, RecordSettings};
 use wgpu::util::DeviceExt;
 
