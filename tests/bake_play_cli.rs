@@ -125,7 +125,7 @@ fn demo_exports_a_scene_that_imports_back_with_the_same_triangles() {
         "{text}"
     );
     assert!(!pngs(&dir.path().join("out/frames")).is_empty());
-    // The demo shows its glass (issue 17 part 4): baked and played at opacity 0.35.
+    // The demo shows its glass: baked and played at opacity 0.35.
     assert!(text.contains("glass at opacity 0.35"), "{text}");
     let baked: trisort_format::Baked = trisort_format::container::read_file(
         trisort_format::FileKind::Baked,

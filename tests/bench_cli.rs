@@ -1,6 +1,6 @@
 //! `trisort bench` through the real binary: the method table on the demo car with half-opaque
 //! glass (where the default pipeline's unsorted transparency is visibly wrong), its JSON
-//! contract (DESIGN § CLI contract), its files, the reuse of its bakes, and its errors.
+//! contract (README § Using it), its files, the reuse of its bakes, and its errors.
 
 use std::path::Path;
 

@@ -1,4 +1,4 @@
-//! glTF as real pipelines deliver it (issue 17, part 2), end to end: CarConcept packed at test
+//! glTF as real pipelines deliver it, end to end: CarConcept packed at test
 //! time by gltfpack — quantized (`KHR_mesh_quantization`), meshopt-compressed (`-cc`,
 //! `EXT_meshopt_compression`), named nodes kept (`-kn`) — and by gltf-pipeline
 //! (`KHR_draco_mesh_compression`, `-d`) is inspected and recorded like the original. The

@@ -49,7 +49,7 @@ fn bake_and_merge_store_the_environment_they_are_given() {
     // 128×64 + 64×32 + … + 4×2 texels of 8 bytes.
     assert_eq!(e["bytes"], 10_920 * 8);
     assert!(e["sun"].is_null(), "an .hdr file has no sun: {e}");
-    // `verify --environment` makes the light anew and compares (issue 28): the .hdr file it
+    // `verify --environment` makes the light anew and compares: the .hdr file it
     // was baked with passes, the studio does not.
     let v = run_json(d, &["verify", "sky.baked", "--environment", "sky.hdr"]);
     assert_eq!(

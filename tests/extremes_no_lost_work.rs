@@ -149,7 +149,7 @@ fn an_interrupted_bake_resumes_to_identical_bytes() {
     );
 }
 
-/// A bake killed while merging (issue 28) leaves its finished recording beside the output and
+/// A bake killed while merging leaves its finished recording beside the output and
 /// no baked file (both are written to a temporary name, then renamed). Run again, it merges
 /// only: it says it resumes from the finished recording, reports `recording_reused`, leaves
 /// the recording untouched (not rewritten) and writes the bytes an uninterrupted bake writes.

@@ -1,4 +1,4 @@
-//! `trisort verify --scene` through the real binary: the JSON keys of DESIGN's CLI contract,
+//! `trisort verify --scene` through the real binary: the JSON keys scripts rely on (README § Using it),
 //! graph and image checks together, difference images, a scene that is not the baked one,
 //! off the pattern only with `--max-error` or `--measure-only`, the mutation check (a file whose order was
 //! corrupted on purpose fails with exit code 3), and frames captured elsewhere
@@ -82,7 +82,7 @@ fn another_scene_is_refused_with_a_clear_error() {
     );
 }
 
-/// Off the recorded pattern nothing passes unchecked (issue 28): without `--max-error` the run
+/// Off the recorded pattern nothing passes unchecked: without `--max-error` the run
 /// is refused before anything is drawn; `--measure-only` measures, says nothing was verified
 /// and exits 4 unless `--allow-unverified`; `--max-error` below the measured error fails.
 #[test]

@@ -1,4 +1,4 @@
-//! Forged baked files (issue 13, part 1): an honest bake of the demo car decoded, altered and
+//! Forged baked files: an honest bake of the demo car decoded, altered and
 //! written back with the format's own writer (so its checksum is right), then given to the
 //! real `trisort verify`. Each is rejected with exit code 3 and a message naming the frame and
 //! the edge (or the figure) it forged; the recording alone decides what may be unordered.
@@ -308,7 +308,7 @@ fn forged_statistics_are_rejected() {
     }
 }
 
-/// A file that names another recording device is checked, not measured (issue 28): with its
+/// A file that names another recording device is checked, not measured: with its
 /// device renamed and its index buffer reversed, `verify --scene` alone (no recording to take
 /// the device from) fails it (exit 3), saying it played on another device at the recorded
 /// pattern. The honest file with the renamed device still passes.

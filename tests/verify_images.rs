@@ -1,4 +1,4 @@
-//! Image verification (issue 6): baked files played by the player against the exact reference
+//! Image verification: baked files played by the player against the exact reference
 //! of the full scene, in all three modes at the recorded pattern, on scenes built here with
 //! known answers and on real scenes; and the mutation check (a file whose order was corrupted
 //! on purpose fails).
@@ -165,7 +165,7 @@ fn reference_config(mode: Mode) -> trisort_reference::ReferenceConfig {
     }
 }
 
-/// On an opaque scene the `depth` reference equals DESIGN's plain z-buffer of all triangles
+/// On an opaque scene the `depth` reference equals a plain z-buffer of all triangles
 /// in ascending id order (the player drawing the whole scene in id order with `Less`).
 #[test]
 fn depth_reference_equals_the_plain_z_buffer_on_opaque_scenes() {

@@ -1,4 +1,4 @@
-//! `--backend` and `--limits` (issue 14): `play --limits webgl2` takes the player's GLES 3.0 /
+//! `--backend` and `--limits`: `play --limits webgl2` takes the player's GLES 3.0 /
 //! WebGL2 path (data-texture bindings, direct draws), says so in `--json`, and writes the same
 //! PNG bytes as the default path on the same adapter; `verify --limits webgl2` checks those
 //! frames at the recorded pattern; `--backend gl` plays through EGL where Mesa's GL is

@@ -7,7 +7,7 @@
 //!   from encoding to the device being idle again.
 //! - [`pipeline_statistics`]: the device's own counts (vertex, clipper and fragment-shader
 //!   invocations) summed over the method's passes. lavapipe counts rasterized fragments there,
-//!   shaded or not (DESIGN § Measured on CarConcept).
+//!   shaded or not, so it overcounts what a GPU with early depth testing shades.
 //! - [`FragmentCounter`]: fragments that survive the depth test in submission order, counted
 //!   per pixel with the stencil buffer — what a GPU with early depth testing shades — and the
 //!   pixels they cover; their ratio is the overdraw (paper 002's measure).

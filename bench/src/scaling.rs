@@ -1,4 +1,4 @@
-//! Scaling of the bake cost (issue 7, "Scaling"): record and merge cost against the scene's
+//! Scaling of the bake cost: record and merge cost against the scene's
 //! triangle count (the procedural demo car, 10 k … 5 M triangles) and against the path's
 //! frame count (real recordings of the demo car along an orbit, 10 … 1,000 frames, each merged
 //! as one matrix and again in segments; synthetic recordings of

@@ -1,4 +1,4 @@
-//! Scaling benchmark (issue 7): the quick configuration runs on the GPU, its rows are
+//! Scaling benchmark: the quick configuration runs on the GPU, its rows are
 //! consistent and every output is written. Timings are measured, never asserted.
 
 use trisort_bench::scaling::{

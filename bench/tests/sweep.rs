@@ -160,7 +160,7 @@ fn check_point(p: &SweepPoint, d: &SweepPoint, frames_px: u64) {
     assert_eq!(p.pixels_differing == 0, p.max_channel_diff == 0, "{what}");
     // At the recorded pattern (playback size and samples, same device, the point's own
     // glass opacity) a bake without unordered samples matches the exact reference within
-    // 1/255 (DESIGN § Frame accuracy). Only the record-size points leave the pattern.
+    // 1/255 (the one rounding of the 8-bit store). Only the record-size points leave the pattern.
     let at_pattern = p.factor != "record-size" || p.value.starts_with("1x");
     if at_pattern && p.unordered_samples == 0 {
         assert!(p.max_channel_diff <= 1, "{what}: {p:?}");

@@ -1,5 +1,6 @@
 //! The merger: per-frame occlusion graphs into one sorted triangle list and a sliding window
-//! of draws per frame (paper 003 §3.2, §4.2, §5; DESIGN § Merger, which corrects the paper).
+//! of draws per frame (paper 003 §3.2, §4.2, §5, with the rules below: an order between two
+//! drawn triangles counts even when it runs through triangles that are not drawn).
 //!
 //! Pure CPU: [`Recording`]s in, a [`Baked`] file out. The steps, one file each:
 //!
@@ -9,7 +10,7 @@
 //! | cycle breaking inside a frame (minimum-weight feedback arc set per SCC: exact for small components, weighted Eades–Lin–Smyth above) | [`cycles`] |
 //! | strategy order and layouts (cell keys) | [`strategy`] |
 //! | cells, copies, per-cell constraint graphs | `cells.rs` |
-//! | seeding and interval splitting | `split.rs` |
+//! | seeding and interval splitting | `split/` |
 //! | the paper's diagonal-by-diagonal seeding | `paper.rs` |
 //! | serialization (Kahn levels, vertex-cache order) | `serialize.rs` |
 //! | transitive reduction of final graphs | [`reduction`] |
@@ -17,8 +18,8 @@
 //! | 32-bit counts, checked | `limits.rs` ([`Limit`]) |
 //! | synthetic recordings for tests and benchmarks | [`synth`] |
 //!
-//! **Rules** (DESIGN § Merger; the `trisort-verify` crate checks them from the two files
-//! alone), for every frame f:
+//! **Rules** (the `trisort-verify` crate checks them from the two files alone), for every
+//! frame f:
 //! 1. every t ∈ V_f is drawn exactly once, no triangle twice, and every copy spans at least
 //!    one frame where its triangle is visible;
 //! 2. a copy may span a frame where its triangle is not visible only as the bridge policy

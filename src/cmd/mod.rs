@@ -1,4 +1,4 @@
-//! The subcommands (DESIGN.md § CLI contract).
+//! The subcommands (README § Using it lists their options and `--json` keys).
 
 mod bake;
 mod bench;

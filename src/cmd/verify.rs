@@ -9,7 +9,7 @@
 //! colour channel at an ordered pixel. Which pixels are unordered (excused) comes from the
 //! recordings' cycles only: with `--scene` alone no pixel is excused. Off the pattern a frame
 //! fails above `--max-error N`: the largest colour-channel difference on ordered pixels, in
-//! 1/255 units. Nothing passes unchecked (issue 28): off the pattern without `--max-error` is
+//! 1/255 units. Nothing passes unchecked: off the pattern without `--max-error` is
 //! an error, and measuring without verifying needs `--measure-only`, which says that nothing
 //! was verified and exits 4 unless `--allow-unverified` is given. The error of an 8-bit sRGB
 //! deployment target is reported separately (`srgb8`) and never gated on.
