@@ -18,11 +18,15 @@ pub enum ShardArg {
 }
 
 /// Parses `I/N` (0 ≤ I < N) or `auto`.
-pub fn parse_shard(s: &str) -> Result<ShardArg, String> {
+pub fn parse_shard(s: &str) -> Result<ShardArg, BakeError> {
     if s == "auto" {
         return Ok(ShardArg::Auto);
     }
-    let bad = || format!("bad shard {s:?}: expected I/N with 0 <= I < N, or auto");
+    let bad = || {
+        BakeError::Shard(format!(
+            "bad shard {s:?}: expected I/N with 0 <= I < N, or auto"
+        ))
+    };
     let (i, n) = s.split_once('/').ok_or_else(bad)?;
     let (i, n): (u32, u32) = (i.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?);
     if n == 0 || i >= n {
