@@ -7,8 +7,9 @@
 //! Every pipeline's shader is [`COMMON`] followed by its own entry points, so all of them use
 //! the one vertex transform (`transform_position`) and the one surface function
 //! (`surface_base`, `shade`), and mark `@builtin(position)` `@invariant`: the recorder, the
-//! player and the reference rasterize bit-identical positions. WGSL has no includes, so
-//! [`compose`] concatenates.
+//! player and the reference rasterize bit-identical positions. WGSL has no includes, so every
+//! shader is assembled one way, by [`shader_source::assemble`]: `enable` directives, the
+//! source files joined in order, `{{NAME}}` placeholders filled.
 #![deny(missing_docs)]
 
 mod data_textures;
@@ -17,6 +18,7 @@ pub mod pipeline;
 pub mod present;
 pub mod raster_probe;
 pub mod readback;
+pub mod shader_source;
 pub mod target;
 mod timer;
 
@@ -41,7 +43,7 @@ pub const SMOKE: &str = include_str!("../../shaders/common/smoke.wgsl");
 /// The complete smoke-test shader: [`COMMON`], the plain pass's vertex stage (`vs_plain`) and
 /// [`SMOKE`]'s `fs_smoke`, which colours each triangle by its material.
 pub fn smoke_shader() -> String {
-    compose(&[], &format!("{PLAIN}\n{SMOKE}"))
+    storage_shader("smoke", &[], &[PLAIN, SMOKE], &[])
 }
 
 /// Entry points of the player (`vs_player`, `fs_player_straight`, `fs_player_premultiplied`).
@@ -55,7 +57,7 @@ pub const REFERENCE: &str = include_str!("../../shaders/reference/reference.wgsl
 /// [`PLAYER`] entry points and the reference's own (needs `Features::PRIMITIVE_INDEX`). The
 /// reference draws with `vs_player` and shades with the player's `player_colour`.
 pub fn reference_shader() -> String {
-    compose(&["primitive_index"], &format!("{PLAYER}\n{REFERENCE}"))
+    storage_shader("reference", &["primitive_index"], &[PLAYER, REFERENCE], &[])
 }
 
 /// The recorder's vertex stage (`vs_record`, `RecordVarying`), shared by [`PEEL`] and
@@ -74,16 +76,16 @@ pub const CAPTURE: &str = include_str!("../../shaders/record/capture.wgsl");
 /// storage in fragment shaders); with `early_depth_test`, its fragment stage forces the depth
 /// test before it runs (needs `Features::SHADER_EARLY_DEPTH_TEST`).
 pub fn capture_shader(early_depth_test: bool) -> String {
-    compose(
+    let early = if early_depth_test {
+        "@early_depth_test(force)"
+    } else {
+        ""
+    };
+    storage_shader(
+        "capture",
         &["primitive_index"],
-        &format!("{RECORD_VERTEX}\n{CAPTURE}").replace(
-            "EARLY_DEPTH_TEST",
-            if early_depth_test {
-                "@early_depth_test(force)"
-            } else {
-                ""
-            },
-        ),
+        &[RECORD_VERTEX, CAPTURE],
+        &[("EARLY_DEPTH_TEST", early)],
     )
 }
 
@@ -95,14 +97,15 @@ pub const CAPTURE_GROWN: &str = include_str!("../../shaders/record/capture_grown
 /// ([`CAPTURE`], group 1), [`GROW`] in group 2 and [`CAPTURE_GROWN`]: the one-pass form of
 /// [`peel_grown_shader`] (needs writable storage in fragment shaders).
 pub fn capture_grown_shader() -> String {
-    compose(
+    storage_shader(
+        "capture grown",
         &["primitive_index"],
-        &format!(
-            "{}\n{}\n{}",
-            format!("{RECORD_VERTEX}\n{CAPTURE}").replace("EARLY_DEPTH_TEST", ""),
-            GROW.replace("CONS_GROUP", "2"),
-            CAPTURE_GROWN.replace("ENVELOPE_ID_BITS_VALUE", &ENVELOPE_ID_BITS.to_string())
-        ),
+        &[RECORD_VERTEX, CAPTURE, GROW, CAPTURE_GROWN],
+        &[
+            ("EARLY_DEPTH_TEST", ""),
+            ("CONS_GROUP", "2"),
+            ("ENVELOPE_ID_BITS", &ENVELOPE_ID_BITS.to_string()),
+        ],
     )
 }
 
@@ -113,62 +116,56 @@ pub const ENVELOPE_ID_BITS: u32 = 24;
 /// The compute pass that gathers a peel layer per sample; compose with [`gather_shader`].
 pub const GATHER: &str = include_str!("../../shaders/record/gather.wgsl");
 
-/// The id texture type, the depth texture type and the sample argument of a `textureLoad` at
-/// sample `sample`, for a sample count: multisampled textures for `samples > 1`, plain ones
-/// (and sample 0) for a single sample.
-fn sample_types(samples: u32) -> (&'static str, &'static str, &'static str) {
+/// The texture placeholders of the shaders that read a previous layer per sample, for a sample
+/// count: `IDS_TYPE` and `DEPTH_TYPE` (multisampled textures for `samples > 1`, plain ones for a
+/// single sample) and `AT_SAMPLE`, `AT_S`, `AT_K`, the sample argument of a `textureLoad` at the
+/// sample held in WGSL variable `sample`, `s` or `k` (`i32(sample)`, or 0 for a single sample).
+fn sample_values(samples: u32) -> [(&'static str, &'static str); 5] {
     if samples > 1 {
-        (
-            "texture_multisampled_2d<u32>",
-            "texture_depth_multisampled_2d",
-            "i32(sample)",
-        )
+        [
+            ("IDS_TYPE", "texture_multisampled_2d<u32>"),
+            ("DEPTH_TYPE", "texture_depth_multisampled_2d"),
+            ("AT_SAMPLE", "i32(sample)"),
+            ("AT_S", "i32(s)"),
+            ("AT_K", "i32(k)"),
+        ]
     } else {
-        ("texture_2d<u32>", "texture_depth_2d", "0")
+        [
+            ("IDS_TYPE", "texture_2d<u32>"),
+            ("DEPTH_TYPE", "texture_depth_2d"),
+            ("AT_SAMPLE", "0"),
+            ("AT_S", "0"),
+            ("AT_K", "0"),
+        ]
     }
 }
 
-/// Fills the texture-type placeholders of the peel and gather shaders for a sample count
-/// ([`sample_types`]).
-fn peel_types(body: &str, samples: u32) -> String {
-    let (ids, depth, sample) = sample_types(samples);
-    body.replace("PREV_IDS_TYPE", ids)
-        .replace("PREV_DEPTH_TYPE", depth)
-        .replace(
-            "LOAD_PREV_DEPTH",
-            &format!("textureLoad(prev_depth, coord, {sample})"),
-        )
-        .replace(
-            "LOAD_PREV_IDS",
-            &format!("textureLoad(prev_ids, coord, {sample})"),
-        )
-        .replace(
-            "LOAD_LAYER_IDS",
-            &format!(
-                "textureLoad(layer_ids, coord, {})",
-                sample.replace("sample", "s")
-            ),
-        )
-        .replace(
-            "LOAD_LAYER_DEPTH",
-            &format!(
-                "textureLoad(layer_depth, coord, {})",
-                sample.replace("sample", "s")
-            ),
-        )
+/// The values of [`sample_values`] for a sample count that name one of `names`.
+fn sample_values_of(samples: u32, names: &[&str]) -> Vec<(&'static str, &'static str)> {
+    sample_values(samples)
+        .into_iter()
+        .filter(|(name, _)| names.contains(name))
+        .collect()
 }
 
 /// The complete peel shader for a sample count (needs `Features::PRIMITIVE_INDEX`).
 pub fn peel_shader(samples: u32) -> String {
-    compose(
+    storage_shader(
+        "peel",
         &["primitive_index"],
-        &peel_types(&format!("{RECORD_VERTEX}\n{PEEL}"), samples),
+        &[RECORD_VERTEX, PEEL],
+        &sample_values_of(samples, &["IDS_TYPE", "DEPTH_TYPE", "AT_SAMPLE"]),
     )
 }
 
 /// The complete gather shader for a sample count (stand-alone: no shared bindings).
 pub fn gather_shader(samples: u32) -> String {
-    peel_types(GATHER, samples)
+    shader_source::assemble(
+        "gather",
+        &[],
+        &[GATHER],
+        &sample_values_of(samples, &["IDS_TYPE", "DEPTH_TYPE", "AT_S"]),
+    )
 }
 
 /// The plain benchmark pass (`vs_plain`, `fs_plain`); compose with [`plain_shader`].
@@ -176,7 +173,7 @@ pub const PLAIN: &str = include_str!("../../shaders/reference/plain.wgsl");
 
 /// The complete plain benchmark shader.
 pub fn plain_shader() -> String {
-    compose(&[], PLAIN)
+    storage_shader("plain", &[], &[PLAIN], &[])
 }
 
 /// The per-sample linked-list OIT renderer's entry points (`fs_oit_list`,
@@ -187,12 +184,11 @@ pub const OIT: &str = include_str!("../../shaders/reference/oit.wgsl");
 /// `player_colour`) and [`OIT`] with a per-sample sort array of `max_sorted` entries (needs
 /// `Features::PRIMITIVE_INDEX`).
 pub fn oit_shader(max_sorted: u32) -> String {
-    compose(
+    storage_shader(
+        "oit",
         &["primitive_index"],
-        &format!(
-            "{PLAYER}\n{}",
-            OIT.replace("OIT_MAX_SORTED", &max_sorted.max(1).to_string())
-        ),
+        &[PLAYER, OIT],
+        &[("OIT_MAX_SORTED", &max_sorted.max(1).to_string())],
     )
 }
 
@@ -206,29 +202,14 @@ pub const PEELING: &str = include_str!("../../shaders/reference/peeling.wgsl");
 /// per-sample loads filled in (needs `Features::PRIMITIVE_INDEX`).
 pub fn peeling_shader(samples: u32) -> String {
     let samples = samples.max(1);
-    let (ids, depth, at) = sample_types(samples);
-    let at_s = at.replace("sample", "s");
-    let body = PEELING
-        .replace("PREV_DEPTH_TYPE", depth)
-        .replace("IDS_TYPE", ids)
-        .replace(
-            "LOAD_PREV_DEPTH",
-            &format!("textureLoad(prev_depth, coord, {at})"),
-        )
-        .replace(
-            "LOAD_PREV_ID",
-            &format!("textureLoad(prev_ids, coord, {at}).x"),
-        )
-        .replace(
-            "LOAD_LAYER_ID",
-            &format!("textureLoad(layer_ids, coord, {at_s}).x"),
-        )
-        .replace("SAMPLE_COUNT", &samples.to_string());
-    compose(&["primitive_index"], &format!("{PLAYER}\n{body}"))
+    let count = samples.to_string();
+    let mut values = sample_values_of(samples, &["IDS_TYPE", "DEPTH_TYPE", "AT_SAMPLE", "AT_S"]);
+    values.push(("SAMPLE_COUNT", &count));
+    storage_shader("peeling", &["primitive_index"], &[PLAYER, PEELING], &values)
 }
 
 /// Triangles grown or shrunk by a tolerance box, pulled from storage (bindings in group
-/// `CONS_GROUP`); the base of [`conservative_shader`] and [`peel_grown_shader`].
+/// `{{CONS_GROUP}}`); the base of [`conservative_shader`] and [`peel_grown_shader`].
 pub const GROW: &str = include_str!("../../shaders/record/grow.wgsl");
 
 /// The recorder's conservative visibility passes (`vs_erode`/`fs_erode`,
@@ -240,25 +221,19 @@ pub const CONSERVATIVE: &str = include_str!("../../shaders/record/conservative.w
 /// filled in.
 pub fn conservative_shader(samples: u32) -> String {
     let samples = samples.max(1);
-    let (_, depth, at) = sample_types(samples);
-    let float = if samples > 1 {
+    let count = samples.to_string();
+    let occluder = if samples > 1 {
         "texture_multisampled_2d<f32>"
     } else {
         "texture_2d<f32>"
     };
-    let at_k = if samples > 1 { "i32(k)" } else { "0" };
-    compose(
-        &[],
-        &format!("{}\n{CONSERVATIVE}", GROW.replace("CONS_GROUP", "1"))
-            .replace("OCCLUDER_TYPE", float)
-            .replace("SURFACE_TYPE", depth)
-            .replace(
-                "LOAD_OCCLUDER",
-                &format!("textureLoad(occluder, coord, {at}).x"),
-            )
-            .replace("LOAD_SURFACE", &format!("textureLoad(surface, c, {at_k})"))
-            .replace("SAMPLE_COUNT", &format!("{samples}u")),
-    )
+    let mut values = sample_values_of(samples, &["DEPTH_TYPE", "AT_SAMPLE", "AT_K"]);
+    values.extend([
+        ("CONS_GROUP", "1"),
+        ("OCCLUDER_TYPE", occluder),
+        ("SAMPLE_COUNT", &count),
+    ]);
+    storage_shader("conservative", &[], &[GROW, CONSERVATIVE], &values)
 }
 
 /// The grown peel's fragment stage (`fs_peel_grown`, after [`GROW`]'s `vs_grown`); compose with
@@ -269,15 +244,13 @@ pub const PEEL_GROWN: &str = include_str!("../../shaders/record/peel_grown.wgsl"
 /// entry points ([`PEEL`], group 1), [`GROW`] in group 2 and [`PEEL_GROWN`] (needs
 /// `Features::PRIMITIVE_INDEX`, as [`PEEL`] does).
 pub fn peel_grown_shader(samples: u32) -> String {
-    compose(
+    let mut values = sample_values_of(samples, &["IDS_TYPE", "DEPTH_TYPE", "AT_SAMPLE"]);
+    values.push(("CONS_GROUP", "2"));
+    storage_shader(
+        "peel grown",
         &["primitive_index"],
-        &peel_types(
-            &format!(
-                "{RECORD_VERTEX}\n{PEEL}\n{}\n{PEEL_GROWN}",
-                GROW.replace("CONS_GROUP", "2")
-            ),
-            samples,
-        ),
+        &[RECORD_VERTEX, PEEL, GROW, PEEL_GROWN],
+        &values,
     )
 }
 
@@ -287,7 +260,7 @@ pub const COVERAGE: &str = include_str!("../../shaders/common/coverage.wgsl");
 /// The complete shader of the recorder's coverage test: [`COMMON`], the player's [`PLAYER`]
 /// entry points (`vs_player`) and [`COVERAGE`] (needs `Features::PRIMITIVE_INDEX`).
 pub fn coverage_shader() -> String {
-    compose(&["primitive_index"], &format!("{PLAYER}\n{COVERAGE}"))
+    storage_shader("coverage", &["primitive_index"], &[PLAYER, COVERAGE], &[])
 }
 
 /// The window viewer's copy of a frame to its surface (`vs_blit`, `fs_blit`); stand-alone (no
@@ -298,10 +271,16 @@ pub const BLIT: &str = include_str!("../../shaders/play/blit.wgsl");
 /// premultiplied colour (`saturate` mode), `encode_srgb` applies the sRGB transfer function in
 /// the shader (for a non-sRGB view of an 8-bit surface).
 pub fn blit_shader(under: bool, encode_srgb: bool, background: [f32; 3]) -> String {
-    format!(
-        "const UNDER: bool = {under};\nconst ENCODE_SRGB: bool = {encode_srgb};\n\
-         const BACKGROUND: vec3<f32> = vec3<f32>({:?}, {:?}, {:?});\n{BLIT}",
-        background[0], background[1], background[2],
+    let [r, g, b] = background;
+    shader_source::assemble(
+        "blit",
+        &[],
+        &[BLIT],
+        &[
+            ("UNDER", &under.to_string()),
+            ("ENCODE_SRGB", &encode_srgb.to_string()),
+            ("BACKGROUND", &format!("{r:?}, {g:?}, {b:?}")),
+        ],
     )
 }
 
@@ -316,7 +295,13 @@ pub fn all() -> Vec<(&'static str, String)> {
         ),
         (
             "smoke textures",
-            compose_with(Bindings::Textures, &[], &format!("{PLAIN}\n{SMOKE}")),
+            tier_shader(
+                Bindings::Textures,
+                "smoke textures",
+                &[],
+                &[PLAIN, SMOKE],
+                &[],
+            ),
         ),
         ("reference", reference_shader()),
         ("peel 1x", peel_shader(1)),
@@ -342,7 +327,7 @@ pub fn all() -> Vec<(&'static str, String)> {
 
 /// Composes a module on the storage tier ([`Bindings::Storage`]): `enable` directives first
 /// (WGSL requires them before any declaration), then [`COMMON`], its binding prelude, then
-/// `body`.
+/// `body`, a complete source (it must hold no `{{NAME}}` placeholder: [`shader_source`]).
 pub fn compose(enables: &[&str], body: &str) -> String {
     compose_with(Bindings::Storage, enables, body)
 }
@@ -350,19 +335,35 @@ pub fn compose(enables: &[&str], body: &str) -> String {
 /// [`compose`] with the binding prelude of `bindings` ([`STORAGE_BINDINGS`] or
 /// [`TEXTURE_BINDINGS`]): the same [`COMMON`] maths over either.
 pub fn compose_with(bindings: Bindings, enables: &[&str], body: &str) -> String {
-    let mut s = String::new();
-    for e in enables {
-        s.push_str(&format!("enable {e};\n"));
-    }
-    s.push_str(COMMON);
-    s.push('\n');
-    s.push_str(match bindings {
+    tier_shader(bindings, "composed", enables, &[body], &[])
+}
+
+/// Shader `name` on the storage tier ([`tier_shader`] with [`Bindings::Storage`]).
+fn storage_shader(
+    name: &str,
+    enables: &[&str],
+    sources: &[&str],
+    values: &[(&str, &str)],
+) -> String {
+    tier_shader(Bindings::Storage, name, enables, sources, values)
+}
+
+/// Shader `name` on a binding tier: [`COMMON`], the tier's binding prelude ([`STORAGE_BINDINGS`]
+/// or [`TEXTURE_BINDINGS`]), then `sources`, assembled with `enables` and placeholder `values`
+/// by [`shader_source::assemble`].
+fn tier_shader(
+    bindings: Bindings,
+    name: &str,
+    enables: &[&str],
+    sources: &[&str],
+    values: &[(&str, &str)],
+) -> String {
+    let prelude = match bindings {
         Bindings::Storage => STORAGE_BINDINGS,
         Bindings::Textures => TEXTURE_BINDINGS,
-    });
-    s.push('\n');
-    s.push_str(body);
-    s
+    };
+    let sources: Vec<&str> = [COMMON, prelude].iter().chain(sources).copied().collect();
+    shader_source::assemble(name, enables, &sources, values)
 }
 
 /// Binding prelude of [`Bindings::Storage`]: node matrices and materials in storage buffers.

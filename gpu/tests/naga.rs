@@ -1,10 +1,16 @@
-//! Every composed shader parses and validates with naga (no GPU needed).
+//! Every composed shader parses and validates with naga (no GPU needed) and has every
+//! `{{NAME}}` placeholder filled.
 
 #[test]
 fn every_shader_validates() {
     let all = trisort_gpu::all();
     assert!(!all.is_empty());
     for (name, source) in all {
+        let left = trisort_gpu::shader_source::placeholders(&source);
+        assert!(
+            left.is_empty(),
+            "{name}: placeholders left unfilled: {left:?}"
+        );
         let module = naga::front::wgsl::parse_str(&source)
             .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
         naga::valid::Validator::new(
@@ -14,6 +20,14 @@ fn every_shader_validates() {
         .validate(&module)
         .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
     }
+}
+
+/// The assembly refuses a placeholder left without a value, so a shader can never reach the
+/// GPU with `{{NAME}}` text in it.
+#[test]
+#[should_panic(expected = "placeholder `{{GROUP}}` is unfilled")]
+fn an_unfilled_placeholder_is_caught() {
+    trisort_gpu::compose(&[], "@group({{GROUP}}) @binding(0) var<uniform> x: f32;");
 }
 
 #[test]
@@ -43,12 +57,9 @@ fn every_wgsl_file_is_validated() {
         );
         files += 1;
         let text = std::fs::read_to_string(&path).expect("readable WGSL");
-        // Placeholders (runs of capitals such as PREV_IDS_TYPE or UNDER) are filled in before
-        // composition: every other line must appear in one composed shader.
-        let placeholder = |l: &str| {
-            l.split(|c: char| !(c.is_ascii_uppercase() || c == '_'))
-                .any(|run| run.len() >= 5)
-        };
+        // Lines with a `{{NAME}}` placeholder are filled in by the assembly: every other line
+        // must appear in one composed shader.
+        let placeholder = |l: &str| !trisort_gpu::shader_source::placeholders(l).is_empty();
         let lines: Vec<&str> = text
             .lines()
             .filter(|l| !l.trim().is_empty() && !placeholder(l))

@@ -1,3 +1,6 @@
+const UNDER: bool = {{UNDER}};
+const ENCODE_SRGB: bool = {{ENCODE_SRGB}};
+const BACKGROUND: vec3<f32> = vec3<f32>({{BACKGROUND}});
 // The copy from the player's linear `Rgba16Float` frame to a window's surface (the window
 // viewer): one triangle over the viewport, each pixel reading the texel under it (nearest;
 // stretched while a resize settles). `UNDER` composites the background under the accumulated

@@ -12,7 +12,7 @@
 // fragments at depth 1 are left out here too. Phase 2 runs no depth test: every fragment is
 // kept. Phase 1 (visibility until saturation) may first draw the triangles that are opaque
 // wherever they are drawn into the depth buffer and then capture with `LessEqual` against it,
-// the test forced before the shader (EARLY_DEPTH_TEST): a sample's walk stops at its first
+// the test forced before the shader ({{EARLY_DEPTH_TEST}}): a sample's walk stops at its first
 // opaque fragment, and every fragment before it in (depth, id) order passes.
 //
 // Each kept fragment takes a node from the pool with an atomic counter and pushes it on its
@@ -60,7 +60,7 @@ struct Node {
 // both sides of a branch on the material, so the texture is left out by specialising.
 override READS_ALPHA: bool = true;
 
-EARLY_DEPTH_TEST
+{{EARLY_DEPTH_TEST}}
 @fragment
 fn fs_capture(
     in: RecordVarying,

@@ -52,7 +52,7 @@ fn fs_capture_grown(
 // Flag bits above the id: the triangle occludes (opaque, its plane valid); edge k crosses the
 // box (bits 1–3); edge k is closable (bits 4–6).
 // Bits of a node's id word that hold the id (trisort_gpu::ENVELOPE_ID_BITS, substituted).
-const ENVELOPE_ID_BITS: u32 = ENVELOPE_ID_BITS_VALUEu;
+const ENVELOPE_ID_BITS: u32 = {{ENVELOPE_ID_BITS}}u;
 const ENVELOPE_OCCLUDES: u32 = 1u;
 
 // Corner `corner` of grown triangle `vi / 3`, with its closable edges: those whose neighbour's

@@ -60,7 +60,7 @@ fn fs_occlude(
 }
 
 // Pass 1's depth (the spread pass's group 1: the tolerance, binding 0, and this).
-@group(1) @binding(5) var surface: SURFACE_TYPE;
+@group(1) @binding(5) var surface: {{DEPTH_TYPE}};
 
 @vertex
 fn vs_full(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
@@ -70,7 +70,7 @@ fn vs_full(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
 
 // The standard sample positions within a pixel (Vulkan, D3D): 1× at the centre, 4× rotated.
 fn sample_position(k: u32) -> vec2<f32> {
-    if (SAMPLE_COUNT == 1u) {
+    if ({{SAMPLE_COUNT}}u == 1u) {
         return vec2<f32>(0.5, 0.5);
     }
     var p = array<vec2<f32>, 4>(
@@ -96,7 +96,7 @@ fn fs_spread(
     for (var dy = -r; dy <= r; dy++) {
         for (var dx = -r; dx <= r; dx++) {
             let c = here + vec2<i32>(dx, dy);
-            for (var k = 0u; k < SAMPLE_COUNT; k++) {
+            for (var k = 0u; k < {{SAMPLE_COUNT}}u; k++) {
                 let d = abs(vec2<f32>(c) + sample_position(k) - me);
                 if (d.x > reach.x || d.y > reach.y) {
                     continue;
@@ -105,7 +105,7 @@ fn fs_spread(
                     // Beyond the image nothing is known: no occluder.
                     m = 1.0;
                 } else {
-                    m = max(m, LOAD_SURFACE);
+                    m = max(m, textureLoad(surface, c, {{AT_K}}));
                 }
             }
         }
@@ -114,7 +114,7 @@ fn fs_spread(
 }
 
 // Pass 3's bindings: pass 2's depth and the per-triangle flags.
-@group(1) @binding(3) var occluder: OCCLUDER_TYPE;
+@group(1) @binding(3) var occluder: {{OCCLUDER_TYPE}};
 @group(1) @binding(4) var<storage, read_write> flags: array<atomic<u32>>;
 
 @fragment
@@ -134,7 +134,7 @@ fn fs_mark(
         z = cons_plane_depth(in) - cons_slack(in.plane, cons.tol_px);
     }
     let coord = vec2<i32>(in.position.xy);
-    let occ = LOAD_OCCLUDER;
+    let occ = textureLoad(occluder, coord, {{AT_SAMPLE}}).x;
     // A little slack for rounding: the peel interpolates depth, this pass evaluates a plane.
     if (z <= occ + 1e-6) {
         atomicStore(&flags[in.tri], 1u);

@@ -14,8 +14,8 @@ struct Dims {
     pad: u32,
 }
 
-@group(0) @binding(0) var layer_ids: PREV_IDS_TYPE;
-@group(0) @binding(1) var layer_depth: PREV_DEPTH_TYPE;
+@group(0) @binding(0) var layer_ids: {{IDS_TYPE}};
+@group(0) @binding(1) var layer_depth: {{DEPTH_TYPE}};
 @group(0) @binding(2) var<storage, read_write> out: array<u32>;
 @group(0) @binding(3) var<uniform> dims: Dims;
 
@@ -27,8 +27,8 @@ fn gather(@builtin(global_invocation_id) g: vec3<u32>) {
     let coord = vec2<i32>(g.xy);
     let n = dims.width * dims.height * dims.samples;
     for (var s = 0u; s < dims.samples; s = s + 1u) {
-        let ids = LOAD_LAYER_IDS;
-        let depth = LOAD_LAYER_DEPTH;
+        let ids = textureLoad(layer_ids, coord, {{AT_S}});
+        let depth = textureLoad(layer_depth, coord, {{AT_S}});
         let slot = (g.y * dims.width + g.x) * dims.samples + s;
         out[slot] = ids.x;
         out[n + slot] = ids.y;
@@ -43,8 +43,8 @@ fn gather_interleaved(@builtin(global_invocation_id) g: vec3<u32>) {
     }
     let coord = vec2<i32>(g.xy);
     for (var s = 0u; s < dims.samples; s = s + 1u) {
-        let ids = LOAD_LAYER_IDS;
-        let depth = LOAD_LAYER_DEPTH;
+        let ids = textureLoad(layer_ids, coord, {{AT_S}});
+        let depth = textureLoad(layer_depth, coord, {{AT_S}});
         let slot = ((g.y * dims.width + g.x) * dims.samples + s) * 4u;
         out[slot] = ids.x;
         out[slot + 1u] = ids.y;

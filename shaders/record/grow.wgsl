@@ -1,6 +1,6 @@
 // Triangles grown or shrunk by a tolerance box in screen space, shared by the conservative
 // visibility passes (conservative.wgsl) and the grown peel (peel_grown.wgsl); its bindings
-// live in group CONS_GROUP.
+// live in group {{CONS_GROUP}}.
 //
 // Triangles are pulled from storage (three invocations per triangle, non-indexed draw),
 // transformed by the one vertex transform, and grown or shrunk in pixel units after the
@@ -22,11 +22,11 @@ struct Cons {
     profile: vec4<f32>,
 }
 
-@group(CONS_GROUP) @binding(0) var<uniform> cons: Cons;
+@group({{CONS_GROUP}}) @binding(0) var<uniform> cons: Cons;
 // Per vertex: local position (xyz) and node (w, bitcast).
-@group(CONS_GROUP) @binding(1) var<storage, read> cons_vertices: array<vec4<f32>>;
+@group({{CONS_GROUP}}) @binding(1) var<storage, read> cons_vertices: array<vec4<f32>>;
 // Per triangle: its three vertex indices and its material.
-@group(CONS_GROUP) @binding(2) var<storage, read> cons_triangles: array<vec4<u32>>;
+@group({{CONS_GROUP}}) @binding(2) var<storage, read> cons_triangles: array<vec4<u32>>;
 
 struct ConsVarying {
     @invariant @builtin(position) position: vec4<f32>,

@@ -14,8 +14,8 @@ struct Peel {
 }
 
 @group(1) @binding(0) var<uniform> peel: Peel;
-@group(1) @binding(1) var prev_depth: PREV_DEPTH_TYPE;
-@group(1) @binding(2) var prev_ids: PREV_IDS_TYPE;
+@group(1) @binding(1) var prev_depth: {{DEPTH_TYPE}};
+@group(1) @binding(2) var prev_ids: {{IDS_TYPE}};
 // Per sample: non-zero once the sample is saturated or has no fragment left.
 @group(1) @binding(3) var<storage, read> done: array<u32>;
 
@@ -37,8 +37,8 @@ fn peeled_before(coord: vec2<i32>, sample: u32, z: f32, id: u32) -> bool {
     if (peel.first_layer != 0u) {
         return false;
     }
-    let pd = LOAD_PREV_DEPTH;
-    let pid = LOAD_PREV_IDS.x;
+    let pd = textureLoad(prev_depth, coord, {{AT_SAMPLE}});
+    let pid = textureLoad(prev_ids, coord, {{AT_SAMPLE}}).x;
     return z < pd || (z == pd && id + 1u <= pid);
 }
 

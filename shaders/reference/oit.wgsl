@@ -9,7 +9,7 @@
 // past the pool's end, so the host knows exactly how many fragments were lost.
 //
 // Resolve pass (`vs_oit_fullscreen`, `fs_oit_resolve`): one invocation per sample gathers the
-// nearest OIT_MAX_SORTED fragments of its list sorted by (depth, id), the exact reference's
+// nearest {{OIT_MAX_SORTED}} fragments of its list sorted by (depth, id), the exact reference's
 // peel order, and composites them back to front over the clear colour with the player's
 // straight-alpha `over`, rounding to binary16 after every layer as the Rgba16Float target does
 // between the reference's blended draws (`oit_f16`). Fragments behind the nearest opaque one
@@ -49,7 +49,7 @@ struct OitNode {
 // Per sample (pixel (x, y) sample s is (y * width + x) * samples + s): first node index + 1.
 @group(1) @binding(1) var<storage, read_write> oit_heads: array<atomic<u32>>;
 // 0: fragments that asked for a node (may exceed the capacity); 1: samples whose list held
-// more than OIT_MAX_SORTED fragments.
+// more than {{OIT_MAX_SORTED}} fragments.
 @group(1) @binding(2) var<storage, read_write> oit_counters: array<atomic<u32>, 2>;
 // The node pool in up to four buffers (unused ones are bound to a one-node dummy).
 @group(1) @binding(3) var<storage, read_write> oit_nodes0: array<OitNode>;
@@ -77,7 +77,7 @@ fn oit_load(n: u32) -> OitNode {
     }
 }
 
-const MAX_SORTED: u32 = OIT_MAX_SORTEDu;
+const MAX_SORTED: u32 = {{OIT_MAX_SORTED}}u;
 
 fn oit_slot(position: vec4<f32>, sample: u32) -> u32 {
     let coord = vec2<u32>(position.xy);

@@ -33,8 +33,8 @@ struct Peeling {
 }
 
 @group(1) @binding(0) var<uniform> peeling: Peeling;
-@group(1) @binding(1) var prev_depth: PREV_DEPTH_TYPE;
-@group(1) @binding(2) var prev_ids: IDS_TYPE;
+@group(1) @binding(1) var prev_depth: {{DEPTH_TYPE}};
+@group(1) @binding(2) var prev_ids: {{IDS_TYPE}};
 
 struct PeelingOut {
     // Triangle id + 1; 0 (the clear value) where the layer has no fragment.
@@ -65,8 +65,8 @@ fn fs_peeling(
     let mode = peeling.mode;
     if (mode != 0u) {
         let coord = vec2<i32>(v.position.xy);
-        let pd = LOAD_PREV_DEPTH;
-        let pid = LOAD_PREV_ID;
+        let pd = textureLoad(prev_depth, coord, {{AT_SAMPLE}});
+        let pid = textureLoad(prev_ids, coord, {{AT_SAMPLE}}).x;
         if (mode == 1u) {
             if (z < pd || (z == pd && id <= pid)) {
                 discard;
@@ -87,7 +87,7 @@ fn fs_peeling(
 
 // The ids of the layer being composited (the last `fs_peeling` pass's colour target); the
 // compositing pipeline's group 1 holds only this binding.
-@group(1) @binding(3) var layer_ids: IDS_TYPE;
+@group(1) @binding(3) var layer_ids: {{IDS_TYPE}};
 
 struct PeelingCompositeOut {
     @location(0) color: vec4<f32>,
@@ -106,8 +106,8 @@ fn fs_peeling_composite(
     let coord = vec2<i32>(v.position.xy);
     let id = primitive + 1u;
     var mask = 0u;
-    for (var s = 0u; s < SAMPLE_COUNTu; s = s + 1u) {
-        if (LOAD_LAYER_ID == id) {
+    for (var s = 0u; s < {{SAMPLE_COUNT}}u; s = s + 1u) {
+        if (textureLoad(layer_ids, coord, {{AT_S}}).x == id) {
             mask = mask | (1u << s);
         }
     }
