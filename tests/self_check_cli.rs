@@ -1,8 +1,10 @@
-//! `play --self-check` and `--subpixel-offset` through the real binary (issue 15): an honest
+//! `play --self-check` and `--subpixel-offset` through the real binary: an honest
 //! bake of the demo car shows no hole at its recorded pattern; the same bake with one visible
 //! triangle removed from frame 0 shows one there (exit 3, per-frame `holes`); a shifted
 //! projection opens holes that `verify --subpixel-offset` measures against the exact
 //! reference shifted the same way.
+
+use std::path::Path;
 
 use trisort_format::{Baked, FileKind, Recording};
 
@@ -190,6 +192,17 @@ fn self_check_holes(dir: &std::path::Path, baked: &str, offset: &str) -> (u64, b
 fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
     let Some(dir) = gpu_tempdir() else { return };
     let d = dir.path();
+    bake_the_raster_profiles(d);
+    the_profiled_bakes_verify(d);
+    moved_by_an_eighth_plain_has_holes_robust_none(d);
+    the_default_within_its_tolerance_has_no_hole(d);
+    the_default_within_its_tolerance_stays_exact_in_blend(d);
+    the_browser_bake_within_its_box_and_beyond_tolerances(d);
+}
+
+/// Bakes plain (`--conservative=false`), default, browser and robust bakes: each reports its
+/// raster profile, and the wider the box the more triangles it keeps.
+fn bake_the_raster_profiles(d: &Path) {
     let bake = format!("bake {SCENE} --path orbit:frames=2,degrees=40 --size 64x64 --samples 4");
     let plain = run_json(
         d,
@@ -248,6 +261,10 @@ fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
     assert!(tris(&robust) > tris(&plain), "{robust}\n{plain}");
     assert!(tris(&default) > tris(&plain), "{default}\n{plain}");
     assert!(tris(&browser) > tris(&default), "{browser}\n{default}");
+}
+
+/// The robust, default and browser bakes are valid and exact at their recorded pattern.
+fn the_profiled_bakes_verify(d: &Path) {
     // Still valid bakes, exact at their recorded pattern.
     for b in ["robust", "default", "browser"] {
         run(
@@ -261,11 +278,19 @@ fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
         &args("verify robust.baked --recording robust.baked.rec --scene demo:10000 --mode depth"),
         true,
     );
-    // Moved by 1/8 px, the plain bake shows holes, the robust one (±1/8 px) none.
+}
+
+/// Moved by 1/8 px, the plain bake shows holes, the robust one (±1/8 px) none.
+fn moved_by_an_eighth_plain_has_holes_robust_none(d: &Path) {
     let (plain_holes, plain_ok) = self_check_holes(d, "plain.baked", "1/8,0");
     assert!(plain_holes > 0 && !plain_ok, "{plain_holes}");
     let (robust_holes, robust_ok) = self_check_holes(d, "robust.baked", "1/8,0");
     assert_eq!((robust_holes, robust_ok), (0, true));
+}
+
+/// The default bake moved within its tolerance opens no hole, on lavapipe and on
+/// llvmpipe-GL.
+fn the_default_within_its_tolerance_has_no_hole(d: &Path) {
     // The default, moved anywhere within its tolerance: no hole, and in blend mode no pixel
     // differs from the exact reference moved alike beyond what the recorded pattern shows.
     for offset in ["1/512,0", "0,-1/512", "-1/512,1/512", "1/1024,1/512"] {
@@ -294,6 +319,11 @@ fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
         assert_eq!(v["self_check"]["holes"], 0, "GL, moved by {offset} px: {v}");
         assert!(out.status.success());
     }
+}
+
+/// The default bake moved within its tolerance differs from the exact reference moved alike
+/// by at most 1/255 in blend mode.
+fn the_default_within_its_tolerance_stays_exact_in_blend(d: &Path) {
     // In blend mode, no pixel differs from the exact reference moved alike by more than
     // 1/255 (`--max-error 1`: such a frame fails), on lavapipe and, played there, on
     // llvmpipe-GL: the grown capture's order holds wherever the moved samples fall.
@@ -331,6 +361,11 @@ fn a_conservative_bake_stays_exact_and_opens_no_hole_within_its_tolerance() {
             );
         }
     }
+}
+
+/// The browser bake opens no hole within its ±1/8 px box; beyond their tolerances the
+/// default and the plain bakes do.
+fn the_browser_bake_within_its_box_and_beyond_tolerances(d: &Path) {
     for offset in ["1/16,0", "1/8,0", "0,-1/8", "-0.1,0.1"] {
         assert_eq!(
             self_check_holes(d, "browser.baked", offset),

@@ -1,4 +1,4 @@
-//! Baking on several machines through the real binary (issue 18): `record --shard I/N|auto`
+//! Baking on several machines through the real binary: `record --shard I/N|auto`
 //! in balanced frame ranges, `record --phase union` (G written once), phase 2 per shard and
 //! `merge --join` give the bytes of a one-machine `bake`; every step refuses what does not
 //! belong to it, naming the file; `merge` refuses recordings of different devices unless
@@ -68,6 +68,18 @@ fn five_shards_bake_the_one_machine_bytes() {
         true,
     );
     let bounds = [0, 9, 19, 28, 38, 48];
+    phase1_shards_record_balanced_ranges(d, &bounds);
+    let vis: Vec<String> = (0..5).map(|i| format!("vis-{i}.rec")).collect();
+    let vis: Vec<&str> = vis.iter().map(String::as_str).collect();
+    union_equals_one_machines_phase1(d, &vis);
+    bad_unions_and_phase2_settings_are_refused(d, &vis);
+    phase2_shards_find_their_shard(d, &bounds);
+    union_refuses_a_phase2_recording(d);
+    join_gives_the_one_machine_bytes(d);
+}
+
+/// Phase 1 of each of the five shards records its balanced frame range.
+fn phase1_shards_record_balanced_ranges(d: &Path, bounds: &[u64; 6]) {
     for i in 0..5 {
         let shard = format!("{i}/5");
         let v = run_json(
@@ -84,10 +96,12 @@ fn five_shards_bake_the_one_machine_bytes() {
         assert_eq!(frames_of(&v), (bounds[i], bounds[i + 1]), "shard {shard}");
         assert!(d.join(format!("vis-{i}.rec")).is_file());
     }
-    let vis: Vec<String> = (0..5).map(|i| format!("vis-{i}.rec")).collect();
-    let vis: Vec<&str> = vis.iter().map(String::as_str).collect();
+}
+
+/// The union of the five phase-1 recordings is a one-machine phase-1 recording's bytes.
+fn union_equals_one_machines_phase1(d: &Path, vis: &[&str]) {
     let mut union = record(&["--phase", "union", "-o", "union.rec", "--visibility"]);
-    union.extend_from_slice(&vis);
+    union.extend_from_slice(vis);
     let v = run_json(d, &union);
     assert_eq!(v["frames"], 48);
     run(
@@ -99,7 +113,10 @@ fn five_shards_bake_the_one_machine_bytes() {
         read(d, "union.rec") == read(d, "whole-vis.rec"),
         "union = one machine's phase 1"
     );
+}
 
+/// A union missing shard 3, and phase 2 with other settings than phase 1's, are refused.
+fn bad_unions_and_phase2_settings_are_refused(d: &Path, vis: &[&str]) {
     // A union missing shard 3, and one given a phase-2 recording, are refused.
     let mut missing = record(&["--phase", "union", "-o", "bad.rec", "--visibility"]);
     missing.extend(vis.iter().filter(|v| **v != "vis-3.rec"));
@@ -133,7 +150,11 @@ fn five_shards_bake_the_one_machine_bytes() {
         "{err}"
     );
     assert!(!d.join("bad.rec").exists());
+}
 
+/// Phase 2 of each shard, two told their shard by Slurm's and Kubernetes' variables, covers
+/// its balanced range.
+fn phase2_shards_find_their_shard(d: &Path, bounds: &[u64; 6]) {
     for i in 0..5u64 {
         let out = format!("graphs-{i}.rec");
         let mut c = no_scheduler(d);
@@ -165,6 +186,10 @@ fn five_shards_bake_the_one_machine_bytes() {
             "phase 2 of shard {i}"
         );
     }
+}
+
+/// A union given a phase-2 recording is refused, naming it.
+fn union_refuses_a_phase2_recording(d: &Path) {
     let err = refused(
         d,
         &record(&[
@@ -180,7 +205,11 @@ fn five_shards_bake_the_one_machine_bytes() {
         err.contains("graphs-0.rec") && err.contains("not a phase-1"),
         "{err}"
     );
+}
 
+/// `merge --join` of the shards, given out of order, writes the one-machine bytes; without
+/// --join the bake names the five recordings.
+fn join_gives_the_one_machine_bytes(d: &Path) {
     // Given out of order: join sorts the shards by frame.
     run(
         d,

@@ -1,4 +1,4 @@
-//! Material variants and the stored frame rate (issue 17, part 3), end to end on CarConcept:
+//! Material variants and the stored frame rate, end to end on CarConcept:
 //! a 64x64 bake of a 2-frame orbit stores the path's fps and the three
 //! `KHR_materials_variants` tables; `play --variant` draws each, and `verify --variant
 //! --frames-dir` checks those very frames against the exact reference drawn with the
@@ -32,7 +32,17 @@ fn car_concept_variants_play_exactly_and_the_bake_keeps_its_fps() {
     };
     let Some(dir) = gpu_tempdir() else { return };
     let d = dir.path();
-    let mut bake = bake_args(&car, "orbit:frames=2", "64x64", "4", "car.baked");
+    let names = ["Carmine Candy", "Pearly Swirly", "Torched Graphite"];
+    bake_stores_fps_and_variants(d, &car, names);
+    each_variant_plays_and_verifies(d, &car, names);
+    webgl2_tier_and_default_verify(d, &car, names);
+    unknown_variant_lists_the_files(d);
+    forged_visibility_variant_is_refused(d);
+}
+
+/// Bakes the car at 24 fps; `inspect` shows the fps and the three variants.
+fn bake_stores_fps_and_variants(d: &Path, car: &str, names: [&str; 3]) {
+    let mut bake = bake_args(car, "orbit:frames=2", "64x64", "4", "car.baked");
     // Unsplit (faster to verify: the reference needs no split scene); the recording's cycles
     // excuse the pixels where triangles pass through each other.
     bake.extend(["--fps", "24", "--keep-intersections"]);
@@ -40,10 +50,13 @@ fn car_concept_variants_play_exactly_and_the_bake_keeps_its_fps() {
 
     let info = run_json(d, &["inspect", "car.baked"]);
     assert_eq!(info["fps"], 24.0);
-    let names = ["Carmine Candy", "Pearly Swirly", "Torched Graphite"];
     assert_eq!(info["variants"], serde_json::json!(names));
     assert_eq!(info["variants_refused"], serde_json::json!({}));
+}
 
+/// `play --variant` recolours every variant but Carmine Candy (the default look); each
+/// recoloured one verifies against the reference with its materials.
+fn each_variant_plays_and_verifies(d: &Path, car: &str, names: [&str; 3]) {
     let played = run_json(d, &args("play car.baked --out-dir default"));
     assert_eq!(played["variant"], serde_json::Value::Null);
     let default = frames(&d.join("default"));
@@ -77,7 +90,7 @@ fn car_concept_variants_play_exactly_and_the_bake_keeps_its_fps() {
                 "--recording",
                 "car.baked.rec",
                 "--scene",
-                &car,
+                car,
                 "--variant",
                 name,
                 "--frames-dir",
@@ -86,6 +99,11 @@ fn car_concept_variants_play_exactly_and_the_bake_keeps_its_fps() {
             true,
         );
     }
+}
+
+/// The WebGL2 tier draws a variant alike; the default check fails on a variant's frames and
+/// still passes on the default.
+fn webgl2_tier_and_default_verify(d: &Path, car: &str, names: [&str; 3]) {
     // The data-texture tier (WebGL2 limits) rewrites its material texels alike.
     let played = run_json(
         d,
@@ -105,7 +123,7 @@ fn car_concept_variants_play_exactly_and_the_bake_keeps_its_fps() {
     // The check can fail: a recoloured variant's frames are not the default look.
     run(
         d,
-        &["verify", "car.baked", "--scene", &car, "--frames-dir", "v1"],
+        &["verify", "car.baked", "--scene", car, "--frames-dir", "v1"],
         false,
     );
     // And the default still verifies.
@@ -117,12 +135,14 @@ fn car_concept_variants_play_exactly_and_the_bake_keeps_its_fps() {
             "--recording",
             "car.baked.rec",
             "--scene",
-            &car,
+            car,
         ],
         true,
     );
+}
 
-    // An unknown variant: the error lists the file's.
+/// An unknown variant: the error lists the file's.
+fn unknown_variant_lists_the_files(d: &Path) {
     let out = run(d, &args("play car.baked --variant Chrome"), false);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -132,9 +152,11 @@ fn car_concept_variants_play_exactly_and_the_bake_keeps_its_fps() {
         ),
         "{err}"
     );
+}
 
-    // A forged variant that turns a paint into a blended one is refused, naming the variant
-    // and both materials, before any frame is written.
+/// A forged variant that turns a paint into a blended one is refused, naming the variant
+/// and both materials, before any frame is written.
+fn forged_visibility_variant_is_refused(d: &Path) {
     let mut baked: Baked =
         trisort_format::read_file(FileKind::Baked, &d.join("car.baked")).unwrap();
     let g = &mut baked.geometry;

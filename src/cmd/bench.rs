@@ -9,7 +9,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
 use trisort_bench::methods::BenchView;
-use trisort_bench::report::{bake_for, markdown, report_json, write_outputs, TableRun};
+use trisort_bench::report::{bake_for, markdown, report_json, write_outputs, BakeRun, TableRun};
 use trisort_bench::table::{run_group, GroupInput, GroupReport, MethodKind};
 use trisort_format::{Bridge, RecordSettings};
 use trisort_gpu::Gpu;
@@ -121,15 +121,7 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
     if let Some(axis) = &a.scaling {
         return run_scaling(&a, axis);
     }
-    if a.samples.is_empty() || a.samples.iter().any(|&s| s != 1 && s != 4) {
-        bail!("--samples takes 1 and/or 4");
-    }
-    if a.mode.is_empty() || a.methods.is_empty() {
-        bail!("--mode and --methods need at least one entry");
-    }
-    if a.repeats == 0 {
-        bail!("--repeats must be at least 1");
-    }
+    check_table_args(&a)?;
     let t0 = Instant::now();
     // Every bake and rival below sees the scene as the default settings record it.
     let working = load_working(&a.scene, &a.path, a.fps, &RecordSettings::default())?;
@@ -145,28 +137,8 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
     if a.sweep {
         return run_sweep(&a, &gpu, &working, frames);
     }
-    let unvalidated = if a.no_unvalidated || !a.methods.contains(&MethodKind::Merged) {
-        None
-    } else {
-        Some(
-            Gpu::with_flags(trisort_player::instance_flags(false))
-                .context("opening a second device with indirect validation off")?,
-        )
-    };
-    let other = if a.device.options() == trisort_gpu::GpuOptions::default()
-        || !a.methods.contains(&MethodKind::Merged)
-    {
-        None
-    } else {
-        let g = crate::common::open_gpu_with(a.device.options()).with_context(|| {
-            format!(
-                "opening the --backend {} --limits {} device",
-                a.device.backend, a.device.limits
-            )
-        })?;
-        say(&format!("merged_device plays on {}", g.describe()));
-        Some(g)
-    };
+    let unvalidated = unvalidated_device(&a)?;
+    let other = other_device(&a)?;
     say(&format!(
         "{} on {}: {} frames measured of {}, {} repeats",
         a.scene,
@@ -175,7 +147,77 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
         n,
         a.repeats
     ));
+    let bakes = bake_samples(&a, &gpu, &working)?;
+    let devices = Devices {
+        gpu: &gpu,
+        unvalidated: unvalidated.as_ref(),
+        other: other.as_ref(),
+    };
+    let groups = run_groups(&a, &devices, &working, &bakes, &frames)?;
 
+    let run = TableRun {
+        device: gpu.describe(),
+        scene: &a.scene,
+        triangles: scene.geometry.triangles.len(),
+        path: &a.path,
+        path_frames: timeline.frames.len(),
+        frames: &frames,
+        size: a.size,
+        repeats: a.repeats,
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    write_table_report(&a, &run, &bakes, &groups)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses table arguments no run could use: samples other than 1 and 4, empty mode or
+/// method lists, no repeats.
+fn check_table_args(a: &BenchArgs) -> Result<()> {
+    if a.samples.is_empty() || a.samples.iter().any(|&s| s != 1 && s != 4) {
+        bail!("--samples takes 1 and/or 4");
+    }
+    if a.mode.is_empty() || a.methods.is_empty() {
+        bail!("--mode and --methods need at least one entry");
+    }
+    if a.repeats == 0 {
+        bail!("--repeats must be at least 1");
+    }
+    Ok(())
+}
+
+/// The second device `merged` is also timed on, with wgpu's indirect-call validation off
+/// (none with --no-unvalidated or without `merged`).
+fn unvalidated_device(a: &BenchArgs) -> Result<Option<Gpu>> {
+    if a.no_unvalidated || !a.methods.contains(&MethodKind::Merged) {
+        return Ok(None);
+    }
+    Ok(Some(
+        Gpu::with_flags(trisort_player::instance_flags(false))
+            .context("opening a second device with indirect validation off")?,
+    ))
+}
+
+/// The `--backend`/`--limits` device `merged_device` plays on (none at the defaults or
+/// without `merged`).
+fn other_device(a: &BenchArgs) -> Result<Option<Gpu>> {
+    if a.device.options() == trisort_gpu::GpuOptions::default()
+        || !a.methods.contains(&MethodKind::Merged)
+    {
+        return Ok(None);
+    }
+    let g = crate::common::open_gpu_with(a.device.options()).with_context(|| {
+        format!(
+            "opening the --backend {} --limits {} device",
+            a.device.backend, a.device.limits
+        )
+    })?;
+    say(&format!("merged_device plays on {}", g.describe()));
+    Ok(Some(g))
+}
+
+/// One bake per `--samples` count, each recorded at its own count (reused when found in
+/// --out).
+fn bake_samples(a: &BenchArgs, gpu: &Gpu, working: &trisort_bake::Working) -> Result<Vec<BakeRun>> {
     let mut bakes = Vec::new();
     for &s in &a.samples {
         let settings = trisort_bake::Settings {
@@ -192,16 +234,35 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
         };
         let mut console = crate::common::Console::new();
         bakes.push(bake_for(
-            &gpu,
-            &working,
+            gpu,
+            working,
             &settings,
             &a.out,
             &mut console,
             &say,
         )?);
     }
+    Ok(bakes)
+}
+
+/// The devices the table times on: the default one, and the optional extra ones.
+struct Devices<'a> {
+    gpu: &'a Gpu,
+    unvalidated: Option<&'a Gpu>,
+    other: Option<&'a Gpu>,
+}
+
+/// Times every method on every (bake, mode) pair: one group each, in that order.
+fn run_groups(
+    a: &BenchArgs,
+    devices: &Devices<'_>,
+    working: &trisort_bake::Working,
+    bakes: &[BakeRun],
+    frames: &[u32],
+) -> Result<Vec<GroupReport>> {
+    let (scene, timeline) = (&working.scene, &working.timeline);
     let mut groups: Vec<GroupReport> = Vec::new();
-    for b in &bakes {
+    for b in bakes {
         for &mode in &a.mode {
             say(&format!("{} samples, {} mode", b.samples, mode.name()));
             let input = GroupInput {
@@ -216,32 +277,31 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
                 },
                 mode,
                 methods: &a.methods,
-                frames: &frames,
+                frames,
                 repeats: a.repeats,
-                unvalidated: unvalidated.as_ref(),
-                other_device: other.as_ref(),
+                unvalidated: devices.unvalidated,
+                other_device: devices.other,
             };
             let label = format!("{}x {}", b.samples, mode.name());
-            groups.push(run_group(&gpu, &input, &|m| {
+            groups.push(run_group(devices.gpu, &input, &|m| {
                 say(&format!("[{label}] {m}"))
             })?);
         }
     }
+    Ok(groups)
+}
 
-    let run = TableRun {
-        device: gpu.describe(),
-        scene: &a.scene,
-        triangles: scene.geometry.triangles.len(),
-        path: &a.path,
-        path_frames: timeline.frames.len(),
-        frames: &frames,
-        size: a.size,
-        repeats: a.repeats,
-        seconds: t0.elapsed().as_secs_f64(),
-    };
-    let value = report_json(&run, &bakes, &groups);
-    write_outputs(&a.out, &value, &groups, &bakes)?;
-    let md = markdown(&value, &groups, &bakes);
+/// Writes bench.json, bench.csv, the plots and bench.md to --out, and prints the JSON or
+/// the Markdown table.
+fn write_table_report(
+    a: &BenchArgs,
+    run: &TableRun<'_>,
+    bakes: &[BakeRun],
+    groups: &[GroupReport],
+) -> Result<()> {
+    let value = report_json(run, bakes, groups);
+    write_outputs(&a.out, &value, groups, bakes)?;
+    let md = markdown(&value, groups, bakes);
     trisort_format::container::write_bytes_atomic(&a.out.join("bench.md"), md.as_bytes())?;
     if a.json {
         print_json(&value);
@@ -249,7 +309,7 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
         print!("{md}");
         println!("wrote {}", a.out.display());
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
 /// `--scaling triangles|frames`: bake cost against scene size or path length.

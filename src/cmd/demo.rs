@@ -6,8 +6,10 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::Args;
-use trisort_format::RecordSettings;
-use trisort_player::headless::HeadlessConfig;
+use trisort_format::{Baked, RecordSettings, Recording};
+use trisort_player::headless::{HeadlessConfig, RenderedFrame};
+use trisort_reference::frames::ImageReport;
+use trisort_verify::GraphReport;
 
 use crate::cmd::play::play_frames;
 use crate::common::parse_size;
@@ -46,36 +48,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         ..RecordSettings::new(a.size, a.samples)
     };
     settings.validate()?;
-    let triangles = a
-        .triangles
-        .unwrap_or(trisort_scene::demo_car::DEFAULT_TRIANGLES);
-    let mut scene = trisort_scene::demo_car::demo_car(triangles);
-    let path = trisort_paths::demo_default(&scene);
-    std::fs::create_dir_all(&a.out_dir)?;
-    if let Some(p) = &a.export_scene {
-        trisort_scene::export::export_glb(&scene, p)?;
-        println!("wrote {}", p.display());
-    }
-    println!(
-        "demo car: {} triangles, {} nodes, {} materials, glass at opacity {}; path: {} frames (orbit, driver door opens and closes)",
-        scene.stats.triangles,
-        scene.geometry.nodes.len(),
-        scene.geometry.materials.len(),
-        a.glass_opacity,
-        path.frames.len()
-    );
-    let t_split = Instant::now();
-    let split =
-        trisort_bake::working_scene(&mut scene, "demo", &path.frames, "the demo path", &settings)?;
-    let working = trisort_bake::Working {
-        scene,
-        timeline: path,
-        split,
-        split_seconds: t_split.elapsed().as_secs_f64(),
-    };
-    if let Some(line) = working.split_summary() {
-        eprintln!("trisort: {line}");
-    }
+    let working = demo_working(&a, &settings)?;
     let bake_settings = trisort_bake::Settings {
         fps: working.timeline.fps,
         record: settings,
@@ -113,16 +86,83 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     )?;
     let play_s = t_play.elapsed().as_secs_f64();
     let t_images = Instant::now();
+    let images = verify_demo_images(&gpu, &baked, &scene.geometry, &rec)?;
+    let images_s = t_images.elapsed().as_secs_f64();
+    print_bake_figures(&baked, &rec, &played, play_s);
+    print_verdicts(&report, &images);
+    let record = if reused { "record (reused)" } else { "record" };
+    println!("times:                  {record} {record_s:.1} s, merge {merge_s:.2} s, play {play_s:.1} s, verify images {images_s:.1} s, total {:.1} s", t0.elapsed().as_secs_f64());
+    println!(
+        "wrote {} and {} PNG frames in {}",
+        baked_path.display(),
+        played.len(),
+        frames_dir.display()
+    );
+    Ok(if report.ok && images.ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(crate::cmd::verify::VERIFY_FAILED)
+    })
+}
+
+/// The procedural car and its default path, split as `settings` record it; writes
+/// `--export-scene` and prints what the car holds.
+fn demo_working(a: &DemoArgs, settings: &RecordSettings) -> Result<trisort_bake::Working> {
+    let triangles = a
+        .triangles
+        .unwrap_or(trisort_scene::demo_car::DEFAULT_TRIANGLES);
+    let mut scene = trisort_scene::demo_car::demo_car(triangles);
+    let path = trisort_paths::demo_default(&scene);
+    std::fs::create_dir_all(&a.out_dir)?;
+    if let Some(p) = &a.export_scene {
+        trisort_scene::export::export_glb(&scene, p)?;
+        println!("wrote {}", p.display());
+    }
+    println!(
+        "demo car: {} triangles, {} nodes, {} materials, glass at opacity {}; path: {} frames (orbit, driver door opens and closes)",
+        scene.stats.triangles,
+        scene.geometry.nodes.len(),
+        scene.geometry.materials.len(),
+        a.glass_opacity,
+        path.frames.len()
+    );
+    let t_split = Instant::now();
+    let split =
+        trisort_bake::working_scene(&mut scene, "demo", &path.frames, "the demo path", settings)?;
+    let working = trisort_bake::Working {
+        scene,
+        timeline: path,
+        split,
+        split_seconds: t_split.elapsed().as_secs_f64(),
+    };
+    if let Some(line) = working.split_summary() {
+        eprintln!("trisort: {line}");
+    }
+    Ok(working)
+}
+
+/// Every frame the demo played, checked in blend mode against the exact reference.
+fn verify_demo_images(
+    gpu: &trisort_gpu::Gpu,
+    baked: &Baked,
+    geometry: &trisort_format::Geometry,
+    rec: &Recording,
+) -> Result<ImageReport> {
     let what = trisort_reference::frames::FramesToVerify {
-        baked: &baked,
-        geometry: &scene.geometry,
-        check: trisort_reference::ImageCheck::recorded(&baked, trisort_player::Mode::Blend),
-        recordings: std::slice::from_ref(&rec),
+        baked,
+        geometry,
+        check: trisort_reference::ImageCheck::recorded(baked, trisort_player::Mode::Blend),
+        recordings: std::slice::from_ref(rec),
         frames: 0..baked.frames.len() as u32,
         source: trisort_reference::frames::Frames::Play,
     };
-    let images = trisort_reference::frames::verify_images(&gpu, what, |_| Ok(()))?;
-    let images_s = t_images.elapsed().as_secs_f64();
+    Ok(trisort_reference::frames::verify_images(gpu, what, |_| {
+        Ok(())
+    })?)
+}
+
+/// The bake's figures: frames, raster profile, |G|, index size, draws and time per frame.
+fn print_bake_figures(baked: &Baked, rec: &Recording, played: &[RenderedFrame], play_s: f64) {
     let s = &baked.stats;
     let gpu_ms: Vec<f64> = played.iter().filter_map(|f| f.gpu_ms).collect();
     println!("frames:                 {}", baked.frames.len());
@@ -163,6 +203,10 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
             gpu_ms.iter().cloned().fold(0.0, f64::max)
         );
     }
+}
+
+/// The two checks' verdicts: the graph rules and the images against the exact reference.
+fn print_verdicts(report: &GraphReport, images: &ImageReport) {
     println!(
         "graph rules (verify):   {}",
         if report.ok {
@@ -182,17 +226,4 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         worst(|f| f.comparison.max_channel_diff_ordered),
         images.frames.iter().map(|f| f.unordered_samples).sum::<u64>()
     );
-    let record = if reused { "record (reused)" } else { "record" };
-    println!("times:                  {record} {record_s:.1} s, merge {merge_s:.2} s, play {play_s:.1} s, verify images {images_s:.1} s, total {:.1} s", t0.elapsed().as_secs_f64());
-    println!(
-        "wrote {} and {} PNG frames in {}",
-        baked_path.display(),
-        played.len(),
-        frames_dir.display()
-    );
-    Ok(if report.ok && images.ok {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(crate::cmd::verify::VERIFY_FAILED)
-    })
 }

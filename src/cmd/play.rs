@@ -9,7 +9,7 @@ use serde_json::json;
 use trisort_format::{Baked, FileKind};
 use trisort_gpu::{DeviceBackend, DeviceLimits, Gpu, GpuOptions, Shading, ToneMap};
 use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
-use trisort_player::{Mode, SelfCheck};
+use trisort_player::{Mode, SelfCheck, SelfCheckFrame};
 
 use crate::common::{parse_range, parse_size, print_json, progress_bar, FrameRange};
 
@@ -287,28 +287,7 @@ pub fn profile_check_json(
 
 pub fn run(a: PlayArgs) -> Result<ExitCode> {
     if a.window {
-        if a.device.options() != GpuOptions::default() {
-            anyhow::bail!("--backend and --limits apply to headless playback, not --window");
-        }
-        if a.subpixel_offset.is_some() || a.self_check {
-            anyhow::bail!(
-                "--subpixel-offset and --self-check apply to headless playback, not --window"
-            );
-        }
-        return super::window::run(super::window::WindowArgs {
-            baked: &a.baked,
-            frames: a.frames,
-            size: a.size,
-            samples: a.samples,
-            mode: a.mode,
-            glass_opacity: a.glass_opacity,
-            fps: a.fps,
-            variant: a.variant.clone(),
-            shading: a.shading,
-            exit_after: a.window_frames,
-            json: a.json,
-            strict_profile: a.strict_profile,
-        });
+        return run_window(&a);
     }
     let baked: Baked = trisort_format::read_file(FileKind::Baked, &a.baked)?;
     baked
@@ -319,17 +298,7 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
         Some(r) => r.resolve(n)?,
         None => 0..n,
     };
-    let mut config = HeadlessConfig::recorded(&baked);
-    config.mode = a.mode;
-    config.glass_opacity = a.glass_opacity;
-    config.shading = a.shading.shading;
-    config.tone_map = a.shading.tonemap;
-    if let Some(s) = a.size {
-        config.size = s;
-    }
-    if let Some(s) = a.samples {
-        config.samples = s;
-    }
+    let config = headless_config(&a, &baked);
     let gpu = crate::common::open_gpu_with(a.device.options())?;
     let offset = a.subpixel_offset.unwrap_or([0.0, 0.0]);
     let profile = check_profile(
@@ -357,95 +326,185 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
     )
     .with_context(|| format!("playing {}", a.baked.display()))?;
     let checks = if a.self_check {
-        let check = SelfCheck::new(&gpu, &baked, config.size, config.samples)?;
-        check.set_subpixel_offset(offset);
-        let bar = progress_bar(range.len() as u64, "self-check");
-        let mut out = Vec::with_capacity(range.len());
-        for f in range {
-            out.push(check.check(f)?);
-            bar.inc(1);
-        }
-        bar.finish_and_clear();
-        Some(out)
+        Some(self_check_frames(&gpu, &baked, &config, offset, range)?)
     } else {
         None
     };
     let holes: u64 = checks.iter().flatten().map(|c| c.holes).sum();
+    let played = Played {
+        gpu: &gpu,
+        config: &config,
+        frames: &frames,
+        path,
+        checks: checks.as_deref(),
+        holes,
+    };
     if a.json {
-        let list: Vec<_> = frames
-            .iter()
-            .enumerate()
-            .map(|(k, f)| {
-                let mut v = json!({"frame": f.frame, "gpu_ms": f.gpu_ms});
-                if let Some(c) = checks.as_ref().map(|c| c[k]) {
-                    v["holes"] = json!(c.holes);
-                    v["holes_max_channel_diff"] = json!(c.max_channel_diff);
-                }
-                v
-            })
-            .collect();
-        let mut v = json!({
-            "device": gpu.info.name,
-            "backend": format!("{:?}", gpu.info.backend),
-            "bindings": path.bindings,
-            "draw_path": path.draw_path,
-            "mode": a.mode.name(),
-            "shading": config.shading.name(),
-            "tonemap": config.tone_map.name(),
-            "texture_bytes": path.texture_bytes,
-            "variant": a.variant,
-            "subpixel_offset": offset,
-            "profile_check": profile_check_json(&baked, &profile),
-            "frames": list,
-        });
-        if checks.is_some() {
-            v["self_check"] = json!({"ok": holes == 0, "holes": holes});
-        }
-        print_json(&v);
+        print_play_json(&a, &baked, &played, offset, &profile);
     } else {
-        let ms: Vec<f64> = frames.iter().filter_map(|f| f.gpu_ms).collect();
-        let timing = if ms.is_empty() {
-            "no GPU timestamps on this adapter".to_string()
-        } else {
-            format!(
-                "GPU {:.3} ms per frame mean, {:.3} max",
-                ms.iter().sum::<f64>() / ms.len() as f64,
-                ms.iter().cloned().fold(0.0, f64::max)
-            )
-        };
-        println!(
-            "played {} frames ({} mode) on {} ({:?}; {} bindings, {} draws): {timing}",
-            frames.len(),
-            a.mode.name(),
-            gpu.info.name,
-            gpu.info.backend,
-            path.bindings,
-            path.draw_path
-        );
-        if let Some(d) = &a.out_dir {
-            println!("wrote {}", d.display());
-        }
-        if let Some(checks) = &checks {
-            let bad: Vec<_> = checks.iter().filter(|c| c.holes > 0).collect();
-            println!(
-                "self-check ({}x{}, {}x MSAA, depth mode, against a z-buffer of the file's own triangles): {} holes in {} of {} frames",
-                config.size.0,
-                config.size.1,
-                config.samples,
-                holes,
-                bad.len(),
-                checks.len()
-            );
-            for c in bad.iter().take(20) {
-                println!(
-                    "  frame {}: {} hole pixels (max {}/255)",
-                    c.frame, c.holes, c.max_channel_diff
-                );
-            }
-        }
+        print_play_text(&a, &played);
     }
     if holes > 0 {
         return Ok(ExitCode::from(super::verify::VERIFY_FAILED));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// `play --window`: refuses the headless-only options, then hands over to the viewer.
+fn run_window(a: &PlayArgs) -> Result<ExitCode> {
+    if a.device.options() != GpuOptions::default() {
+        anyhow::bail!("--backend and --limits apply to headless playback, not --window");
+    }
+    if a.subpixel_offset.is_some() || a.self_check {
+        anyhow::bail!(
+            "--subpixel-offset and --self-check apply to headless playback, not --window"
+        );
+    }
+    super::window::run(super::window::WindowArgs {
+        baked: &a.baked,
+        frames: a.frames,
+        size: a.size,
+        samples: a.samples,
+        mode: a.mode,
+        glass_opacity: a.glass_opacity,
+        fps: a.fps,
+        variant: a.variant.clone(),
+        shading: a.shading,
+        exit_after: a.window_frames,
+        json: a.json,
+        strict_profile: a.strict_profile,
+    })
+}
+
+/// The headless playback settings: the recorded ones with the command line's overrides.
+fn headless_config(a: &PlayArgs, baked: &Baked) -> HeadlessConfig {
+    let mut config = HeadlessConfig::recorded(baked);
+    config.mode = a.mode;
+    config.glass_opacity = a.glass_opacity;
+    config.shading = a.shading.shading;
+    config.tone_map = a.shading.tonemap;
+    if let Some(s) = a.size {
+        config.size = s;
+    }
+    if let Some(s) = a.samples {
+        config.samples = s;
+    }
+    config
+}
+
+/// `--self-check`: every frame of `range` checked for holes on this device.
+fn self_check_frames(
+    gpu: &Gpu,
+    baked: &Baked,
+    config: &HeadlessConfig,
+    offset: [f64; 2],
+    range: std::ops::Range<u32>,
+) -> Result<Vec<SelfCheckFrame>> {
+    let check = SelfCheck::new(gpu, baked, config.size, config.samples)?;
+    check.set_subpixel_offset(offset);
+    let bar = progress_bar(range.len() as u64, "self-check");
+    let mut out = Vec::with_capacity(range.len());
+    for f in range {
+        out.push(check.check(f)?);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    Ok(out)
+}
+
+/// What a headless `play` did, for its report.
+struct Played<'a> {
+    gpu: &'a Gpu,
+    config: &'a HeadlessConfig,
+    frames: &'a [RenderedFrame],
+    path: PlayedPath,
+    /// Per-frame self-check results (with `--self-check`).
+    checks: Option<&'a [SelfCheckFrame]>,
+    /// Hole pixels over all checked frames.
+    holes: u64,
+}
+
+/// `play --json`: the device, how it played and per-frame figures.
+fn print_play_json(
+    a: &PlayArgs,
+    baked: &Baked,
+    p: &Played<'_>,
+    offset: [f64; 2],
+    profile: &trisort_gpu::raster_probe::ProfileCheck,
+) {
+    let list: Vec<_> = p
+        .frames
+        .iter()
+        .enumerate()
+        .map(|(k, f)| {
+            let mut v = json!({"frame": f.frame, "gpu_ms": f.gpu_ms});
+            if let Some(c) = p.checks.map(|c| c[k]) {
+                v["holes"] = json!(c.holes);
+                v["holes_max_channel_diff"] = json!(c.max_channel_diff);
+            }
+            v
+        })
+        .collect();
+    let mut v = json!({
+        "device": p.gpu.info.name,
+        "backend": format!("{:?}", p.gpu.info.backend),
+        "bindings": p.path.bindings,
+        "draw_path": p.path.draw_path,
+        "mode": a.mode.name(),
+        "shading": p.config.shading.name(),
+        "tonemap": p.config.tone_map.name(),
+        "texture_bytes": p.path.texture_bytes,
+        "variant": a.variant,
+        "subpixel_offset": offset,
+        "profile_check": profile_check_json(baked, profile),
+        "frames": list,
+    });
+    if p.checks.is_some() {
+        v["self_check"] = json!({"ok": p.holes == 0, "holes": p.holes});
+    }
+    print_json(&v);
+}
+
+/// `play` without `--json`: timing, where the frames went and the self-check's holes.
+fn print_play_text(a: &PlayArgs, p: &Played<'_>) {
+    let ms: Vec<f64> = p.frames.iter().filter_map(|f| f.gpu_ms).collect();
+    let timing = if ms.is_empty() {
+        "no GPU timestamps on this adapter".to_string()
+    } else {
+        format!(
+            "GPU {:.3} ms per frame mean, {:.3} max",
+            ms.iter().sum::<f64>() / ms.len() as f64,
+            ms.iter().cloned().fold(0.0, f64::max)
+        )
+    };
+    println!(
+        "played {} frames ({} mode) on {} ({:?}; {} bindings, {} draws): {timing}",
+        p.frames.len(),
+        a.mode.name(),
+        p.gpu.info.name,
+        p.gpu.info.backend,
+        p.path.bindings,
+        p.path.draw_path
+    );
+    if let Some(d) = &a.out_dir {
+        println!("wrote {}", d.display());
+    }
+    if let Some(checks) = p.checks {
+        let bad: Vec<_> = checks.iter().filter(|c| c.holes > 0).collect();
+        println!(
+            "self-check ({}x{}, {}x MSAA, depth mode, against a z-buffer of the file's own triangles): {} holes in {} of {} frames",
+            p.config.size.0,
+            p.config.size.1,
+            p.config.samples,
+            p.holes,
+            bad.len(),
+            checks.len()
+        );
+        for c in bad.iter().take(20) {
+            println!(
+                "  frame {}: {} hole pixels (max {}/255)",
+                c.frame, c.holes, c.max_channel_diff
+            );
+        }
+    }
 }
