@@ -45,6 +45,10 @@ pub enum BakeError {
         /// Frames of the path.
         frames: u32,
     },
+    /// Recordings that cannot be used as given (malformed, of another scene, path, settings
+    /// or device, not covering the path).
+    #[error("{0}")]
+    Input(String),
     /// Shards that do not fit the path or the scheduler's environment.
     #[error("{0}")]
     Shard(String),

@@ -13,6 +13,7 @@
 
 mod error;
 pub mod figures;
+pub mod inputs;
 mod pipeline;
 mod record;
 pub mod shard;

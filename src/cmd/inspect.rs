@@ -47,7 +47,7 @@ fn inspect_recording(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
     if a.matrix.is_some() {
         anyhow::bail!("{}: --matrix needs a baked file, not a recording", a.file);
     }
-    let rec: Recording = crate::cmd::merge::read_recording(path)?;
+    let rec: Recording = trisort_bake::inputs::read_recording(path)?;
     let v = trisort_bake::figures::recording_json(&rec, None);
     if a.json {
         print_json(&v);

@@ -5,8 +5,10 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use trisort_format::{Bridge, Choice, FileKind, Layout, Recording, Seeding, Strategy};
+use trisort_format::{Bridge, Choice, FileKind, Layout, Seeding, Strategy};
 use trisort_merger::MergeOptions;
+
+use trisort_bake::inputs::{check_compatible, read_recordings};
 
 use crate::common::{choice_parser, option_parser, print_json};
 
@@ -96,81 +98,6 @@ pub struct MergeArgs {
     json: bool,
 }
 
-/// Reads recordings and checks their structure ([`Recording::check_structure`]), naming the
-/// file that fails.
-pub fn read_recordings(files: &[PathBuf]) -> Result<Vec<Recording>> {
-    files.iter().map(|f| read_recording(f)).collect()
-}
-
-/// Reads one recording and checks its structure, naming the file in the error.
-pub fn read_recording(file: &std::path::Path) -> Result<Recording> {
-    let rec: Recording = trisort_format::read_file(FileKind::Recording, file)?;
-    rec.check_structure()
-        .map_err(|e| anyhow::anyhow!("{}: malformed recording: {e}", file.display()))?;
-    Ok(rec)
-}
-
-/// A merger error, which names recordings by index, with the file of each index.
-pub fn name_files(e: &str, files: &[impl AsRef<std::path::Path>]) -> String {
-    format!(
-        "{e} (recordings: {})",
-        files
-            .iter()
-            .enumerate()
-            .map(|(i, n)| format!("{i} = {}", n.as_ref().display()))
-            .collect::<Vec<_>>()
-            .join(", ")
-    )
-}
-
-/// Checks that `recs` (read from `files`) are parts of one bake ([`trisort_merger::differences`]
-/// against the first): an error naming the file and every difference, except that with
-/// `allow_mixed_devices` a different device only gives a warning (returned, and printed on
-/// stderr).
-pub fn check_compatible(
-    recs: &[Recording],
-    files: &[PathBuf],
-    allow_mixed_devices: bool,
-) -> Result<Vec<String>> {
-    let mut warnings = Vec::new();
-    for (k, r) in recs.iter().enumerate().skip(1) {
-        let (device, other): (Vec<_>, Vec<_>) = trisort_merger::differences(&recs[0], r)
-            .into_iter()
-            .partition(|d| d.device);
-        if !other.is_empty() {
-            bail!(
-                "{} is not part of the same bake as {}: {}",
-                files[k].display(),
-                files[0].display(),
-                trisort_merger::list_differences(&other)
-            );
-        }
-        if !device.is_empty() {
-            if !allow_mixed_devices {
-                bail!(
-                    "{} was recorded on another device than {}: {}; a bake of both is exact \
-                     on neither (re-record it on one kind of device, or merge anyway with \
-                     --allow-mixed-devices)",
-                    files[k].display(),
-                    files[0].display(),
-                    trisort_merger::list_differences(&device)
-                );
-            }
-            let w = format!(
-                "{} was recorded on another device than {}: {}; merged anyway \
-                 (--allow-mixed-devices): the bake is exact on neither, and its device says \
-                 \"mixed: …\"",
-                files[k].display(),
-                files[0].display(),
-                trisort_merger::list_differences(&device)
-            );
-            eprintln!("trisort: warning: {w}");
-            warnings.push(w);
-        }
-    }
-    Ok(warnings)
-}
-
 pub fn run(a: MergeArgs) -> Result<ExitCode> {
     let mut recs = read_recordings(&a.recordings)?;
     for (r, f) in recs.iter().zip(&a.recordings) {
@@ -182,7 +109,9 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
             );
         }
     }
-    check_compatible(&recs, &a.recordings, a.allow_mixed_devices)?;
+    for w in check_compatible(&recs, &a.recordings, a.allow_mixed_devices)? {
+        eprintln!("trisort: warning: {w}");
+    }
     // Before anything is written: a bad light leaves no output.
     let environment = a.opts.light().load()?;
     let mut names: Vec<String> = a
@@ -192,8 +121,11 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
         .collect();
     let t0 = std::time::Instant::now();
     if let Some(join) = &a.join {
-        let joined = trisort_merger::join(&recs)
-            .map_err(|e| anyhow::anyhow!("{}", name_files(&e.to_string(), &a.recordings)))?;
+        let joined =
+            trisort_merger::join(&recs).map_err(|error| trisort_bake::BakeError::Merge {
+                error,
+                files: names.clone(),
+            })?;
         trisort_format::write_file_atomic(FileKind::Recording, join, &joined)
             .with_context(|| format!("writing {}", join.display()))?;
         recs = vec![joined];

@@ -7,9 +7,10 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use trisort_bake::figures::{add_split_json, recording_json};
+use trisort_bake::inputs::{join_visibility, union_of_visibility};
 use trisort_bake::shard::{parse_shard, shard_range, ShardArg};
 use trisort_bake::{record_to_file, RecordTarget};
-use trisort_format::{DeviceInfo, FileKind, Phase, Recording};
+use trisort_format::{FileKind, Phase};
 
 use crate::cmd::RecordOpts;
 use crate::common::{load_working, print_json, Console, FrameRange};
@@ -66,7 +67,7 @@ pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
     let settings = a.opts.settings()?;
     let working = load_working(&a.scene, &a.path, a.opts.fps, &settings)?;
-    let (scene, timeline) = (&working.scene, &working.timeline);
+    let timeline = &working.timeline;
     if let Some(shard) = a.shard {
         let (i, n) = shard.resolve(&|k| std::env::var(k).ok())?;
         let range = shard_range(i, n, timeline.frames.len() as u32)?;
@@ -92,12 +93,15 @@ pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
             (Phase::Graphs, None)
         }
         PhaseArg::Graphs => {
-            let known = union_of_visibility(&a.visibility, scene, timeline, &settings)?;
-            let (g, devices) = known.unzip();
-            visibility_devices = devices.unwrap_or_default();
-            (Phase::Graphs, g)
+            if a.visibility.is_empty() {
+                (Phase::Graphs, None)
+            } else {
+                let (g, devices) = union_of_visibility(&a.visibility, &working, &settings)?;
+                visibility_devices = devices;
+                (Phase::Graphs, Some(g))
+            }
         }
-        PhaseArg::Union => return write_union(&a, scene, timeline, t0),
+        PhaseArg::Union => return write_union(&a, &working, t0),
     };
     let gpu = crate::common::open_gpu()?;
     // G from another device's phase 1 is not this device's: its visible sets could fall
@@ -149,100 +153,21 @@ pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// A recording file and the device it was recorded on.
-type FileDevice = (PathBuf, DeviceInfo);
-
-/// G from phase-1 recordings that together cover every frame of the path, recorded with
-/// `settings`; with the device each file was recorded on (phase 2 must run on the same).
-fn union_of_visibility(
-    files: &[PathBuf],
-    scene: &trisort_scene::Scene,
-    timeline: &trisort_paths::Timeline,
-    settings: &trisort_format::RecordSettings,
-) -> Result<Option<(Vec<u32>, Vec<FileDevice>)>> {
-    if files.is_empty() {
-        return Ok(None);
-    }
-    let n = timeline.frames.len();
-    let mut seen = vec![false; n];
-    let mut g = Vec::new();
-    let mut devices = Vec::new();
-    for f in files {
-        let rec: Recording = crate::cmd::merge::read_recording(f)?;
-        if rec.scene_hash != scene.hash()
-            || rec.path_hash != timeline.hash()
-            || rec.frame_states.len() != n
-        {
-            bail!("{}: recorded from another scene or path", f.display());
-        }
-        let differ = trisort_merger::settings_differences(&rec.settings, settings);
-        if !differ.is_empty() {
-            bail!(
-                "{}: recorded with other settings than this command line's: {}",
-                f.display(),
-                trisort_merger::list_differences(&differ)
-            );
-        }
-        devices.push((f.clone(), rec.device.clone()));
-        for fr in &rec.frames {
-            seen[fr.frame as usize] = true;
-            g.extend_from_slice(&fr.visible);
-        }
-    }
-    if let Some(missing) = seen.iter().position(|s| !s) {
-        bail!("the --visibility recordings do not cover frame {missing} of the path's {n}; G needs every frame");
-    }
-    g.sort_unstable();
-    g.dedup();
-    Ok(Some((g, devices)))
-}
-
 /// `--phase union`: joins the `--visibility` phase-1 recordings into one phase-1 recording of
 /// the whole path (G once, for every shard's phase 2) and writes it atomically.
-fn write_union(
-    a: &RecordArgs,
-    scene: &trisort_scene::Scene,
-    timeline: &trisort_paths::Timeline,
-    t0: Instant,
-) -> Result<ExitCode> {
+fn write_union(a: &RecordArgs, working: &trisort_bake::Working, t0: Instant) -> Result<ExitCode> {
     if a.visibility.is_empty() {
         bail!("--phase union needs the phase-1 recordings: --visibility REC...");
     }
     if a.shard.is_some() || a.opts.frames.is_some() {
         bail!("--phase union joins whole-path results; it takes no --shard or --frames");
     }
-    let recs = crate::cmd::merge::read_recordings(&a.visibility)?;
-    for (r, f) in recs.iter().zip(&a.visibility) {
-        if r.phase != Phase::Visibility {
-            bail!(
-                "{}: not a phase-1 recording (record it with --phase visibility)",
-                f.display()
-            );
-        }
-    }
-    crate::cmd::merge::check_compatible(&recs, &a.visibility, false)?;
-    let rec = trisort_merger::join(&recs).map_err(|e| {
-        anyhow::anyhow!(
-            "{}",
-            crate::cmd::merge::name_files(&e.to_string(), &a.visibility)
-        )
-    })?;
-    if rec.scene_hash != scene.hash() || rec.path_hash != timeline.hash() {
-        bail!(
-            "{}: recorded from another scene or path than {} --path {}",
-            a.visibility[0].display(),
-            a.scene,
-            a.path
-        );
-    }
-    let differ = trisort_merger::settings_differences(&rec.settings, &a.opts.settings()?);
-    if !differ.is_empty() {
-        bail!(
-            "{}: recorded with other settings than this command line's: {}",
-            a.visibility[0].display(),
-            trisort_merger::list_differences(&differ)
-        );
-    }
+    let (rec, joined) = join_visibility(
+        &a.visibility,
+        working,
+        &a.opts.settings()?,
+        (&a.scene, &a.path),
+    )?;
     trisort_format::write_file_atomic(FileKind::Recording, &a.output, &rec)?;
     let secs = t0.elapsed().as_secs_f64();
     if a.json {
@@ -250,7 +175,7 @@ fn write_union(
     } else {
         println!(
             "joined {} phase-1 recordings of {} frames: |G| = {} of {} triangles; wrote {}",
-            recs.len(),
+            joined,
             rec.frames.len(),
             rec.unique_visible.len(),
             rec.scene_triangles,

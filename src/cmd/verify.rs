@@ -28,8 +28,8 @@ use trisort_reference::frames::{verify_images, write_diff, Frames, FramesToVerif
 use trisort_reference::report::{json_report, text_report};
 use trisort_reference::ImageCheck;
 
-use crate::cmd::merge::read_recordings;
 use crate::common::{load_scene, parse_range, parse_size, print_json, FrameRange};
+use trisort_bake::inputs::read_recordings;
 use trisort_bake::working_scene;
 
 /// Exit code of a verification that ran and found the baked file wrong.

@@ -1,0 +1,156 @@
+//! Recordings as inputs of a merge or of a shard's phase 2: read and checked, checked to be
+//! parts of one bake, and phase-1 results joined into G.
+
+use std::path::{Path, PathBuf};
+
+use trisort_format::{DeviceInfo, FileKind, Phase, RecordSettings, Recording};
+use trisort_merger::{list_differences, settings_differences};
+
+use crate::{BakeError, Working};
+
+/// Reads one recording and checks its structure, naming the file when either fails.
+pub fn read_recording(file: &Path) -> Result<Recording, BakeError> {
+    let rec: Recording = trisort_format::read_file(FileKind::Recording, file)?;
+    rec.check_structure()
+        .map_err(|e| BakeError::Input(format!("{}: malformed recording: {e}", file.display())))?;
+    Ok(rec)
+}
+
+/// Reads recordings and checks their structure ([`read_recording`]).
+pub fn read_recordings(files: &[PathBuf]) -> Result<Vec<Recording>, BakeError> {
+    files.iter().map(|f| read_recording(f)).collect()
+}
+
+/// Checks that `recs` (read from `files`) are parts of one bake
+/// ([`trisort_merger::differences`] against the first): an error naming the file and every
+/// difference, except that with `allow_mixed_devices` a different device only gives a
+/// warning, returned for the caller to show.
+pub fn check_compatible(
+    recs: &[Recording],
+    files: &[PathBuf],
+    allow_mixed_devices: bool,
+) -> Result<Vec<String>, BakeError> {
+    let mut warnings = Vec::new();
+    for (k, r) in recs.iter().enumerate().skip(1) {
+        let (device, other): (Vec<_>, Vec<_>) = trisort_merger::differences(&recs[0], r)
+            .into_iter()
+            .partition(|d| d.device);
+        let (this, first) = (files[k].display(), files[0].display());
+        if !other.is_empty() {
+            return Err(BakeError::Input(format!(
+                "{this} is not part of the same bake as {first}: {}",
+                list_differences(&other)
+            )));
+        }
+        if device.is_empty() {
+            continue;
+        }
+        if !allow_mixed_devices {
+            return Err(BakeError::Input(format!(
+                "{this} was recorded on another device than {first}: {}; a bake of both is \
+                 exact on neither (re-record it on one kind of device, or merge anyway with \
+                 --allow-mixed-devices)",
+                list_differences(&device)
+            )));
+        }
+        warnings.push(format!(
+            "{this} was recorded on another device than {first}: {}; merged anyway \
+             (--allow-mixed-devices): the bake is exact on neither, and its device says \
+             \"mixed: …\"",
+            list_differences(&device)
+        ));
+    }
+    Ok(warnings)
+}
+
+/// An error unless `rec` (read from `file`) was recorded with `settings`.
+fn check_settings(
+    rec: &Recording,
+    file: &Path,
+    settings: &RecordSettings,
+) -> Result<(), BakeError> {
+    let differ = settings_differences(&rec.settings, settings);
+    if differ.is_empty() {
+        return Ok(());
+    }
+    Err(BakeError::Input(format!(
+        "{}: recorded with other settings than this command line's: {}",
+        file.display(),
+        list_differences(&differ)
+    )))
+}
+
+/// G from phase-1 recordings (`files`) that together cover every frame of `working`'s path,
+/// recorded with `settings`; with the device each file was recorded on (phase 2 must run on
+/// the same kind).
+pub fn union_of_visibility(
+    files: &[PathBuf],
+    working: &Working,
+    settings: &RecordSettings,
+) -> Result<(Vec<u32>, Vec<(PathBuf, DeviceInfo)>), BakeError> {
+    let n = working.timeline.frames.len();
+    let mut seen = vec![false; n];
+    let mut g = Vec::new();
+    let mut devices = Vec::new();
+    for f in files {
+        let rec = read_recording(f)?;
+        if rec.scene_hash != working.scene.hash()
+            || rec.path_hash != working.timeline.hash()
+            || rec.frame_states.len() != n
+        {
+            let why = format!("{}: recorded from another scene or path", f.display());
+            return Err(BakeError::Input(why));
+        }
+        check_settings(&rec, f, settings)?;
+        devices.push((f.clone(), rec.device.clone()));
+        for fr in &rec.frames {
+            seen[fr.frame as usize] = true;
+            g.extend_from_slice(&fr.visible);
+        }
+    }
+    if let Some(missing) = seen.iter().position(|s| !s) {
+        return Err(BakeError::Input(format!(
+            "the --visibility recordings do not cover frame {missing} of the path's {n}; G \
+             needs every frame"
+        )));
+    }
+    g.sort_unstable();
+    g.dedup();
+    Ok((g, devices))
+}
+
+/// Joins phase-1 recordings (`files`, frame ranges covering `working`'s path, e.g. one per
+/// shard) into one phase-1 recording of the whole path, whose G every shard's phase 2 reads;
+/// they must be of `working`'s scene (`scene` and `path` name it in errors) and recorded with
+/// `settings`.
+pub fn join_visibility(
+    files: &[PathBuf],
+    working: &Working,
+    settings: &RecordSettings,
+    names: (&str, &str),
+) -> Result<(Recording, usize), BakeError> {
+    let recs = read_recordings(files)?;
+    for (r, f) in recs.iter().zip(files) {
+        if r.phase != Phase::Visibility {
+            return Err(BakeError::Input(format!(
+                "{}: not a phase-1 recording (record it with --phase visibility)",
+                f.display()
+            )));
+        }
+    }
+    check_compatible(&recs, files, false)?;
+    let rec = trisort_merger::join(&recs).map_err(|error| BakeError::Merge {
+        error,
+        files: files.iter().map(|f| f.display().to_string()).collect(),
+    })?;
+    if rec.scene_hash != working.scene.hash() || rec.path_hash != working.timeline.hash() {
+        return Err(BakeError::Input(format!(
+            "{}: recorded from another scene or path than {} --path {}",
+            files[0].display(),
+            names.0,
+            names.1
+        )));
+    }
+    check_settings(&rec, &files[0], settings)?;
+    Ok((rec, recs.len()))
+}
