@@ -275,3 +275,28 @@ pub fn scene_json(
         "intersections_left": split.pairs_skipped_sliver,
     })
 }
+
+/// `play --json`'s `profile_check`: `ok`, `differences` (in words), the `profile` checked
+/// against (the bake's `raster_profile`), what the API reported (`api`: `subpixel_bits`,
+/// `standard_sample_locations`, null where it cannot say) and what the probe measured
+/// (`probe`: `consistent_subpixel_bits`, the coverage steps `x` and `y` in pixels).
+pub fn profile_check_json(
+    baked: &Baked,
+    c: &trisort_gpu::raster_probe::ProfileCheck,
+) -> serde_json::Value {
+    json!({
+        "ok": c.ok,
+        "differences": c.differences,
+        "profile": raster_profile_json(&baked.settings),
+        "api": {
+            "subpixel_bits": c.api.subpixel_bits,
+            "standard_sample_locations": c.api.standard_sample_locations,
+        },
+        "probe": {
+            "samples": c.probe.samples,
+            "consistent_subpixel_bits": c.probe.consistent_bits,
+            "x": c.probe.drops[0],
+            "y": c.probe.drops[1],
+        },
+    })
+}

@@ -80,6 +80,9 @@ fn check_settings(
     )))
 }
 
+/// A recording's file and the device it was recorded on.
+pub type FileDevice = (PathBuf, DeviceInfo);
+
 /// G from phase-1 recordings (`files`) that together cover every frame of `working`'s path,
 /// recorded with `settings`; with the device each file was recorded on (phase 2 must run on
 /// the same kind).
@@ -87,7 +90,7 @@ pub fn union_of_visibility(
     files: &[PathBuf],
     working: &Working,
     settings: &RecordSettings,
-) -> Result<(Vec<u32>, Vec<(PathBuf, DeviceInfo)>), BakeError> {
+) -> Result<(Vec<u32>, Vec<FileDevice>), BakeError> {
     let n = working.timeline.frames.len();
     let mut seen = vec![false; n];
     let mut g = Vec::new();

@@ -1,13 +1,14 @@
-//! Image verification of a range of frames: each frame played here, read from PNGs drawn
-//! elsewhere, or played on another device, checked against the exact reference
-//! ([`ImageVerifier`]), with difference images for the frames that fail.
+//! Frames as images: a range of frames played to PNGs ([`play_frames_to`]), and image
+//! verification of a range of frames, each played here, read from PNGs drawn elsewhere, or
+//! played on another device, checked against the exact reference ([`ImageVerifier`]), with
+//! difference images for the frames that fail.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use trisort_format::{Baked, Geometry, Recording};
 use trisort_gpu::Gpu;
-use trisort_player::headless::HeadlessRenderer;
+use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
 
 use crate::compare::{difference_image, mask_image};
 use crate::{FrameImageReport, ImageCheck, ImageVerifier, ReferenceError, VerifiedFrame};
@@ -188,4 +189,80 @@ pub fn write_diff(dir: &Path, v: &VerifiedFrame, size: (u32, u32)) -> Result<(),
     write_png(&dir.join(format!("{f:05}-diff.png")), w, h, &diff)?;
     let mask = mask_image(&r.unordered);
     write_png(&dir.join(format!("{f:05}-unordered.png")), w, h, &mask)
+}
+
+/// What [`play_frames_to`] plays: frames of a baked file at `config`, the projection moved
+/// by `offset` pixels, with material variant `variant` (`None`: the default materials),
+/// written as `frame-NNNNN.png` into `out_dir` when given.
+pub struct PlayFrames<'a> {
+    /// The baked file.
+    pub baked: &'a Baked,
+    /// Size, samples, mode, shading.
+    pub config: &'a HeadlessConfig,
+    /// The frames.
+    pub frames: Range<u32>,
+    /// Where to write the PNGs (created if missing).
+    pub out_dir: Option<&'a Path>,
+    /// Sub-pixel shift of the projection, in pixels.
+    pub offset: [f64; 2],
+    /// Material variant.
+    pub variant: Option<&'a str>,
+}
+
+/// How [`play_frames_to`] played: the player's binding tier, draw path, texture bytes and
+/// warnings.
+#[derive(Clone, Debug)]
+pub struct PlayedPath {
+    /// `storage` or `textures` (`trisort_gpu::Bindings::name`).
+    pub bindings: &'static str,
+    /// `multi-draw-indirect` or `direct` (`trisort_player::DrawPath::name`).
+    pub draw_path: &'static str,
+    /// GPU bytes of the scene's textures and environment (`SceneGpu::texture_bytes`).
+    pub texture_bytes: u64,
+    /// The player's warnings (e.g. a size other than the recorded one).
+    pub warnings: Vec<String>,
+}
+
+/// Plays `what`'s frames with the player, writing each as PNG when asked, and calls `each`
+/// after every frame. The frames come back without their pixels (which are in the PNGs),
+/// with their timings. One untimed render comes first: the first draw compiles pipelines
+/// (about 150 ms on lavapipe), which is not playback cost.
+pub fn play_frames_to(
+    gpu: &Gpu,
+    what: PlayFrames<'_>,
+    mut each: impl FnMut(u32),
+) -> Result<(Vec<RenderedFrame>, PlayedPath), FramesError> {
+    let renderer = HeadlessRenderer::new(gpu, what.baked, what.config)?;
+    renderer.set_subpixel_offset(what.offset);
+    renderer.set_variant(what.variant)?;
+    let player = renderer.player();
+    let path = PlayedPath {
+        bindings: player.bindings().name(),
+        draw_path: player.config().draw_path.name(),
+        texture_bytes: player.texture_bytes(),
+        warnings: player.warnings().to_vec(),
+    };
+    if let Some(d) = what.out_dir {
+        std::fs::create_dir_all(d).map_err(|e| FramesError::Write {
+            path: d.to_path_buf(),
+            problem: format!("creating: {e}"),
+        })?;
+    }
+    if !what.frames.is_empty() {
+        renderer.render(what.frames.start)?;
+    }
+    let (w, h) = what.config.size;
+    let mut out = Vec::with_capacity(what.frames.len());
+    for f in what.frames {
+        let r = renderer.render(f)?;
+        if let Some(d) = what.out_dir {
+            write_png(&d.join(format!("frame-{f:05}.png")), w, h, &r.rgba8)?;
+        }
+        each(f);
+        out.push(RenderedFrame {
+            rgba8: Vec::new(),
+            ..r
+        });
+    }
+    Ok((out, path))
 }

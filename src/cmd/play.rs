@@ -8,8 +8,10 @@ use clap::Args;
 use serde_json::json;
 use trisort_format::{Baked, FileKind};
 use trisort_gpu::{DeviceBackend, DeviceLimits, Gpu, GpuOptions, Shading, ToneMap};
-use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
+use trisort_player::headless::{HeadlessConfig, RenderedFrame};
 use trisort_player::{Mode, SelfCheck, SelfCheckFrame};
+
+use trisort_reference::frames::{play_frames_to, PlayFrames, PlayedPath};
 
 use crate::common::{parse_range, parse_size, print_json, progress_bar, FrameRange};
 
@@ -149,24 +151,6 @@ impl DeviceArgs {
     }
 }
 
-/// What `play_frames` played with: the player's binding tier and draw path.
-#[derive(Clone, Copy, Debug)]
-pub struct PlayedPath {
-    /// `storage` or `textures` (`trisort_gpu::Bindings::name`).
-    pub bindings: &'static str,
-    /// `multi-draw-indirect` or `direct` (`trisort_player::DrawPath::name`).
-    pub draw_path: &'static str,
-    /// GPU bytes of the scene's textures and environment (`SceneGpu::texture_bytes`).
-    pub texture_bytes: u64,
-}
-
-/// Writes a frame as PNG atomically.
-pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
-    Ok(trisort_reference::frames::write_png(
-        path, width, height, rgba8,
-    )?)
-}
-
 /// Renders frames of a baked file, optionally writing PNGs; prints the player's warnings.
 pub fn play_frames(
     gpu: &Gpu,
@@ -175,60 +159,26 @@ pub fn play_frames(
     frames: std::ops::Range<u32>,
     out_dir: Option<&Path>,
 ) -> Result<Vec<RenderedFrame>> {
-    Ok(play_frames_on_path(gpu, baked, config, frames, out_dir, [0.0, 0.0], None)?.0)
+    let what = PlayFrames {
+        baked,
+        config,
+        frames,
+        out_dir,
+        offset: [0.0, 0.0],
+        variant: None,
+    };
+    Ok(play_with_progress(gpu, what)?.0)
 }
 
-/// [`play_frames`] with the projection shifted by `offset` pixels and the materials of
-/// material variant `variant` (`None`: the default ones), also saying which binding tier and
-/// draw path played.
-pub fn play_frames_on_path(
-    gpu: &Gpu,
-    baked: &Baked,
-    config: &HeadlessConfig,
-    frames: std::ops::Range<u32>,
-    out_dir: Option<&Path>,
-    offset: [f64; 2],
-    variant: Option<&str>,
-) -> Result<(Vec<RenderedFrame>, PlayedPath)> {
-    let renderer = HeadlessRenderer::new(gpu, baked, config)?;
-    renderer.set_subpixel_offset(offset);
-    renderer.set_variant(variant)?;
-    let path = PlayedPath {
-        bindings: renderer.player().bindings().name(),
-        draw_path: renderer.player().config().draw_path.name(),
-        texture_bytes: renderer.player().texture_bytes(),
-    };
-    for w in renderer.player().warnings() {
+/// [`play_frames_to`] with a progress bar on stderr and the player's warnings printed.
+fn play_with_progress(gpu: &Gpu, what: PlayFrames<'_>) -> Result<(Vec<RenderedFrame>, PlayedPath)> {
+    let bar = progress_bar(what.frames.len() as u64, "play");
+    let played = play_frames_to(gpu, what, |_| bar.inc(1))?;
+    bar.finish_and_clear();
+    for w in &played.1.warnings {
         eprintln!("trisort: warning: {w}");
     }
-    if let Some(d) = out_dir {
-        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
-    }
-    // One untimed render first: the first draw compiles pipelines (≈150 ms on lavapipe),
-    // which is not playback cost.
-    if !frames.is_empty() {
-        renderer.render(frames.start)?;
-    }
-    let bar = progress_bar(frames.len() as u64, "play");
-    let mut out = Vec::new();
-    for f in frames {
-        let r = renderer.render(f)?;
-        if let Some(d) = out_dir {
-            write_png(
-                &d.join(format!("frame-{f:05}.png")),
-                config.size.0,
-                config.size.1,
-                &r.rgba8,
-            )?;
-        }
-        bar.inc(1);
-        out.push(RenderedFrame {
-            rgba8: Vec::new(),
-            ..r
-        });
-    }
-    bar.finish_and_clear();
-    Ok((out, path))
+    Ok(played)
 }
 
 /// Checks the device against the bake's raster profile at `samples` with the projection moved
@@ -258,31 +208,6 @@ pub fn check_profile(
         eprintln!("trisort: warning: {what} (frames may show holes or order errors there)");
     }
     Ok(check)
-}
-
-/// `play --json`'s `profile_check`: `ok`, `differences` (in words), the `profile` checked
-/// against (the bake's `raster_profile`), what the API reported (`api`: `subpixel_bits`,
-/// `standard_sample_locations`, null where it cannot say) and what the probe measured
-/// (`probe`: `consistent_subpixel_bits`, the coverage steps `x` and `y` in pixels).
-pub fn profile_check_json(
-    baked: &Baked,
-    c: &trisort_gpu::raster_probe::ProfileCheck,
-) -> serde_json::Value {
-    json!({
-        "ok": c.ok,
-        "differences": c.differences,
-        "profile": trisort_bake::figures::raster_profile_json(&baked.settings),
-        "api": {
-            "subpixel_bits": c.api.subpixel_bits,
-            "standard_sample_locations": c.api.standard_sample_locations,
-        },
-        "probe": {
-            "samples": c.probe.samples,
-            "consistent_subpixel_bits": c.probe.consistent_bits,
-            "x": c.probe.drops[0],
-            "y": c.probe.drops[1],
-        },
-    })
 }
 
 pub fn run(a: PlayArgs) -> Result<ExitCode> {
@@ -315,16 +240,16 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
             offset[0], offset[1]
         );
     }
-    let (frames, path) = play_frames_on_path(
-        &gpu,
-        &baked,
-        &config,
-        range.clone(),
-        a.out_dir.as_deref(),
+    let what = PlayFrames {
+        baked: &baked,
+        config: &config,
+        frames: range.clone(),
+        out_dir: a.out_dir.as_deref(),
         offset,
-        a.variant.as_deref(),
-    )
-    .with_context(|| format!("playing {}", a.baked.display()))?;
+        variant: a.variant.as_deref(),
+    };
+    let (frames, path) =
+        play_with_progress(&gpu, what).with_context(|| format!("playing {}", a.baked.display()))?;
     let checks = if a.self_check {
         Some(self_check_frames(&gpu, &baked, &config, offset, range)?)
     } else {
@@ -456,7 +381,7 @@ fn print_play_json(
         "texture_bytes": p.path.texture_bytes,
         "variant": a.variant,
         "subpixel_offset": offset,
-        "profile_check": profile_check_json(baked, profile),
+        "profile_check": trisort_bake::figures::profile_check_json(baked, profile),
         "frames": list,
     });
     if p.checks.is_some() {
