@@ -1,13 +1,14 @@
-//! Helpers shared by the subcommands: loading scenes and paths, parsing sizes and ranges,
-//! progress bars and JSON output.
-
-use std::ops::Range;
-use std::sync::OnceLock;
+//! Helpers shared by the subcommands: loading scenes and paths with notes on stderr, the
+//! value parsers, progress bars and JSON output.
 
 use anyhow::Result;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use trisort_format::{Choice, Choosable, OptionValue, ParseOptionError, RecordSettings};
 use trisort_scene::Scene;
+
+pub use trisort_bake::spec::{
+    default_size, parse_bits, parse_range, parse_size, parse_subpixel_offset, FrameRange,
+};
 
 /// Loads a scene ([`trisort_bake::load_scene`]) and prints the importer's notes on stderr.
 pub fn load_scene(spec: &str) -> Result<Scene> {
@@ -16,36 +17,6 @@ pub fn load_scene(spec: &str) -> Result<Scene> {
         eprintln!("trisort: note: {note}");
     }
     Ok(scene)
-}
-
-/// Parses `WIDTHxHEIGHT` or a single number for a square.
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let parse = |x: &str| {
-        x.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("bad size {s:?}: expected WIDTHxHEIGHT"))
-    };
-    let (w, h) = match s.split_once(['x', 'X']) {
-        Some((w, h)) => (parse(w)?, parse(h)?),
-        None => {
-            let n = parse(s)?;
-            (n, n)
-        }
-    };
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        return Err(format!("size {s}: each side must be 1..=16384"));
-    }
-    Ok((w, h))
-}
-
-/// The default recording size as `--size` spells it (`512x512`: [`RecordSettings::DEFAULT_SIZE`]),
-/// for clap's `default_value`.
-pub fn default_size() -> &'static str {
-    static SIZE: OnceLock<String> = OnceLock::new();
-    SIZE.get_or_init(|| {
-        let (w, h) = RecordSettings::DEFAULT_SIZE;
-        format!("{w}x{h}")
-    })
 }
 
 /// The clap value parser of a typed option (`--bridge`, `--seeding`): its names are the
@@ -74,59 +45,6 @@ pub fn choice_parser<T: Choosable>() -> impl TypedValueParser<Value = Choice<T>>
 fn parse_listed<T: std::str::FromStr<Err = ParseOptionError>>(name: &str) -> T {
     name.parse()
         .unwrap_or_else(|e| unreachable!("clap accepted an unlisted name: {e}"))
-}
-
-/// Parses a half-open frame range `a..b` (also `a..` and `..b`, and a single frame `a`).
-pub fn parse_range(s: &str) -> Result<FrameRange, String> {
-    let num = |x: &str| -> Result<Option<u32>, String> {
-        if x.is_empty() {
-            Ok(None)
-        } else {
-            x.parse()
-                .map(Some)
-                .map_err(|_| format!("bad frame range {s:?}: expected a..b"))
-        }
-    };
-    let (a, b) = match s.split_once("..") {
-        Some((a, b)) => (num(a)?, num(b)?),
-        None => {
-            let a = num(s)?.ok_or_else(|| format!("bad frame range {s:?}"))?;
-            (Some(a), Some(a + 1))
-        }
-    };
-    Ok(FrameRange { start: a, end: b })
-}
-
-/// A frame range whose open ends are resolved against the path length.
-#[derive(Clone, Copy, Debug)]
-pub struct FrameRange {
-    start: Option<u32>,
-    end: Option<u32>,
-}
-
-impl From<Range<u32>> for FrameRange {
-    fn from(r: Range<u32>) -> FrameRange {
-        FrameRange {
-            start: Some(r.start),
-            end: Some(r.end),
-        }
-    }
-}
-
-impl FrameRange {
-    /// The concrete range for a path of `n` frames; an error if it is empty or past the end.
-    pub fn resolve(&self, n: u32) -> Result<Range<u32>> {
-        let r = self.start.unwrap_or(0)..self.end.unwrap_or(n);
-        if r.start >= r.end || r.end > n {
-            return Err(trisort_bake::BakeError::FrameRange {
-                start: r.start,
-                end: r.end,
-                frames: n,
-            }
-            .into());
-        }
-        Ok(r)
-    }
 }
 
 /// A progress bar on stderr (hidden when stderr is not a terminal).

@@ -3,10 +3,11 @@
 
 use std::path::{Path, PathBuf};
 
-use trisort_format::{DeviceInfo, FileKind, Phase, RecordSettings, Recording};
+use trisort_format::{Baked, DeviceInfo, FileKind, Phase, RecordSettings, Recording};
 use trisort_merger::{list_differences, settings_differences};
+use trisort_scene::Scene;
 
-use crate::{BakeError, Working};
+use crate::{working_scene, BakeError, Working};
 
 /// Reads one recording and checks its structure, naming the file when either fails.
 pub fn read_recording(file: &Path) -> Result<Recording, BakeError> {
@@ -156,4 +157,51 @@ pub fn join_visibility(
     }
     check_settings(&rec, &files[0], settings)?;
     Ok((rec, recs.len()))
+}
+
+/// A baked file and the recordings (may be none) it was merged from, with their files.
+pub struct Recorded<'a> {
+    /// The baked file.
+    pub baked: &'a Baked,
+    /// Its file, for messages.
+    pub baked_file: &'a Path,
+    /// Its recordings.
+    pub recordings: &'a [Recording],
+    /// Their files, in the same order.
+    pub files: &'a [PathBuf],
+}
+
+/// Makes `scene` (loaded from `spec`) the scene `recorded` was recorded from: split where
+/// the recording split it (by the first recording's path and settings, else the baked
+/// file's), and checked against the baked file's and every recording's scene hash, so that
+/// a reference renders what was baked and the recordings' cycles excuse that scene's pixels.
+pub fn recorded_scene(
+    scene: &mut Scene,
+    spec: &str,
+    recorded: &Recorded<'_>,
+) -> Result<(), BakeError> {
+    let baked = recorded.baked;
+    let (states, settings, from) = match (recorded.recordings.first(), recorded.files.first()) {
+        (Some(r), Some(file)) => (&r.frame_states, r.settings, file.as_path()),
+        _ => (&baked.frame_states, baked.settings, recorded.baked_file),
+    };
+    working_scene(scene, spec, states, &from.display().to_string(), &settings)?;
+    let hash = scene.hash();
+    if hash != baked.scene_hash {
+        return Err(BakeError::Input(format!(
+            "scene {spec} (hash {}) is not the scene the baked file was made from (hash {}): \
+             give the same scene file, or for demo the same demo:TRIANGLES",
+            &trisort_format::hash_hex(&hash)[..16],
+            &trisort_format::hash_hex(&baked.scene_hash)[..16]
+        )));
+    }
+    for (file, r) in recorded.files.iter().zip(recorded.recordings) {
+        if r.scene_hash != hash {
+            return Err(BakeError::Input(format!(
+                "{}: the recording is not of scene {spec}: its pixels cannot excuse the scene's",
+                file.display()
+            )));
+        }
+    }
+    Ok(())
 }

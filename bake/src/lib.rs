@@ -18,6 +18,7 @@ mod pipeline;
 mod record;
 pub mod shard;
 mod source;
+pub mod spec;
 
 pub use error::BakeError;
 pub use pipeline::{bake, finished_recording, merge_to_file, recording_path, Baking};

@@ -11,8 +11,9 @@ use trisort_gpu::Gpu;
 use trisort_merger::MergeOptions;
 
 use crate::methods::source_baked;
+use crate::methods::BenchView;
 use crate::plot::{write_svg, Chart, Series, Style};
-use crate::table::GroupReport;
+use crate::table::{run_group, GroupInput, GroupReport, MethodKind};
 use crate::BenchError;
 
 /// What a table run measured, for [`report_json`].
@@ -436,4 +437,84 @@ pub fn markdown(value: &serde_json::Value, groups: &[GroupReport], bakes: &[Bake
         }
     }
     s
+}
+
+/// What a table run measures: the playback size and glass, the modes and methods, the
+/// frames and how often each is repeated.
+pub struct Table<'a> {
+    /// Playback size.
+    pub size: (u32, u32),
+    /// Glass opacity of playback.
+    pub glass_opacity: f32,
+    /// The modes, one group per bake and mode.
+    pub modes: &'a [trisort_player::Mode],
+    /// The methods compared in every group.
+    pub methods: &'a [MethodKind],
+    /// The frames measured.
+    pub frames: &'a [u32],
+    /// Repeats of each measurement.
+    pub repeats: u32,
+}
+
+/// Frames measured: `max` evenly spaced frames of `range` (all when `max` is 0).
+pub fn measured_frames(range: std::ops::Range<u32>, max: u32) -> Vec<u32> {
+    let n = range.end - range.start;
+    if max == 0 || n <= max {
+        return range.collect();
+    }
+    let mut v: Vec<u32> = (0..max)
+        .map(|k| range.start + ((k as u64 * (n - 1) as u64) / (max - 1).max(1) as u64) as u32)
+        .collect();
+    v.dedup();
+    v
+}
+
+/// The devices the table times on: the default one, and the optional extra ones.
+pub struct Devices<'a> {
+    /// The device every method plays on.
+    pub gpu: &'a Gpu,
+    /// `merged` again with wgpu's indirect-call validation off.
+    pub unvalidated: Option<&'a Gpu>,
+    /// `merged_device`: `merged` on another backend or with other limits.
+    pub other: Option<&'a Gpu>,
+}
+
+/// Times every method on every (bake, mode) pair: one group each, in that order.
+pub fn run_groups(
+    a: &Table<'_>,
+    devices: &Devices<'_>,
+    working: &Working,
+    bakes: &[BakeRun],
+    say: &dyn Fn(&str),
+) -> Result<Vec<GroupReport>, BenchError> {
+    let frames = a.frames;
+    let (scene, timeline) = (&working.scene, &working.timeline);
+    let mut groups: Vec<GroupReport> = Vec::new();
+    for b in bakes {
+        for &mode in a.modes {
+            say(&format!("{} samples, {} mode", b.samples, mode.name()));
+            let input = GroupInput {
+                geometry: &scene.geometry,
+                frame_states: &timeline.frames,
+                baked: &b.baked,
+                source: &b.source,
+                view: BenchView {
+                    size: a.size,
+                    samples: b.samples,
+                    glass_opacity: a.glass_opacity,
+                },
+                mode,
+                methods: a.methods,
+                frames,
+                repeats: a.repeats,
+                unvalidated: devices.unvalidated,
+                other_device: devices.other,
+            };
+            let label = format!("{}x {}", b.samples, mode.name());
+            groups.push(run_group(devices.gpu, &input, &|m| {
+                say(&format!("[{label}] {m}"))
+            })?);
+        }
+    }
+    Ok(groups)
 }

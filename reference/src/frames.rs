@@ -266,3 +266,24 @@ pub fn play_frames_to(
     }
     Ok((out, path))
 }
+
+/// The player of `baked` on `gpu` set up as `check` plays: its size, samples, mode, shading,
+/// tone map and sub-pixel shift (for frames played on another device and then checked as
+/// captured ones).
+pub fn checked_player<'g>(
+    gpu: &'g Gpu,
+    baked: &Baked,
+    check: &ImageCheck,
+) -> Result<HeadlessRenderer<'g>, FramesError> {
+    let config = HeadlessConfig {
+        size: check.size,
+        samples: check.samples,
+        mode: check.mode,
+        shading: check.shading,
+        tone_map: check.tone_map,
+        ..HeadlessConfig::recorded(baked)
+    };
+    let player = HeadlessRenderer::new(gpu, baked, &config)?;
+    player.set_subpixel_offset(check.subpixel_offset);
+    Ok(player)
+}

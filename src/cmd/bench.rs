@@ -8,9 +8,11 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
-use trisort_bench::methods::BenchView;
-use trisort_bench::report::{bake_for, markdown, report_json, write_outputs, BakeRun, TableRun};
-use trisort_bench::table::{run_group, GroupInput, GroupReport, MethodKind};
+use trisort_bench::report::{
+    bake_for, markdown, measured_frames, report_json, run_groups, write_outputs, BakeRun, Devices,
+    Table, TableRun,
+};
+use trisort_bench::table::{GroupReport, MethodKind};
 use trisort_format::{Bridge, RecordSettings};
 use trisort_gpu::Gpu;
 use trisort_merger::MergeOptions;
@@ -104,19 +106,6 @@ fn say(msg: &str) {
     eprintln!("trisort bench: {msg}");
 }
 
-/// Frames measured: `max` evenly spaced frames of `range` (all when `max` is 0).
-fn measured_frames(range: std::ops::Range<u32>, max: u32) -> Vec<u32> {
-    let n = range.end - range.start;
-    if max == 0 || n <= max {
-        return range.collect();
-    }
-    let mut v: Vec<u32> = (0..max)
-        .map(|k| range.start + ((k as u64 * (n - 1) as u64) / (max - 1).max(1) as u64) as u32)
-        .collect();
-    v.dedup();
-    v
-}
-
 pub fn run(a: BenchArgs) -> Result<ExitCode> {
     if let Some(axis) = &a.scaling {
         return run_scaling(&a, axis);
@@ -153,7 +142,15 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
         unvalidated: unvalidated.as_ref(),
         other: other.as_ref(),
     };
-    let groups = run_groups(&a, &devices, &working, &bakes, &frames)?;
+    let table = Table {
+        size: a.size,
+        glass_opacity: a.glass_opacity,
+        modes: &a.mode,
+        methods: &a.methods,
+        frames: &frames,
+        repeats: a.repeats,
+    };
+    let groups = run_groups(&table, &devices, &working, &bakes, &say)?;
 
     let run = TableRun {
         device: gpu.describe(),
@@ -243,52 +240,6 @@ fn bake_samples(a: &BenchArgs, gpu: &Gpu, working: &trisort_bake::Working) -> Re
         )?);
     }
     Ok(bakes)
-}
-
-/// The devices the table times on: the default one, and the optional extra ones.
-struct Devices<'a> {
-    gpu: &'a Gpu,
-    unvalidated: Option<&'a Gpu>,
-    other: Option<&'a Gpu>,
-}
-
-/// Times every method on every (bake, mode) pair: one group each, in that order.
-fn run_groups(
-    a: &BenchArgs,
-    devices: &Devices<'_>,
-    working: &trisort_bake::Working,
-    bakes: &[BakeRun],
-    frames: &[u32],
-) -> Result<Vec<GroupReport>> {
-    let (scene, timeline) = (&working.scene, &working.timeline);
-    let mut groups: Vec<GroupReport> = Vec::new();
-    for b in bakes {
-        for &mode in &a.mode {
-            say(&format!("{} samples, {} mode", b.samples, mode.name()));
-            let input = GroupInput {
-                geometry: &scene.geometry,
-                frame_states: &timeline.frames,
-                baked: &b.baked,
-                source: &b.source,
-                view: BenchView {
-                    size: a.size,
-                    samples: b.samples,
-                    glass_opacity: a.glass_opacity,
-                },
-                mode,
-                methods: &a.methods,
-                frames,
-                repeats: a.repeats,
-                unvalidated: devices.unvalidated,
-                other_device: devices.other,
-            };
-            let label = format!("{}x {}", b.samples, mode.name());
-            groups.push(run_group(devices.gpu, &input, &|m| {
-                say(&format!("[{label}] {m}"))
-            })?);
-        }
-    }
-    Ok(groups)
 }
 
 /// Writes bench.json, bench.csv, the plots and bench.md to --out, and prints the JSON or

@@ -16,9 +16,10 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 
-use trisort_format::{DepthAt, ProfileName, RecordSettings, Robust};
+use trisort_bake::spec::ProfileChoice;
+use trisort_format::{DepthAt, ProfileName, RecordSettings};
 
-use crate::common::{default_size, option_parser, parse_range, parse_size, FrameRange};
+use crate::common::{default_size, option_parser, parse_bits, parse_range, parse_size, FrameRange};
 
 /// trisort: bake fixed camera paths into one depth-sorted index buffer with a sliding window
 /// per frame, and play, verify and measure the result.
@@ -124,52 +125,19 @@ pub struct RecordOpts {
     pub depth_at: Option<DepthAt>,
 }
 
-/// Parses `--subpixel-bits`: `N` or `LEAST..MOST`.
-fn parse_bits(s: &str) -> Result<(u32, u32), String> {
-    let bits = |t: &str| {
-        t.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("`{t}` is not a number of bits"))
-    };
-    let (lo, hi) = match s.split_once("..") {
-        Some((a, b)) => (bits(a)?, bits(b.trim_start_matches('='))?),
-        None => (bits(s)?, bits(s)?),
-    };
-    trisort_format::RasterProfile::check_bits(lo, hi).map_err(|e| e.to_string())?;
-    Ok((lo, hi))
-}
-
 impl RecordOpts {
     /// The settings stored in the recording: the named raster profile (by default the
     /// conformant one, `exact` under `--conservative=false`) with the knobs given on top.
     pub fn settings(&self) -> Result<RecordSettings> {
-        let name = match (self.raster_profile, self.conservative) {
-            (Some(ProfileName::Exact), Some(true)) => anyhow::bail!(
-                "--raster-profile exact records the pattern only; it cannot be --conservative"
-            ),
-            (Some(n), Some(false)) if n != ProfileName::Exact => anyhow::bail!(
-                "--raster-profile {n} records conservatively; --conservative=false is \
-                 --raster-profile exact"
-            ),
-            (Some(n), _) => n,
-            (None, Some(false)) => ProfileName::Exact,
-            (None, _) => Robust::DEFAULT.profile.name,
-        };
-        let mut robust = Robust::profile_named(name);
-        robust.patterns = self.robust;
-        if let Some(t) = self.robust_tolerance {
-            robust.tolerance = t;
+        let robust = ProfileChoice {
+            name: self.raster_profile,
+            conservative: self.conservative,
+            patterns: self.robust,
+            tolerance: self.robust_tolerance,
+            subpixel_bits: self.subpixel_bits,
+            depth_at: self.depth_at,
         }
-        if let Some(c) = self.conservative {
-            robust.conservative = c;
-        }
-        if let Some((lo, hi)) = self.subpixel_bits {
-            robust.profile.subpixel_bits_min = lo;
-            robust.profile.subpixel_bits_max = hi;
-        }
-        if let Some(d) = self.depth_at {
-            robust.profile.depth_at = d;
-        }
+        .robust()?;
         Ok(RecordSettings {
             width: self.size.0,
             height: self.size.1,

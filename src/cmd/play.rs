@@ -13,7 +13,9 @@ use trisort_player::{Mode, SelfCheck, SelfCheckFrame};
 
 use trisort_reference::frames::{play_frames_to, PlayFrames, PlayedPath};
 
-use crate::common::{parse_range, parse_size, print_json, progress_bar, FrameRange};
+use crate::common::{
+    parse_range, parse_size, parse_subpixel_offset, print_json, progress_bar, FrameRange,
+};
 
 /// Arguments of `play`.
 #[derive(Args, Debug)]
@@ -96,36 +98,6 @@ pub struct ShadingArgs {
     /// Tone map of --shading pbr: neutral (Khronos PBR Neutral) or aces.
     #[arg(long, default_value = "neutral")]
     pub tonemap: ToneMap,
-}
-
-/// Parses `--subpixel-offset X,Y`: two finite numbers of pixels, each a decimal or a fraction
-/// `a/b`, at most 16 pixels.
-pub fn parse_subpixel_offset(s: &str) -> Result<[f64; 2], String> {
-    let bad = || format!("bad offset {s:?}: expected X,Y in pixels, e.g. 0.0625,0 or 1/16,0");
-    let number = |x: &str| -> Result<f64, String> {
-        let x = x.trim();
-        let v = match x.split_once('/') {
-            Some((a, b)) => {
-                let (a, b) = (
-                    a.trim().parse::<f64>().map_err(|_| bad())?,
-                    b.trim().parse::<f64>().map_err(|_| bad())?,
-                );
-                if b == 0.0 {
-                    return Err(bad());
-                }
-                a / b
-            }
-            None => x.parse::<f64>().map_err(|_| bad())?,
-        };
-        if !v.is_finite() || v.abs() > 16.0 {
-            return Err(format!(
-                "offset {s}: each component must be a finite number of pixels in [-16, 16]"
-            ));
-        }
-        Ok(v)
-    };
-    let (x, y) = s.split_once(',').ok_or_else(bad)?;
-    Ok([number(x)?, number(y)?])
 }
 
 /// `--backend` and `--limits`: the device `play`, `verify` and `bench` open.

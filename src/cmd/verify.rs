@@ -20,17 +20,16 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::{json, Value};
-use trisort_format::{Baked, RecordSettings, Recording};
+use trisort_format::{Baked, Recording};
 use trisort_gpu::{Gpu, GpuOptions};
-use trisort_player::headless::{HeadlessConfig, HeadlessRenderer};
+use trisort_player::headless::HeadlessRenderer;
 use trisort_player::Mode;
 use trisort_reference::frames::{verify_images, write_diff, Frames, FramesToVerify, ImageReport};
 use trisort_reference::report::{json_report, text_report};
 use trisort_reference::ImageCheck;
 
 use crate::common::{load_scene, parse_range, parse_size, print_json, FrameRange};
-use trisort_bake::inputs::read_recordings;
-use trisort_bake::working_scene;
+use trisort_bake::inputs::{read_recordings, recorded_scene, Recorded};
 
 /// Exit code of a verification that ran and found the baked file wrong.
 pub const VERIFY_FAILED: u8 = 3;
@@ -95,7 +94,7 @@ pub struct VerifyArgs {
     /// Shift the projection of the player and of the exact reference by X,Y pixels (x right,
     /// y down; decimals or fractions such as `1/16,0`): a test aid standing for another GPU's
     /// vertex snapping. Off the recorded pattern: measured, failing only above --max-error.
-    #[arg(long, value_name = "X,Y", value_parser = crate::cmd::play::parse_subpixel_offset, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y", value_parser = crate::common::parse_subpixel_offset, allow_hyphen_values = true)]
     subpixel_offset: Option<[f64; 2]>,
     /// The light the file was baked with (`studio`, or the .hdr file given to
     /// `bake`/`merge --environment`): made anew and compared with the file's stored
@@ -118,20 +117,6 @@ pub struct VerifyArgs {
     device: crate::cmd::play::DeviceArgs,
 }
 
-/// Checks the scene against the file's scene hash: the reference must render the scene the
-/// file was baked from.
-pub fn check_scene(baked: &Baked, scene: &trisort_scene::Scene, spec: &str) -> Result<()> {
-    let hash = scene.hash();
-    if hash != baked.scene_hash {
-        bail!(
-            "scene {spec} (hash {}) is not the scene the baked file was made from (hash {}): give the same scene file, or for demo the same demo:TRIANGLES",
-            &trisort_format::hash_hex(&hash)[..16],
-            &trisort_format::hash_hex(&baked.scene_hash)[..16]
-        );
-    }
-    Ok(())
-}
-
 /// `--backend`/`--limits` other than the defaults: the device the frames are played on before
 /// they are checked as captured frames.
 fn elsewhere_device(a: &VerifyArgs) -> Result<Gpu> {
@@ -148,16 +133,7 @@ fn elsewhere_player<'g>(
     baked: &Baked,
     check: &ImageCheck,
 ) -> Result<HeadlessRenderer<'g>> {
-    let config = HeadlessConfig {
-        size: check.size,
-        samples: check.samples,
-        mode: check.mode,
-        shading: check.shading,
-        tone_map: check.tone_map,
-        ..HeadlessConfig::recorded(baked)
-    };
-    let player = HeadlessRenderer::new(gpu, baked, &config)?;
-    player.set_subpixel_offset(check.subpixel_offset);
+    let player = trisort_reference::frames::checked_player(gpu, baked, check)?;
     for w in player.player().warnings() {
         eprintln!("trisort: warning: {w}");
     }
@@ -293,29 +269,15 @@ fn image_check(
     baked: &Baked,
     recs: &[Recording],
 ) -> Result<(ImageReport, ImageCheck)> {
-    let (states, settings, from): (&[_], RecordSettings, _) =
-        match (recs.first(), a.recording.first()) {
-            (Some(r), Some(file)) => (&r.frame_states, r.settings, file),
-            _ => (&baked.frame_states, baked.settings, &a.baked),
-        };
+    let settings = recs.first().map_or(baked.settings, |r| r.settings);
     let mut scene = load_scene(spec)?;
-    // The scene as it was recorded: split where the recording split it.
-    working_scene(
-        &mut scene,
-        spec,
-        states,
-        &from.display().to_string(),
-        &settings,
-    )?;
-    check_scene(baked, &scene, spec)?;
-    for (file, r) in a.recording.iter().zip(recs) {
-        if r.scene_hash != scene.hash() {
-            bail!(
-                "{}: the recording is not of scene {spec}: its pixels cannot excuse the scene's",
-                file.display()
-            );
-        }
-    }
+    let recorded = Recorded {
+        baked,
+        baked_file: &a.baked,
+        recordings: recs,
+        files: &a.recording,
+    };
+    recorded_scene(&mut scene, spec, &recorded)?;
     // A variant: the file and the scene both with the variant's material table (after the
     // hash checks, which are of the default materials).
     let with_variant;
