@@ -380,22 +380,34 @@ impl PeakWindow {
     }
 }
 
+/// One measured recording: `frames` frames of `scene` along the path `template`, reported on
+/// axis `axis`, merged again in segments of `segment` frames when given.
+struct RealRun<'a> {
+    axis: &'a str,
+    scene: &'a trisort_scene::Scene,
+    template: &'a str,
+    frames: u32,
+    segment: Option<u32>,
+}
+
 /// Records `frames` frames of `scene` along `template`, merges them with the default options
 /// (`auto`, one matrix) and measures both; with `segment`, merges the same recording again
 /// in segments of that many frames (a second row on [`AXIS_FRAMES_SEGMENTED`], whose
 /// record figures repeat the first's and whose peak memory covers that merge alone, with
 /// the recording in memory).
-#[allow(clippy::too_many_arguments)]
 fn run_real(
     gpu: &Gpu,
     config: &ScalingConfig,
-    axis: &str,
-    scene: &trisort_scene::Scene,
-    template: &str,
-    frames: u32,
-    segment: Option<u32>,
+    run: RealRun<'_>,
     progress: &dyn Fn(&str),
 ) -> Result<Vec<ScalingRow>, BenchError> {
+    let RealRun {
+        axis,
+        scene,
+        template,
+        frames,
+        segment,
+    } = run;
     let spec = path_spec(template, frames)?;
     let timeline = trisort_paths::load(&spec, scene, &trisort_paths::PathOptions::default())
         .map_err(|e| BenchError::Invalid(format!("path {spec}: {e}")))?;
@@ -505,11 +517,13 @@ pub fn triangles(
         rows.extend(run_real(
             gpu,
             config,
-            AXIS_TRIANGLES,
-            &scene,
-            &config.triangle_path,
-            config.triangle_axis_frames,
-            None,
+            RealRun {
+                axis: AXIS_TRIANGLES,
+                scene: &scene,
+                template: &config.triangle_path,
+                frames: config.triangle_axis_frames,
+                segment: None,
+            },
             progress,
         )?);
     }
@@ -538,11 +552,13 @@ pub fn frames(
             rows.extend(run_real(
                 gpu,
                 config,
-                AXIS_FRAMES,
-                &scene,
-                &config.path,
-                n,
-                Some(config.segment),
+                RealRun {
+                    axis: AXIS_FRAMES,
+                    scene: &scene,
+                    template: &config.path,
+                    frames: n,
+                    segment: Some(config.segment),
+                },
                 progress,
             )?);
         }
