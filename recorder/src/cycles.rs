@@ -1,128 +1,28 @@
 //! Which edges of a directed graph lie on a cycle: those whose two ends are distinct and in one
 //! strongly connected component. The recorder needs only this much graph theory (to keep the
-//! grown peel's edges from closing cycles), so it has its own small iterative Tarjan rather
-//! than depending on the validator, which checks what the recorder and merger produce.
+//! grown peel's edges from closing cycles); it takes the components from petgraph rather than
+//! from the validator, which checks what the recorder and merger produce.
 
 use std::collections::{HashMap, HashSet};
 
+use petgraph::algo::kosaraju_scc;
+use petgraph::graphmap::DiGraphMap;
+
 /// The edges of `edges` (`(from, to)`, any ids) on a cycle of the graph they form: both ends
-/// distinct and in one strongly connected component. O(V + E) with hashing; no recursion, so
-/// a chain of any length is fine.
+/// distinct and in one strongly connected component. O(V + E); Kosaraju's algorithm runs
+/// without recursion, so a chain of any length is fine.
 pub(crate) fn on_cycle(edges: &[(u32, u32)]) -> HashSet<(u32, u32)> {
-    let mut local: HashMap<u32, usize> = HashMap::new();
-    let mut ends = Vec::with_capacity(edges.len());
-    for &(a, b) in edges {
-        let mut id = |v: u32| {
-            let next = local.len();
-            *local.entry(v).or_insert(next)
-        };
-        let a = id(a);
-        let b = id(b);
-        ends.push((a, b));
-    }
-    let component = components(local.len(), &ends);
+    let graph: DiGraphMap<u32, ()> = DiGraphMap::from_edges(edges);
+    let component: HashMap<u32, usize> = kosaraju_scc(&graph)
+        .into_iter()
+        .enumerate()
+        .flat_map(|(c, members)| members.into_iter().map(move |v| (v, c)))
+        .collect();
     edges
         .iter()
-        .zip(&ends)
-        .filter(|(_, &(a, b))| a != b && component[a] == component[b])
-        .map(|(&e, _)| e)
+        .filter(|&&(a, b)| a != b && component[&a] == component[&b])
+        .copied()
         .collect()
-}
-
-/// The strongly connected component of each of `n` vertices (numbers in no particular order)
-/// of the graph with edges `ends`: Tarjan's algorithm with an explicit call stack.
-fn components(n: usize, ends: &[(usize, usize)]) -> Vec<usize> {
-    // Adjacency lists, compressed: vertex v's successors are `out[off[v]..off[v + 1]]`.
-    let mut off = vec![0usize; n + 1];
-    for &(a, _) in ends {
-        off[a + 1] += 1;
-    }
-    for v in 0..n {
-        off[v + 1] += off[v];
-    }
-    let mut fill = off.clone();
-    let mut out = vec![0usize; ends.len()];
-    for &(a, b) in ends {
-        out[fill[a]] = b;
-        fill[a] += 1;
-    }
-    let mut t = Tarjan {
-        index: vec![UNSEEN; n],
-        low: vec![0; n],
-        on_stack: vec![false; n],
-        component: vec![UNSEEN; n],
-        stack: Vec::new(),
-        calls: Vec::new(),
-        next_index: 0,
-        next_component: 0,
-    };
-    for root in 0..n {
-        if t.index[root] != UNSEEN {
-            continue;
-        }
-        t.enter(root, off[root]);
-        while let Some(top) = t.calls.last_mut() {
-            let v = top.0;
-            if top.1 < off[v + 1] {
-                let w = out[top.1];
-                top.1 += 1;
-                if t.index[w] == UNSEEN {
-                    t.enter(w, off[w]);
-                } else if t.on_stack[w] {
-                    t.low[v] = t.low[v].min(t.index[w]);
-                }
-            } else {
-                t.finish(v);
-            }
-        }
-    }
-    t.component
-}
-
-const UNSEEN: usize = usize::MAX;
-
-/// The state of [`components`].
-struct Tarjan {
-    index: Vec<usize>,
-    low: Vec<usize>,
-    on_stack: Vec<bool>,
-    component: Vec<usize>,
-    stack: Vec<usize>,
-    /// The explicit call stack: (vertex, position of its next out-edge).
-    calls: Vec<(usize, usize)>,
-    next_index: usize,
-    next_component: usize,
-}
-
-impl Tarjan {
-    /// Enters `v`, whose out-edges start at `first`: numbers it and pushes it on both stacks.
-    fn enter(&mut self, v: usize, first: usize) {
-        self.index[v] = self.next_index;
-        self.low[v] = self.next_index;
-        self.next_index += 1;
-        self.stack.push(v);
-        self.on_stack[v] = true;
-        self.calls.push((v, first));
-    }
-
-    /// Leaves `v` (the top call) once its edges are done: passes its low link to its caller
-    /// and pops its component if it is the component's root.
-    fn finish(&mut self, v: usize) {
-        self.calls.pop();
-        if let Some(&(parent, _)) = self.calls.last() {
-            self.low[parent] = self.low[parent].min(self.low[v]);
-        }
-        if self.low[v] == self.index[v] {
-            while let Some(w) = self.stack.pop() {
-                self.on_stack[w] = false;
-                self.component[w] = self.next_component;
-                if w == v {
-                    break;
-                }
-            }
-            self.next_component += 1;
-        }
-    }
 }
 
 #[cfg(test)]
