@@ -14,7 +14,7 @@
 //!
 //! The flags are read back per frame and join V_f. Phase 2 takes the edges these triangles
 //! need from the layers of the grown triangles: captured in one pass (`capture_grown.wgsl`)
-//! where the device can, else peeled ([`crate::Peeler::grown`]).
+//! where the device can, else peeled (the grown peel, `peel_grown.wgsl`).
 //!
 //! What it guarantees, and where not: a triangle that wins a sample moved by up to the
 //! tolerance is flagged unless the opaque surface in front of it leaves a gap narrower than

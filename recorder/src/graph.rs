@@ -79,7 +79,7 @@ impl<'a> GraphParts<'a> {
 /// Phase 2 of one frame over G (`g` = scene ids of the drawn list): covered set, edges, ties.
 /// With robust settings, the union over the sample patterns of
 /// [`Robust::offsets`](trisort_format::Robust::offsets) and, for conservative recording, the
-/// grown peel (`grown`, [`Peeler::grown`]): edge weights add up.
+/// grown peel (`grown`, `Peeler::build` with `grow`): edge weights add up.
 pub(crate) fn graph_frame(
     source: &Layers,
     grown: Option<&(&Layers, GrownOrder)>,

@@ -22,7 +22,7 @@ pub(crate) enum Purpose {
     /// Phase 2: ids and depth of every layer (a peeler reads back depth, not alpha).
     Graphs,
     /// Phase 2 of `record --conservative`: the triangles grown by this tolerance in pixels
-    /// ([`Peeler::grown`]).
+    /// (the grown peel, `Peeler::build` with `grow`).
     Grown(Robust),
 }
 

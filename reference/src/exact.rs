@@ -151,10 +151,7 @@ impl UnorderedEdges {
         let scene = |t: u32| baked.scene_ids.get(t as usize).copied().unwrap_or(u32::MAX);
         let drawn = DrawnSets::new(baked);
         for (f, removed) in baked.removed_edges.iter().enumerate() {
-            let mut ids: Vec<u32> = drawn.of_frame(f).collect();
-            ids.sort_unstable();
-            ids.dedup();
-            edges.set_drawn(f, ids);
+            edges.set_drawn(f, drawn.of_frame(f).collect());
             edges.set_frame(
                 f,
                 removed
@@ -174,12 +171,14 @@ impl UnorderedEdges {
         }
     }
 
-    /// Frame `f`'s drawn triangles (scene ids).
+    /// Frame `f`'s drawn triangles (scene ids, any order, repeats allowed): kept sorted and
+    /// without repeats.
     fn set_drawn(&mut self, f: usize, mut drawn: Vec<u32>) {
         if self.drawn.len() <= f {
             self.drawn.resize_with(f + 1, Vec::new);
         }
         drawn.sort_unstable();
+        drawn.dedup();
         self.drawn[f] = drawn;
     }
 

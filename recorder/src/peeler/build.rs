@@ -148,32 +148,11 @@ impl<'g> Peeler<'g> {
         )
     }
 
-    /// [`Peeler::new`] over the triangles grown by `robust`'s tolerance in pixels
-    /// (`peel_grown.wgsl`):
-    /// each sample's layers list every triangle that could cover it when the pattern moves
-    /// within the tolerance, by the depth of its plane at the sample. Phase 2 of
-    /// `record --conservative` takes the edges of the triangles it adds from here. Layers
-    /// carry alpha 1.
-    pub fn grown(
-        gpu: &'g Gpu,
-        geometry: &Geometry,
-        triangles: &[u32],
-        frames: &[FrameState],
-        view: View,
-        robust: &Robust,
-    ) -> Result<Self, RecordError> {
-        Peeler::build(
-            gpu,
-            geometry,
-            triangles,
-            frames,
-            view,
-            Some(robust),
-            &Default::default(),
-        )
-    }
-
-    /// [`Peeler::new`] (`grow` `None`) or [`Peeler::grown`], built as `internals` say.
+    /// [`Peeler::new`] (`grow` `None`), or with `grow` the peel over the triangles grown by
+    /// `robust`'s tolerance in pixels (`peel_grown.wgsl`): each sample's layers list every
+    /// triangle that could cover it when the pattern moves within the tolerance, by the depth
+    /// of its plane at the sample, with alpha 1; phase 2 of a conservative recording takes the
+    /// edges of the triangles it adds from there. Built as `internals` say.
     pub(crate) fn build(
         gpu: &'g Gpu,
         geometry: &Geometry,

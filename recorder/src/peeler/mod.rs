@@ -120,7 +120,7 @@ pub struct Peeler<'g> {
     dims: wgpu::Buffer,
     view: View,
     plain: wgpu::RenderPipeline,
-    /// The grown peel's triangle storage (group 2), for [`Peeler::grown`].
+    /// The grown peel's triangle storage (group 2), for the grown peel.
     grown: Option<wgpu::BindGroup>,
     /// Read back the alpha and depth arrays ([`Peeler::with_readback`]).
     read_alpha: bool,
