@@ -92,6 +92,26 @@ pub fn storage_entry(
     }
 }
 
+/// A bind-group layout entry for a 2-D texture of `sample_type` read by `visibility`,
+/// multisampled where `samples > 1` (the peel, gather and conservative passes' targets).
+pub fn texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    sample_type: wgpu::TextureSampleType,
+    samples: u32,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: samples > 1,
+        },
+        count: None,
+    }
+}
+
 /// A uniform-buffer entry of a bind group layout at `binding`, seen by `visibility`, with
 /// dynamic offsets where `dynamic` and a minimum size of `min_size` bytes where given.
 pub fn uniform_entry(

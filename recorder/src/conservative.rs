@@ -531,15 +531,13 @@ fn pass_layouts(device: &wgpu::Device, samples: u32) -> [wgpu::BindGroupLayout; 
         label: Some("conservative occluders"),
         entries: &base,
     });
-    let texture_entry = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
+    let texture_entry = |binding, sample_type| {
+        trisort_gpu::pipeline::texture_entry(
+            binding,
+            wgpu::ShaderStages::FRAGMENT,
             sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: samples > 1,
-        },
-        count: None,
+            samples,
+        )
     };
     let spread_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("conservative spread"),

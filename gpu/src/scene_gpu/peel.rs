@@ -6,15 +6,8 @@
 /// offset, 1 the previous pass's depth, 2 its ids (unsigned); both textures multisampled where
 /// `samples > 1`. Both peelers build their peel layout from these.
 pub fn previous_key_entries(samples: u32) -> [wgpu::BindGroupLayoutEntry; 3] {
-    let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: samples > 1,
-        },
-        count: None,
+    let texture = |binding, sample_type| {
+        crate::pipeline::texture_entry(binding, wgpu::ShaderStages::FRAGMENT, sample_type, samples)
     };
     [
         crate::pipeline::uniform_entry(0, wgpu::ShaderStages::FRAGMENT, true, Some(16)),

@@ -45,16 +45,9 @@ fn gather_pipeline(
     samples: u32,
     interleaved: bool,
 ) -> (wgpu::BindGroupLayout, wgpu::ComputePipeline) {
-    let ms = samples > 1;
-    let tex = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: ms,
-        },
-        count: None,
+    let stages = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+    let tex = |binding, sample_type| {
+        trisort_gpu::pipeline::texture_entry(binding, stages, sample_type, samples)
     };
     let gather_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("gather"),

@@ -230,16 +230,12 @@ impl<'g> PeelingRenderer<'g> {
         });
         let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("peeling composite"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Uint,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: samples > 1,
-                },
-                count: None,
-            }],
+            entries: &[trisort_gpu::pipeline::texture_entry(
+                3,
+                wgpu::ShaderStages::FRAGMENT,
+                wgpu::TextureSampleType::Uint,
+                samples,
+            )],
         });
         let peel_pipeline = |label, compare| {
             ScenePipeline {
