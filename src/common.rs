@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-use trisort_format::{Choice, Choosable, OptionValue, ParseOptionError, RecordSettings};
+use trisort_format::{Choice, Choosable, OptionValue, ParseOptionError};
 use trisort_scene::Scene;
 
 pub use trisort_bake::spec::{
@@ -97,16 +97,11 @@ pub fn open_gpu_with(options: trisort_gpu::GpuOptions) -> Result<trisort_gpu::Gp
     Ok(gpu)
 }
 
-/// The scene `scene_spec` and the path `path_spec` over it (at `fps`), made the scene a
-/// recording with `settings` is made of ([`trisort_bake::Working::load`]); prints the
-/// importer's notes and what was split on stderr.
-pub fn load_working(
-    scene_spec: &str,
-    path_spec: &str,
-    fps: f64,
-    settings: &RecordSettings,
-) -> Result<trisort_bake::Working> {
-    let working = trisort_bake::Working::load(scene_spec, path_spec, fps, settings)?;
+/// The scene and path `settings` name, made the ones its recording is made of
+/// ([`trisort_bake::Working::for_settings`]); prints the importer's notes and what was split
+/// on stderr.
+pub fn load_working(settings: &trisort_bake::Settings) -> Result<trisort_bake::Working> {
+    let working = trisort_bake::Working::for_settings(settings)?;
     for note in &working.scene.notes {
         eprintln!("trisort: note: {note}");
     }

@@ -257,7 +257,7 @@ pub fn scene_json(
     let bounds = scene
         .bounds()
         .map(|(lo, hi)| json!({"min": lo.to_array(), "max": hi.to_array()}));
-    json!({
+    let mut v = json!({
         "scene": scene.name,
         "triangles": st.triangles, "zero_area_triangles": st.zero_area_triangles,
         "meshes": st.meshes, "primitives": st.primitives, "nodes": st.nodes,
@@ -269,11 +269,9 @@ pub fn scene_json(
         "bounds": bounds,
         "notes": scene.notes,
         "variants": scene.variants,
-        "intersections_split": split.pairs_split + split.pairs_split_across_groups,
-        "intersections_split_across_groups": split.pairs_split_across_groups,
-        "triangles_added": split.triangles_added,
-        "intersections_left": split.pairs_skipped_sliver,
-    })
+    });
+    add_split_json(&mut v, Some(split));
+    v
 }
 
 /// `play --json`'s `profile_check`: `ok`, `differences` (in words), the `profile` checked

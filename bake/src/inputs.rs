@@ -25,13 +25,13 @@ pub fn read_recordings(files: &[PathBuf]) -> Result<Vec<Recording>, BakeError> {
 /// Checks that `recs` (read from `files`) are parts of one bake
 /// ([`trisort_merger::differences`] against the first): an error naming the file and every
 /// difference, except that with `allow_mixed_devices` a different device only gives a
-/// warning, returned for the caller to show.
+/// warning, handed to `warn` as soon as it is found (before a later file may be refused).
 pub fn check_compatible(
     recs: &[Recording],
     files: &[PathBuf],
     allow_mixed_devices: bool,
-) -> Result<Vec<String>, BakeError> {
-    let mut warnings = Vec::new();
+    warn: &mut dyn FnMut(String),
+) -> Result<(), BakeError> {
     for (k, r) in recs.iter().enumerate().skip(1) {
         let (device, other): (Vec<_>, Vec<_>) = trisort_merger::differences(&recs[0], r)
             .into_iter()
@@ -54,14 +54,14 @@ pub fn check_compatible(
                 list_differences(&device)
             )));
         }
-        warnings.push(format!(
+        warn(format!(
             "{this} was recorded on another device than {first}: {}; merged anyway \
              (--allow-mixed-devices): the bake is exact on neither, and its device says \
              \"mixed: …\"",
             list_differences(&device)
         ));
     }
-    Ok(warnings)
+    Ok(())
 }
 
 /// An error unless `rec` (read from `file`) was recorded with `settings`.
@@ -96,11 +96,10 @@ pub fn union_of_visibility(
     let mut seen = vec![false; n];
     let mut g = Vec::new();
     let mut devices = Vec::new();
+    let (scene_hash, path_hash) = (working.scene.hash(), working.timeline.hash());
     for f in files {
         let rec = read_recording(f)?;
-        if rec.scene_hash != working.scene.hash()
-            || rec.path_hash != working.timeline.hash()
-            || rec.frame_states.len() != n
+        if rec.scene_hash != scene_hash || rec.path_hash != path_hash || rec.frame_states.len() != n
         {
             let why = format!("{}: recorded from another scene or path", f.display());
             return Err(BakeError::Input(why));
@@ -142,7 +141,7 @@ pub fn join_visibility(
             )));
         }
     }
-    check_compatible(&recs, files, false)?;
+    check_compatible(&recs, files, false, &mut |_| {})?;
     let rec = trisort_merger::join(&recs).map_err(|error| BakeError::Merge {
         error,
         files: files.iter().map(|f| f.display().to_string()).collect(),

@@ -90,7 +90,7 @@ pub fn bake(
     events: &mut dyn Events,
 ) -> Result<Baking, BakeError> {
     if let Some(r) = &settings.frames {
-        check_range(r, working.timeline.frames.len() as u32)?;
+        crate::spec::FrameRange::from(r.clone()).resolve(working.timeline.frames.len() as u32)?;
     }
     let t0 = Instant::now();
     let rec_path = recording_path(output);
@@ -127,16 +127,4 @@ pub fn bake(
         merge_seconds: t1.elapsed().as_secs_f64(),
         recording_reused,
     })
-}
-
-/// An error unless `range` is a non-empty range of a path of `frames` frames.
-pub(crate) fn check_range(range: &std::ops::Range<u32>, frames: u32) -> Result<(), BakeError> {
-    if range.start >= range.end || range.end > frames {
-        return Err(BakeError::FrameRange {
-            start: range.start,
-            end: range.end,
-            frames,
-        });
-    }
-    Ok(())
 }

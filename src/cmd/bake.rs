@@ -35,12 +35,7 @@ pub struct BakeArgs {
 
 /// The pipeline's settings for `scene` and `path` from the command line's options; the
 /// frame range is resolved against the path once it is loaded.
-pub fn settings(
-    scene: &str,
-    path: &str,
-    record: &RecordOpts,
-    merge: &MergeOpts,
-) -> Result<Settings> {
+fn settings(scene: &str, path: &str, record: &RecordOpts, merge: &MergeOpts) -> Result<Settings> {
     Ok(Settings {
         scene: scene.to_string(),
         path: path.to_string(),
@@ -56,7 +51,7 @@ pub fn run(a: BakeArgs) -> Result<ExitCode> {
     let mut settings = settings(&a.scene, &a.path, &a.record, &a.merge)?;
     // First: a bad light fails before the scene is loaded and split.
     let environment = settings.light.load()?;
-    let working = load_working(&a.scene, &a.path, settings.fps, &settings.record)?;
+    let working = load_working(&settings)?;
     let n = working.timeline.frames.len() as u32;
     settings.frames = a.record.frames.map(|r| r.resolve(n)).transpose()?;
     let gpu = crate::common::open_gpu()?;

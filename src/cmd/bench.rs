@@ -113,7 +113,10 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
     check_table_args(&a)?;
     let t0 = Instant::now();
     // Every bake and rival below sees the scene as the default settings record it.
-    let working = load_working(&a.scene, &a.path, a.fps, &RecordSettings::default())?;
+    let working = load_working(&trisort_bake::Settings {
+        fps: a.fps,
+        ..trisort_bake::Settings::new(&a.scene, &a.path)
+    })?;
     let (scene, timeline) = (&working.scene, &working.timeline);
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let gpu = crate::common::open_gpu()?;

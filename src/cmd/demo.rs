@@ -52,7 +52,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
     let bake_settings = trisort_bake::Settings {
         fps: working.timeline.fps,
         record: settings,
-        ..trisort_bake::Settings::new("demo", "demo")
+        ..trisort_bake::Settings::new(format!("demo:{}", demo_triangles(&a)), "demo")
     };
     let gpu = crate::common::open_gpu()?;
     println!("device: {}", gpu.describe());
@@ -107,11 +107,14 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
 
 /// The procedural car and its default path, split as `settings` record it; writes
 /// `--export-scene` and prints what the car holds.
+/// The car's triangles (`--triangles`, else the default): the demo bakes `demo:N`.
+fn demo_triangles(a: &DemoArgs) -> u32 {
+    a.triangles
+        .unwrap_or(trisort_scene::demo_car::DEFAULT_TRIANGLES)
+}
+
 fn demo_working(a: &DemoArgs, settings: &RecordSettings) -> Result<trisort_bake::Working> {
-    let triangles = a
-        .triangles
-        .unwrap_or(trisort_scene::demo_car::DEFAULT_TRIANGLES);
-    let mut scene = trisort_scene::demo_car::demo_car(triangles);
+    let mut scene = trisort_scene::demo_car::demo_car(demo_triangles(a));
     let path = trisort_paths::demo_default(&scene);
     std::fs::create_dir_all(&a.out_dir)?;
     if let Some(p) = &a.export_scene {

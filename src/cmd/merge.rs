@@ -109,9 +109,9 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
             );
         }
     }
-    for w in check_compatible(&recs, &a.recordings, a.allow_mixed_devices)? {
-        eprintln!("trisort: warning: {w}");
-    }
+    check_compatible(&recs, &a.recordings, a.allow_mixed_devices, &mut |w| {
+        eprintln!("trisort: warning: {w}")
+    })?;
     // Before anything is written: a bad light leaves no output.
     let environment = a.opts.light().load()?;
     let mut names: Vec<String> = a

@@ -66,7 +66,11 @@ pub struct RecordArgs {
 pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
     let settings = a.opts.settings()?;
-    let working = load_working(&a.scene, &a.path, a.opts.fps, &settings)?;
+    let working = load_working(&trisort_bake::Settings {
+        fps: a.opts.fps,
+        record: settings,
+        ..trisort_bake::Settings::new(&a.scene, &a.path)
+    })?;
     let timeline = &working.timeline;
     if let Some(shard) = a.shard {
         let (i, n) = shard.resolve(&|k| std::env::var(k).ok())?;
@@ -101,7 +105,7 @@ pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
                 (Phase::Graphs, Some(g))
             }
         }
-        PhaseArg::Union => return write_union(&a, &working, t0),
+        PhaseArg::Union => return write_union(&a, &working, &settings, t0),
     };
     let gpu = crate::common::open_gpu()?;
     // G from another device's phase 1 is not this device's: its visible sets could fall
@@ -155,19 +159,19 @@ pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
 
 /// `--phase union`: joins the `--visibility` phase-1 recordings into one phase-1 recording of
 /// the whole path (G once, for every shard's phase 2) and writes it atomically.
-fn write_union(a: &RecordArgs, working: &trisort_bake::Working, t0: Instant) -> Result<ExitCode> {
+fn write_union(
+    a: &RecordArgs,
+    working: &trisort_bake::Working,
+    settings: &trisort_format::RecordSettings,
+    t0: Instant,
+) -> Result<ExitCode> {
     if a.visibility.is_empty() {
         bail!("--phase union needs the phase-1 recordings: --visibility REC...");
     }
     if a.shard.is_some() || a.opts.frames.is_some() {
         bail!("--phase union joins whole-path results; it takes no --shard or --frames");
     }
-    let (rec, joined) = join_visibility(
-        &a.visibility,
-        working,
-        &a.opts.settings()?,
-        (&a.scene, &a.path),
-    )?;
+    let (rec, joined) = join_visibility(&a.visibility, working, settings, (&a.scene, &a.path))?;
     trisort_format::write_file_atomic(FileKind::Recording, &a.output, &rec)?;
     let secs = t0.elapsed().as_secs_f64();
     if a.json {

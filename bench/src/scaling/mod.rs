@@ -452,12 +452,12 @@ fn run_real(
     let measure = |axis: &str, opts: &MergeOptions, window: PeakWindow| {
         let cpu1 = cpu_seconds();
         let t1 = Instant::now();
+        // The rows need the merge's statistics, not a lit file: no light is made or stored.
         let merged = trisort_merger::merge(std::slice::from_ref(&rec), opts)?;
         let merge_seconds = t1.elapsed().as_secs_f64();
-        let baked = merged.lit(trisort_bake::Light::Studio.load()?);
         let merge_cpu_seconds = cpu_since(cpu1);
         let peak = window.peak();
-        let s = &baked.stats;
+        let s = merged.stats();
         let row = ScalingRow {
             axis: axis.into(),
             triangles,
@@ -610,7 +610,7 @@ fn synthetic(frames: u32, segment: u32, progress: &dyn Fn(&str)) -> Result<Scali
     let window = PeakWindow::start();
     let cpu0 = cpu_seconds();
     let t0 = Instant::now();
-    let baked = trisort_merger::merge(
+    let merged = trisort_merger::merge(
         &parts,
         &MergeOptions {
             segment: Some(segment),
@@ -618,10 +618,9 @@ fn synthetic(frames: u32, segment: u32, progress: &dyn Fn(&str)) -> Result<Scali
         },
     )?;
     let merge_seconds = t0.elapsed().as_secs_f64();
-    let baked = baked.lit(trisort_bake::Light::Studio.load()?);
     let merge_cpu_seconds = cpu_since(cpu0);
     let peak = window.peak();
-    let s = &baked.stats;
+    let s = merged.stats();
     progress(&format!(
         "{AXIS_SYNTHETIC}: merged in {merge_seconds:.2} s: {} copies, draws {:.1} / {}",
         s.index_triangles, s.draws_per_frame_mean, s.draws_per_frame_max

@@ -121,6 +121,8 @@ impl Sweep<'_> {
         let mut elsewhere: Option<Vec<Vec<Vec<u8>>>> = None;
         let mut measured: Bakes = Vec::new();
         let mut done = 0usize;
+        // Every bake is lit by the studio, as `bake` lights it by default: made once here.
+        let studio = trisort_bake::Light::Studio.load()?;
         for settings in &recording_order {
             let users: Vec<&Variant> = variants
                 .iter()
@@ -150,7 +152,7 @@ impl Sweep<'_> {
                 let t = Instant::now();
                 let merged = trisort_merger::merge(std::slice::from_ref(&rec), &v.merge)?;
                 let merge_seconds = t.elapsed().as_secs_f64();
-                let baked = merged.lit(trisort_bake::Light::Studio.load()?);
+                let baked = merged.lit(studio.clone());
                 // The reference lights like the bake: with its environment.
                 if let Entry::Vacant(slot) = references.entry(glass_key) {
                     slot.insert(self.reference_frames(settings.glass_opacity, &baked.environment)?);
