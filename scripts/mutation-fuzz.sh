@@ -21,6 +21,12 @@ cargo build --release --quiet --bin trisort
 cargo build --release --quiet -p trisort-testkit --example mutate
 t=$PWD/target/release/trisort
 mutate=$PWD/target/release/examples/mutate
+# The output folder is emptied first: refuse anything but a folder of its own.
+case "$(realpath -m "$out")" in
+  / | "$PWD" | "$PWD"/.. | "$HOME" | "$PWD"/src | "$PWD"/tests)
+    echo "mutation-fuzz: refusing to empty $out; give a folder of its own" >&2
+    exit 2 ;;
+esac
 rm -rf "$out"
 mkdir -p "$out"
 cd "$out"
