@@ -21,8 +21,15 @@ pub fn trisort(dir: &Path) -> Command {
 
 /// Runs and returns the output, panicking with the command, directory and stderr if the exit
 /// status is not `expect_success`.
+///
+/// With `TRISORT_TEST_TIMES=FILE` each run appends a line to FILE: seconds, the test (its
+/// thread's name) and the command, to find where the suite spends its time.
 pub fn run(dir: &Path, args: &[&str], expect_success: bool) -> Output {
+    let started = std::time::Instant::now();
     let out = trisort(dir).args(args).output().expect("spawn trisort");
+    if let Some(log) = std::env::var_os("TRISORT_TEST_TIMES") {
+        log_time(Path::new(&log), started.elapsed().as_secs_f64(), args);
+    }
     if out.status.success() != expect_success {
         panic!(
             "trisort {} (in {}) exited with {:?}, expected {}\n--- stdout\n{}\n--- stderr\n{}",
@@ -35,6 +42,19 @@ pub fn run(dir: &Path, args: &[&str], expect_success: bool) -> Output {
         );
     }
     out
+}
+
+/// Appends one timing line to `log` (best effort: a diagnostic, not part of any check).
+fn log_time(log: &Path, seconds: f64, args: &[&str]) {
+    use std::io::Write;
+    let test = std::thread::current().name().unwrap_or("?").to_string();
+    if let Ok(mut f) = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(log)
+    {
+        let _ = writeln!(f, "{seconds:.2}\t{test}\ttrisort {}", args.join(" "));
+    }
 }
 
 /// The arguments of a command line written as one string, split at whitespace:
