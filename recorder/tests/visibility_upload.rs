@@ -10,7 +10,7 @@ use trisort_scene::Scene;
 
 use crate::compact_readback::{assert_internals_keep_recording, shared_scene, variants};
 
-/// Records three frames of `scene`'s orbit with the visibility-only and the full upload, for
+/// Records two frames of `scene`'s orbit with the visibility-only and the full upload, for
 /// every settings of [`variants`], and asserts the bytes agree.
 fn record_both(gpu: &trisort_gpu::Gpu, scene: &Scene) {
     for settings in variants() {
