@@ -90,7 +90,7 @@ fn an_interrupted_recording_resumes_to_identical_bytes() {
             "record",
             car.as_str(),
             "--path",
-            "orbit:frames=8",
+            "orbit:frames=5",
             "--size",
             "64x64",
             "--samples",
