@@ -534,9 +534,10 @@ pub fn triangles(
 /// `config.frames_axis_triangles` triangles recorded along `config.path` at `config.size` and
 /// `config.samples` and merged with the default options (`auto`, one matrix), then merged
 /// again in segments of `config.segment` frames (rows `frames` and `frames-segmented`, in
-/// that order for each count); then for each of `config.synthetic_frames`, a synthetic turntable recording of that many frames (24
-/// objects × 16 sides, 128 samples, 0.36° per frame), cut into four recordings as four
-/// machines would record them, merged with `auto` in segments of `config.segment` frames.
+/// that order for each count); then for each of `config.synthetic_frames`, a synthetic
+/// turntable recording of that many frames (24 objects × 16 sides, 128 samples, 0.36° per
+/// frame), cut into four recordings as four machines would record them, merged with `auto`
+/// in segments of `config.segment` frames.
 pub fn frames(
     gpu: &Gpu,
     config: &ScalingConfig,
