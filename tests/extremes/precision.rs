@@ -400,8 +400,8 @@ fn surfaces_closer_than_f32_resolution_tie_by_id() {
     }
 }
 
-/// The tie rule (`recorder/src/tie_rule/`: neighbours in one plane go lower id first) with the default
-/// raster profile (conformant: the recorded pattern and every sample moved by up to its
+/// The tie rule (`recorder/src/tie_rule/`: neighbours in one plane go lower id first) with the
+/// default raster profile (conformant: the recorded pattern and every sample moved by up to its
 /// tolerance): three scenes whose surfaces the rasterizer's depths cannot order verify exact
 /// in every mode, with no unordered sample:
 /// - a transparent decal on an opaque panel, in one plane, seen obliquely (their interpolated

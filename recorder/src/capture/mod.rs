@@ -148,9 +148,9 @@ impl<'g> Capture<'g> {
     }
 
     /// [`Capture::new`] over the triangles grown by a tolerance box (`capture_grown.wgsl`):
-    /// with [`Grow::Peel`], the one-pass form of the grown peel (`Peeler::build` with `grow`), whose layers phase 2
-    /// of `record --conservative` takes the added triangles' edges from (fragments carry alpha
-    /// 1); with [`Grow::Envelope`], phase 1's envelope capture ([`crate::envelope`]): each
+    /// with [`Grow::Peel`], the one-pass form of the grown peel (`Peeler::build` with
+    /// `grow`), whose layers phase 2 of `record --conservative` takes the added triangles'
+    /// edges from (fragments carry alpha 1); with [`Grow::Envelope`], phase 1's envelope capture ([`crate::envelope`]): each
     /// fragment has its plane's nearest depth over the depth box as its depth, its farthest as
     /// its opacity, and flags above the id (whether it occludes, which of its edges cross the
     /// box and which are closable).
