@@ -1,3 +1,63 @@
+/*
+ * trisort.h: the C API of libtrisort (crate trisort-capi), the player library.
+ *
+ * It opens a file baked by `trisort bake` and copies out what a host needs to draw each frame
+ * depth-sorted with its own graphics API: the sorted index buffer, each frame's draw ranges
+ * (or indirect-draw arguments), the vertex streams, cameras, node matrices, materials,
+ * textures and light. It also reads ORDER files; writing them needs the glTF importer and is
+ * libtrisort_export's (trisort_export.h). Link it with `pkg-config --cflags --libs trisort`
+ * or CMake's `find_package(trisort)` and the target `trisort::trisort` (README § C API).
+ *
+ * Conventions (every function follows them; a function's comment says only what differs):
+ *
+ * - Status. Every function returns a TrisortStatus, except trisort_abi_version(),
+ *   trisort_format_version(), trisort_version_string(), trisort_last_error() and the close
+ *   functions. On failure trisort_last_error() gives a message naming the file and the
+ *   problem; it is kept per thread until that thread's next call.
+ * - Out parameters. A function that stores one value takes `out`, a pointer the library
+ *   writes one value to; NULL is TRISORT_STATUS_NULL_ARGUMENT.
+ * - The copy convention (out, cap, len). The library never hands out its own memory: arrays
+ *   are copied into the host's. A copy function takes `out` (the host's array), `cap` (its
+ *   capacity in elements) and `len` (size_t *). It stores the element count in *len when len
+ *   is not NULL; with out NULL it only reports that count; with cap smaller than the count it
+ *   returns TRISORT_STATUS_BUFFER_TOO_SMALL and copies nothing; out and len both NULL is
+ *   TRISORT_STATUS_NULL_ARGUMENT. So: call once with out = NULL to learn *len, allocate, call
+ *   again.
+ * - Strings (names) are copied the same way, as UTF-8 bytes plus a terminating NUL: *len is
+ *   the length in bytes without the NUL, and cap must be at least *len + 1. Paths passed in
+ *   are NUL-terminated UTF-8.
+ * - Enums. An enum passed *to* the library is a uint32_t holding one of the enum's values,
+ *   range-checked (TRISORT_STATUS_OUT_OF_RANGE otherwise). Enums in structs the library fills
+ *   in (TrisortStatus returned, TrisortMode, TrisortAlphaMode) are int-sized and always hold
+ *   one of their values. bool is C99's bool (stdbool.h).
+ * - Matrices are 16 floats, column major: element (row r, column c) at index 4 * c + r, as
+ *   glUniformMatrix4fv(location, 1, GL_FALSE, m) and GLSL's mat4 read them. They multiply
+ *   column vectors: clip = projection * view * world * position.
+ * - Coordinates and units are glTF's: right handed, +Y up, metres, angles in radians. View
+ *   space looks down -Z. trisort_frame_projection() gives clip depth in [0, 1] (Vulkan,
+ *   Direct3D, Metal, WebGPU: what trisort records with) or [-1, 1] (OpenGL, OpenGL ES), near
+ *   at the low end. Image row 0 is the top row. A bake is exact at its recorded width,
+ *   height and MSAA sample count (TrisortInfo) on a rasterizer within its raster profile
+ *   (trisort_raster_profile(), trisort_check_device()).
+ * - Handles. trisort_open_path() and trisort_open_bytes() (trisort_order_open_*() for ORDER
+ *   files) read, check (magic, version, checksum, structure) and keep the whole file in
+ *   memory; the bytes given to trisort_open_bytes() are copied, so the host may free them
+ *   after the call. trisort_close() (trisort_order_close()) frees the handle; NULL is ignored;
+ *   a handle must not be used or closed again after it.
+ * - Lifetimes. Everything copied out belongs to the host. The string of
+ *   trisort_version_string() is static. No function keeps a pointer the host passed.
+ * - Threads. An open handle is never modified: any number of threads may call functions on
+ *   the same handle at once. Closing a handle must not overlap another call on it. The last
+ *   error is per thread. The library has no other global state, starts no threads and never
+ *   calls back into the host.
+ * - Panics. No Rust panic crosses the boundary: an internal error returns
+ *   TRISORT_STATUS_PANIC (please report it).
+ * - Versions. TRISORT_ABI_VERSION is this header's; trisort_abi_version() the loaded
+ *   library's, which must be at least the header's. TRISORT_FORMAT_VERSION and
+ *   trisort_format_version() name the baked-file format read (files of another version are
+ *   refused with TRISORT_STATUS_FORMAT). The shared library's SONAME is libtrisort.so.0.
+ */
+
 #ifndef TRISORT_H
 #define TRISORT_H
 
@@ -7,345 +67,595 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// The ABI version of this library: bumped whenever a function, a struct or an enum of the
-// header changes incompatibly. Hosts compare [`trisort_abi_version`] with the header's
-// `TRISORT_ABI_VERSION`.
-//
-// 3 added [`TrisortStatus::Absent`], the environment ([`trisort_environment_info`],
-// [`trisort_environment_name`], [`trisort_environment_level`]), material variants
-// ([`trisort_variant_count`], [`trisort_variant_name`], [`trisort_variant_materials`]) and
-// the frame rate ([`trisort_fps`]); the functions of 2 are unchanged. 4 added the raster
-// profile ([`trisort_raster_profile`], [`trisort_check_device`],
-// [`TrisortStatus::ProfileMismatch`]); the functions of 3 are unchanged.
-#define TRISORT_ABI_VERSION 4
+/**
+ * The ABI version of this header. A host compares it with `trisort_abi_version()`, the
+ * version of the library it actually loaded: a library of a higher version keeps every
+ * function, struct and enum of the lower ones unchanged (each version only added), so a host
+ * needs `trisort_abi_version() >= TRISORT_ABI_VERSION`. A change that is not an addition
+ * renames the shared library (its SONAME, `libtrisort.so.0`).
+ *
+ * 3 added `TRISORT_STATUS_ABSENT`, the environment (`trisort_environment_info()`,
+ * `trisort_environment_name()`, `trisort_environment_level()`), material variants
+ * (`trisort_variant_count()`, `trisort_variant_name()`, `trisort_variant_materials()`) and
+ * the frame rate (`trisort_fps()`). 4 added the raster profile (`trisort_raster_profile()`,
+ * `trisort_check_device()`, `TRISORT_STATUS_PROFILE_MISMATCH`). 5 added
+ * `trisort_format_version()` and `trisort_version_string()`, and takes the projection's depth
+ * range as a `uint32_t` (the same values and calling convention as the enum it was; an
+ * out-of-range value is now `TRISORT_STATUS_OUT_OF_RANGE` instead of undefined behaviour);
+ * `trisort_export_order()` moved to `libtrisort_export` (`trisort_export.h`).
+ */
+#define TRISORT_ABI_VERSION 5
 
-// [`TrisortRasterProfile::name`]: the recorded pattern only (`--raster-profile exact`).
+/**
+ * The baked-file format version this header's library reads (`trisort_format_version()`
+ * says what the loaded library reads): a file of another version is refused with
+ * `TRISORT_STATUS_FORMAT` and a message saying to bake it again.
+ */
+#define TRISORT_FORMAT_VERSION 5
+
+/**
+ * `TrisortRasterProfile.name`: the recorded pattern only (`--raster-profile exact`).
+ */
 #define TRISORT_PROFILE_EXACT 0
 
-// [`TrisortRasterProfile::name`]: a conformant GPU (the default): standard sample
-// locations, 8 sub-pixel bits, depth at the sample.
+/**
+ * `TrisortRasterProfile.name`: a conformant GPU (the default): standard sample
+ * locations, 8 sub-pixel bits, depth at the sample.
+ */
 #define TRISORT_PROFILE_CONFORMANT 1
 
-// [`TrisortRasterProfile::name`]: as conformant, snapping to 4 to 8 sub-pixel bits.
+/**
+ * `TrisortRasterProfile.name`: as conformant, snapping to 4 to 8 sub-pixel bits.
+ */
 #define TRISORT_PROFILE_SNAP4 2
 
-// [`TrisortRasterProfile::name`]: SwiftShader's rules (the web build).
+/**
+ * `TrisortRasterProfile.name`: SwiftShader's rules (the web build).
+ */
 #define TRISORT_PROFILE_BROWSER 3
 
-// The ORDER file version this build writes and reads.
+/**
+ * The ORDER file version this build writes and reads.
+ */
 #define TRISORT_ORDER_VERSION 1
 
-// The result of a call.
+/**
+ * The result of a call.
+ */
 typedef enum TrisortStatus {
-  // Success.
+  /**
+   * Success.
+   */
   TRISORT_STATUS_OK = 0,
-  // A required pointer argument was null.
+  /**
+   * A required pointer argument was null.
+   */
   TRISORT_STATUS_NULL_ARGUMENT = 1,
-  // A file could not be read or written.
+  /**
+   * A file could not be read or written.
+   */
   TRISORT_STATUS_IO = 2,
-  // A file is not a valid trisort file of a supported version.
+  /**
+   * A file is not a valid trisort file of a supported version.
+   */
   TRISORT_STATUS_FORMAT = 3,
-  // A frame, texture or other index is out of range.
+  /**
+   * A frame, texture or other index is out of range.
+   */
   TRISORT_STATUS_OUT_OF_RANGE = 4,
-  // The caller's buffer is smaller than the data (see `len`).
+  /**
+   * The caller's buffer is smaller than the data (see `len`).
+   */
   TRISORT_STATUS_BUFFER_TOO_SMALL = 5,
-  // The request cannot be met for this file (e.g. u16 indices for more than 65,536
-  // vertices, or a scene that is not the baked file's).
+  /**
+   * The request cannot be met for this file (e.g. u16 indices for more than 65,536
+   * vertices, or a scene that is not the baked file's).
+   */
   TRISORT_STATUS_UNSUPPORTED = 6,
-  // An internal error (a panic, caught): please report it.
+  /**
+   * An internal error (a panic, caught): please report it.
+   */
   TRISORT_STATUS_PANIC = 7,
-  // The file holds no such thing: no frame rate ([`trisort_fps`]), no material variant of
-  // that name ([`trisort_variant_materials`]). The message says what is missing.
+  /**
+   * The file holds no such thing: no frame rate (`trisort_fps()`), no material variant of
+   * that name (`trisort_variant_materials()`). The message says what is missing.
+   */
   TRISORT_STATUS_ABSENT = 8,
-  // The device is outside the bake's raster profile ([`trisort_check_device`]); the
-  // message names each difference.
+  /**
+   * The device is outside the bake's raster profile (`trisort_check_device()`); the
+   * message names each difference.
+   */
   TRISORT_STATUS_PROFILE_MISMATCH = 9,
 } TrisortStatus;
 
-// How frames are drawn (the player's `--mode`).
+/**
+ * How frames are drawn (the player's `--mode`).
+ */
 typedef enum TrisortMode {
-  // Back to front (reversed order), straight-alpha *over*, no depth test.
+  /**
+   * Back to front (reversed order), straight-alpha *over*, no depth test.
+   */
   TRISORT_MODE_BLEND = 0,
-  // Front to back, depth test `LESS` with depth writes, *over*.
+  /**
+   * Front to back, depth test `LESS` with depth writes, *over*.
+   */
   TRISORT_MODE_DEPTH = 1,
-  // Front to back, premultiplied *under* on a target cleared to alpha 0, no depth test.
+  /**
+   * Front to back, premultiplied *under* on a target cleared to alpha 0, no depth test.
+   */
   TRISORT_MODE_SATURATE = 2,
 } TrisortMode;
 
-// Clip-space depth convention of a projection matrix.
-typedef enum TrisortDepthRange {
-  // Depth in [0, 1] (Vulkan, Direct3D, Metal, WebGPU: what trisort renders with).
-  TRISORT_DEPTH_RANGE_ZERO_TO_ONE = 0,
-  // Depth in [-1, 1] (OpenGL and OpenGL ES defaults).
-  TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE = 1,
-} TrisortDepthRange;
-
-// glTF alpha mode.
+/**
+ * glTF alpha mode.
+ */
 typedef enum TrisortAlphaMode {
-  // Opaque: alpha 1.
+  /**
+   * Opaque: alpha 1.
+   */
   TRISORT_ALPHA_MODE_OPAQUE = 0,
-  // Cut out below the cutoff, else opaque.
+  /**
+   * Cut out below the cutoff, else opaque.
+   */
   TRISORT_ALPHA_MODE_MASK = 1,
-  // Blended with its base-colour alpha.
+  /**
+   * Blended with its base-colour alpha.
+   */
   TRISORT_ALPHA_MODE_BLEND = 2,
 } TrisortAlphaMode;
 
-// A baked file opened by [`trisort_open_path`] or [`trisort_open_bytes`].
+/**
+ * A baked file opened by `trisort_open_path()` or `trisort_open_bytes()`.
+ */
 typedef struct TrisortBaked TrisortBaked;
 
-// An ORDER file opened by [`trisort_order_open_path`] or [`trisort_order_open_bytes`].
+/**
+ * An ORDER file opened by `trisort_order_open_path()` or `trisort_order_open_bytes()`.
+ */
 typedef struct TrisortOrder TrisortOrder;
 
-// Figures of a baked file.
+/**
+ * Figures of a baked file.
+ */
 typedef struct TrisortInfo {
-  // Frames.
+  /**
+   * Frames.
+   */
   uint32_t frame_count;
-  // Recorded image width (the bake is exact at this size and sample count).
+  /**
+   * Recorded image width (the bake is exact at this size and sample count).
+   */
   uint32_t width;
-  // Recorded image height.
+  /**
+   * Recorded image height.
+   */
   uint32_t height;
-  // Recorded MSAA sample count (1 or 4).
+  /**
+   * Recorded MSAA sample count (1 or 4).
+   */
   uint32_t samples;
-  // Vertices of G.
+  /**
+   * Vertices of G.
+   */
   uint32_t vertex_count;
-  // Triangles of G (the vertex streams' triangles).
+  /**
+   * Triangles of G (the vertex streams' triangles).
+   */
   uint32_t triangle_count;
-  // Triangles of the sorted index buffer (3 indices each).
+  /**
+   * Triangles of the sorted index buffer (3 indices each).
+   */
   uint32_t index_triangle_count;
-  // Draw ranges over all frames.
+  /**
+   * Draw ranges over all frames.
+   */
   uint32_t draw_count;
-  // Nodes.
+  /**
+   * Nodes.
+   */
   uint32_t node_count;
-  // Materials.
+  /**
+   * Materials.
+   */
   uint32_t material_count;
-  // Textures.
+  /**
+   * Textures.
+   */
   uint32_t texture_count;
-  // Opacity transmissive (glass) materials are drawn with.
+  /**
+   * Opacity transmissive (glass) materials are drawn with.
+   */
   float glass_opacity;
-  // Whether u16 indices suffice (at most 65,536 vertices).
+  /**
+   * Whether u16 indices suffice (at most 65,536 vertices).
+   */
   bool fits_u16;
-  // Whether the file plays only with the depth test ([`TrisortMode::Depth`]).
+  /**
+   * Whether the file plays only with the depth test (`TRISORT_MODE_DEPTH`).
+   */
   bool depth_only;
-  // Whether intersecting triangles were split before recording.
+  /**
+   * Whether intersecting triangles were split before recording.
+   */
   bool split_intersections;
-  // The mode the file plays best in: [`TrisortMode::Depth`] when `depth_only`, else
-  // [`TrisortMode::Blend`].
+  /**
+   * The mode the file plays best in: `TRISORT_MODE_DEPTH` when `depth_only`, else
+   * `TRISORT_MODE_BLEND`.
+   */
   enum TrisortMode recommended_mode;
 } TrisortInfo;
 
-// One draw: `count` indices starting at index `first` of the index buffer (for
-// `glDrawElements(GL_TRIANGLES, count, type, first * index_size)`).
+/**
+ * One draw: `count` indices starting at index `first` of the index buffer (for
+ * `glDrawElements(GL_TRIANGLES, count, type, first * index_size)`).
+ */
 typedef struct TrisortRange {
-  // First index.
+  /**
+   * First index.
+   */
   uint32_t first;
-  // Number of indices (a multiple of 3).
+  /**
+   * Number of indices (a multiple of 3).
+   */
   uint32_t count;
 } TrisortRange;
 
-// One indexed indirect draw, laid out as Vulkan's `VkDrawIndexedIndirectCommand` and
-// OpenGL's `DrawElementsIndirectCommand` read it.
+/**
+ * One indexed indirect draw, laid out as Vulkan's `VkDrawIndexedIndirectCommand` and
+ * OpenGL's `DrawElementsIndirectCommand` read it.
+ */
 typedef struct TrisortDrawIndexedIndirectArgs {
-  // Number of indices.
+  /**
+   * Number of indices.
+   */
   uint32_t index_count;
-  // Number of instances (1).
+  /**
+   * Number of instances (1).
+   */
   uint32_t instance_count;
-  // First index.
+  /**
+   * First index.
+   */
   uint32_t first_index;
-  // Added to each index (0).
+  /**
+   * Added to each index (0).
+   */
   int32_t base_vertex;
-  // First instance (0).
+  /**
+   * First instance (0).
+   */
   uint32_t first_instance;
 } TrisortDrawIndexedIndirectArgs;
 
-// One vertex of G, 64 bytes, as trisort's own pipelines read it (the file's vertex layout:
-// `tangent` at byte 40, `uv1` at byte 56).
+/**
+ * One vertex of G, 64 bytes, as trisort's own pipelines read it (the file's vertex layout:
+ * `tangent` at byte 40, `uv1` at byte 56).
+ */
 typedef struct TrisortVertex {
-  // Position in the local space of `node`.
+  /**
+   * Position in the local space of `node`.
+   */
   float position[3];
-  // Unit normal in the local space of `node` (zero when unknown).
+  /**
+   * Unit normal in the local space of `node` (zero when unknown).
+   */
   float normal[3];
-  // Texture coordinate set 0 (`TEXCOORD_0`; zero where no texture samples it).
+  /**
+   * Texture coordinate set 0 (`TEXCOORD_0`; zero where no texture samples it).
+   */
   float uv[2];
-  // Material index.
+  /**
+   * Material index.
+   */
   uint32_t material;
-  // Node index: the node matrix that moves this vertex.
+  /**
+   * Node index: the node matrix that moves this vertex.
+   */
   uint32_t node;
-  // Tangent in the local space of `node` (xyz unit) and handedness (w, ±1): the bitangent
-  // is `cross(normal, tangent.xyz) * tangent.w`. Zero where the material has no normal
-  // texture.
+  /**
+   * Tangent in the local space of `node` (xyz unit) and handedness (w, ±1): the bitangent
+   * is `cross(normal, tangent.xyz) * tangent.w`. Zero where the material has no normal
+   * texture.
+   */
   float tangent[4];
-  // Texture coordinate set 1 (`TEXCOORD_1`; zero where no texture samples it).
+  /**
+   * Texture coordinate set 1 (`TEXCOORD_1`; zero where no texture samples it).
+   */
   float uv1[2];
 } TrisortVertex;
 
-// A material's reference to a texture: which, sampled at which texture coordinate set,
-// through which `KHR_texture_transform`.
+/**
+ * A material's reference to a texture: which, sampled at which texture coordinate set,
+ * through which `KHR_texture_transform`.
+ */
 typedef struct TrisortTextureSlot {
-  // Texture index, or -1 for none.
+  /**
+   * Texture index, or -1 for none.
+   */
   int32_t texture;
-  // Texture coordinate set: 0 (the vertex `uv`) or 1 (`uv1`).
+  /**
+   * Texture coordinate set: 0 (the vertex `uv`) or 1 (`uv1`).
+   */
   uint32_t tex_coord;
-  // The transform as a 2×3 matrix, row major: `u' = m[0]·u + m[1]·v + m[2]`,
-  // `v' = m[3]·u + m[4]·v + m[5]` (identity: 1, 0, 0, 0, 1, 0).
+  /**
+   * The transform as a 2×3 matrix, row major: `u' = m[0]·u + m[1]·v + m[2]`,
+   * `v' = m[3]·u + m[4]·v + m[5]` (identity: 1, 0, 0, 0, 1, 0).
+   */
   float transform[6];
 } TrisortTextureSlot;
 
-// A material: glTF metallic-roughness with the extensions trisort reads.
+/**
+ * A material: glTF metallic-roughness with the extensions trisort reads.
+ */
 typedef struct TrisortMaterial {
-  // Linear RGBA base colour factor.
+  /**
+   * Linear RGBA base colour factor.
+   */
   float base_color[4];
-  // Linear RGB emissive colour (factor × `KHR_materials_emissive_strength`).
+  /**
+   * Linear RGB emissive colour (factor × `KHR_materials_emissive_strength`).
+   */
   float emissive[3];
-  // Alpha cutoff (for [`TrisortAlphaMode::Mask`]).
+  /**
+   * Alpha cutoff (for `TRISORT_ALPHA_MODE_MASK`).
+   */
   float alpha_cutoff;
-  // `KHR_materials_transmission` factor; > 0 marks glass, drawn at the info's
-  // `glass_opacity`.
+  /**
+   * `KHR_materials_transmission` factor; > 0 marks glass, drawn at the info's
+   * `glass_opacity`.
+   */
   float transmission;
-  // Base-colour texture index, or -1 for none (the same as `base_color_slot.texture`).
+  /**
+   * Base-colour texture index, or -1 for none (the same as `base_color_slot.texture`).
+   */
   int32_t base_color_texture;
-  // Alpha mode.
+  /**
+   * Alpha mode.
+   */
   enum TrisortAlphaMode alpha_mode;
-  // Whether back faces are drawn (single-sided materials discard them).
+  /**
+   * Whether back faces are drawn (single-sided materials discard them).
+   */
   bool double_sided;
-  // Base-colour texture (sRGB) with its set and transform; its alpha is what MASK and BLEND
-  // materials are recorded with.
+  /**
+   * Base-colour texture (sRGB) with its set and transform; its alpha is what MASK and BLEND
+   * materials are recorded with.
+   */
   struct TrisortTextureSlot base_color_slot;
-  // Metallic factor.
+  /**
+   * Metallic factor.
+   */
   float metallic;
-  // Perceptual roughness factor.
+  /**
+   * Perceptual roughness factor.
+   */
   float roughness;
-  // Metallic-roughness texture (linear; blue: metallic, green: roughness).
+  /**
+   * Metallic-roughness texture (linear; blue: metallic, green: roughness).
+   */
   struct TrisortTextureSlot metallic_roughness;
-  // Tangent-space normal texture (linear).
+  /**
+   * Tangent-space normal texture (linear).
+   */
   struct TrisortTextureSlot normal;
-  // Scale of the normal texture's x and y.
+  /**
+   * Scale of the normal texture's x and y.
+   */
   float normal_scale;
-  // Occlusion texture (linear, red channel).
+  /**
+   * Occlusion texture (linear, red channel).
+   */
   struct TrisortTextureSlot occlusion;
-  // Strength of the occlusion texture.
+  /**
+   * Strength of the occlusion texture.
+   */
   float occlusion_strength;
-  // Emissive texture (sRGB), multiplied by `emissive`.
+  /**
+   * Emissive texture (sRGB), multiplied by `emissive`.
+   */
   struct TrisortTextureSlot emissive_texture;
-  // `KHR_materials_clearcoat` intensity (0: none).
+  /**
+   * `KHR_materials_clearcoat` intensity (0: none).
+   */
   float clearcoat;
-  // `KHR_materials_clearcoat` roughness.
+  /**
+   * `KHR_materials_clearcoat` roughness.
+   */
   float clearcoat_roughness;
 } TrisortMaterial;
 
-// A texture's size, colour space and mip levels.
+/**
+ * A texture's size, colour space and mip levels.
+ */
 typedef struct TrisortTextureInfo {
-  // Width of level 0 in texels.
+  /**
+   * Width of level 0 in texels.
+   */
   uint32_t width;
-  // Height of level 0 in texels.
+  /**
+   * Height of level 0 in texels.
+   */
   uint32_t height;
-  // Whether the colour channels are sRGB-encoded (base colour, emissive: upload as
-  // `GL_SRGB8_ALPHA8`) rather than linear data (metallic-roughness, normal, occlusion:
-  // `GL_RGBA8`).
+  /**
+   * Whether the colour channels are sRGB-encoded (base colour, emissive: upload as
+   * `GL_SRGB8_ALPHA8`) rather than linear data (metallic-roughness, normal, occlusion:
+   * `GL_RGBA8`).
+   */
   bool srgb;
-  // Levels stored, level 0 included: the full chain down to 1×1 (level k is
-  // `max(1, width >> k)` × `max(1, height >> k)`; 1 for a 1×1 texture).
+  /**
+   * Levels stored, level 0 included: the full chain down to 1×1 (level k is
+   * `max(1, width >> k)` × `max(1, height >> k)`; 1 for a 1×1 texture).
+   */
   uint32_t level_count;
 } TrisortTextureInfo;
 
-// What a baked file assumes about the rasterizer that plays it (`trisort inspect`'s
-// `raster_profile`): frames played on a device outside it may show holes.
+/**
+ * What a baked file assumes about the rasterizer that plays it (`trisort inspect`'s
+ * `raster_profile`): frames played on a device outside it may show holes.
+ */
 typedef struct TrisortRasterProfile {
-  // The profile's name: one of `TRISORT_PROFILE_EXACT`, `_CONFORMANT`, `_SNAP4`,
-  // `_BROWSER`.
+  /**
+   * The profile's name: one of `TRISORT_PROFILE_EXACT`, `_CONFORMANT`, `_SNAP4`,
+   * `_BROWSER`.
+   */
   uint32_t name;
-  // How far (pixels, in x and y) a sample may lie from the recorded one relative to the
-  // exact geometry, besides the snapping of corners.
+  /**
+   * How far (pixels, in x and y) a sample may lie from the recorded one relative to the
+   * exact geometry, besides the snapping of corners.
+   */
   float tolerance;
-  // The fewest sub-pixel bits a device of the profile snaps corners to.
+  /**
+   * The fewest sub-pixel bits a device of the profile snaps corners to.
+   */
   uint32_t subpixel_bits_min;
-  // The most sub-pixel bits.
+  /**
+   * The most sub-pixel bits.
+   */
   uint32_t subpixel_bits_max;
-  // Whether the profile's devices take a sample's depth at the sample (the Vulkan and GLES
-  // rule); false: anywhere in its pixel.
+  /**
+   * Whether the profile's devices take a sample's depth at the sample (the Vulkan and GLES
+   * rule); false: anywhere in its pixel.
+   */
   bool depth_at_sample;
-  // Whether the recording was conservative (false: the recorded pattern only).
+  /**
+   * Whether the recording was conservative (false: the recorded pattern only).
+   */
   bool conservative;
-  // Sample patterns unioned (1: the recorded one only).
+  /**
+   * Sample patterns unioned (1: the recorded one only).
+   */
   uint32_t patterns;
 } TrisortRasterProfile;
 
-// What the host's graphics API reports about the device it plays on, for
-// [`trisort_check_device`].
+/**
+ * What the host's graphics API reports about the device it plays on, for
+ * `trisort_check_device()`.
+ */
 typedef struct TrisortDeviceRaster {
-  // Sub-pixel precision in bits (Vulkan's `VkPhysicalDeviceLimits::subPixelPrecisionBits`,
-  // GL's `GL_SUBPIXEL_BITS`); 0 when unknown.
+  /**
+   * Sub-pixel precision in bits (Vulkan's `VkPhysicalDeviceLimits::subPixelPrecisionBits`,
+   * GL's `GL_SUBPIXEL_BITS`); 0 when unknown.
+   */
   uint32_t subpixel_bits;
-  // 1 where the device uses the standard sample locations (Vulkan's
-  // `standardSampleLocations`), 0 where it does not, −1 when unknown.
+  /**
+   * 1 where the device uses the standard sample locations (Vulkan's
+   * `standardSampleLocations`), 0 where it does not, −1 when unknown.
+   */
   int32_t standard_sample_locations;
-  // The MSAA sample count the host plays at.
+  /**
+   * The MSAA sample count the host plays at.
+   */
   uint32_t samples;
 } TrisortDeviceRaster;
 
-// The light a baked file is shaded with (trisort's image-based light and optional sun), in
-// world space (+Y up, glTF's convention).
-//
-// The radiance is an equirectangular image ([`trisort_environment_level`]): texel (x, y) of
-// level 0 looks along `(sin θ cos φ, cos θ, sin θ sin φ)` with `φ = 2π (x + 0.5) / width`
-// and `θ = π (y + 0.5) / height` (row 0 at the zenith). Level k has `max(1, width >> k)` ×
-// `max(1, height >> k)` texels and holds the radiance prefiltered for GGX perceptual
-// roughness `k / (level_count - 1)` (level 0: the mirror image; with one level, roughness 0).
+/**
+ * The light a baked file is shaded with (trisort's image-based light and optional sun), in
+ * world space (+Y up, glTF's convention).
+ *
+ * The radiance is an equirectangular image (`trisort_environment_level()`): texel (x, y) of
+ * level 0 looks along `(sin θ cos φ, cos θ, sin θ sin φ)` with `φ = 2π (x + 0.5) / width`
+ * and `θ = π (y + 0.5) / height` (row 0 at the zenith). Level k has `max(1, width >> k)` ×
+ * `max(1, height >> k)` texels and holds the radiance prefiltered for GGX perceptual
+ * roughness `k / (level_count - 1)` (level 0: the mirror image; with one level, roughness 0).
+ */
 typedef struct TrisortEnvironmentInfo {
-  // Width of level 0 in texels.
+  /**
+   * Width of level 0 in texels.
+   */
   uint32_t width;
-  // Height of level 0 in texels.
+  /**
+   * Height of level 0 in texels.
+   */
   uint32_t height;
-  // Prefiltered levels stored, level 0 included.
+  /**
+   * Prefiltered levels stored, level 0 included.
+   */
   uint32_t level_count;
-  // Irradiance / π as order-2 spherical harmonics: 9 RGB coefficients in the order Y00,
-  // Y1-1, Y10, Y11, Y2-2, Y2-1, Y20, Y21, Y22. A Lambertian surface of albedo ρ and
-  // world-space unit normal n = (x, y, z) reflects `ρ · Σ sh[i] · Y_i(n)`, with `Y_i`:
-  // `0.282095`, `0.488603·y`, `0.488603·z`, `0.488603·x`, `1.092548·xy`, `1.092548·yz`,
-  // `0.315392·(3z² − 1)`, `1.092548·xz`, `0.546274·(x² − y²)` (these formulas on glTF's
-  // axes as they are).
+  /**
+   * Irradiance / π as order-2 spherical harmonics: 9 RGB coefficients in the order Y00,
+   * Y1-1, Y10, Y11, Y2-2, Y2-1, Y20, Y21, Y22. A Lambertian surface of albedo ρ and
+   * world-space unit normal n = (x, y, z) reflects `ρ · Σ sh[i] · Y_i(n)`, with `Y_i`:
+   * `0.282095`, `0.488603·y`, `0.488603·z`, `0.488603·x`, `1.092548·xy`, `1.092548·yz`,
+   * `0.315392·(3z² − 1)`, `1.092548·xz`, `0.546274·(x² − y²)` (these formulas on glTF's
+   * axes as they are).
+   */
   float sh[9][3];
-  // Whether a directional light (sun) is added to the environment; when false,
-  // `sun_direction` and `sun_color` are zero.
+  /**
+   * Whether a directional light (sun) is added to the environment; when false,
+   * `sun_direction` and `sun_color` are zero.
+   */
   bool has_sun;
-  // World-space unit direction *towards* the sun.
+  /**
+   * World-space unit direction *towards* the sun.
+   */
   float sun_direction[3];
-  // The sun's linear RGB radiance (colour × intensity).
+  /**
+   * The sun's linear RGB radiance (colour × intensity).
+   */
   float sun_color[3];
-  // Exposure: a multiplier on all light (environment and sun) before tone mapping.
+  /**
+   * Exposure: a multiplier on all light (environment and sun) before tone mapping.
+   */
   float exposure;
 } TrisortEnvironmentInfo;
 
-// Figures of an ORDER file.
+/**
+ * Figures of an ORDER file.
+ */
 typedef struct TrisortOrderInfo {
-  // Frames.
+  /**
+   * Frames.
+   */
   uint32_t frame_count;
-  // Ranges over all frames.
+  /**
+   * Ranges over all frames.
+   */
   uint32_t range_count;
-  // Index-buffer triangles.
+  /**
+   * Index-buffer triangles.
+   */
   uint32_t triangle_count;
-  // Whether the bake split intersecting triangles (several consecutive entries can then
-  // name one source triangle: see docs/FORMAT.md § ORDER).
+  /**
+   * Whether the bake split intersecting triangles (several consecutive entries can then
+   * name one source triangle: see docs/FORMAT.md § ORDER).
+   */
   bool split;
 } TrisortOrderInfo;
 
-// One run of consecutive index-buffer triangles drawn by one call.
+/**
+ * One run of consecutive index-buffer triangles drawn by one call.
+ */
 typedef struct TrisortOrderRange {
-  // First triangle (multiply by 3 for the first index).
+  /**
+   * First triangle (multiply by 3 for the first index).
+   */
   uint32_t first;
-  // Number of triangles.
+  /**
+   * Number of triangles.
+   */
   uint32_t count;
 } TrisortOrderRange;
 
-// Where one index-buffer triangle comes from in the glTF file (all indices of the file).
+/**
+ * Where one index-buffer triangle comes from in the glTF file (all indices of the file).
+ */
 typedef struct TrisortOrderSource {
-  // Mesh index.
+  /**
+   * Mesh index.
+   */
   uint32_t mesh;
-  // Primitive index within the mesh.
+  /**
+   * Primitive index within the mesh.
+   */
   uint32_t primitive;
-  // Triangle index within the primitive (its indices `3t, 3t+1, 3t+2` for a triangle
-  // list; strips and fans as the glTF specification derives them).
+  /**
+   * Triangle index within the primitive (its indices `3t, 3t+1, 3t+2` for a triangle
+   * list; strips and fans as the glTF specification derives them).
+   */
   uint32_t triangle;
-  // Node index (the instance of the mesh: its world transform moves the triangle).
+  /**
+   * Node index (the instance of the mesh: its world transform moves the triangle).
+   */
   uint32_t node;
 } TrisortOrderSource;
 
@@ -353,71 +663,102 @@ typedef struct TrisortOrderSource {
 extern "C" {
 #endif // __cplusplus
 
-// The library's ABI version ([`TRISORT_ABI_VERSION`] of the library actually linked).
+/**
+ * The library's ABI version (`TRISORT_ABI_VERSION` of the library actually linked): a host
+ * built with this header needs at least its `TRISORT_ABI_VERSION`.
+ */
 uint32_t trisort_abi_version(void);
 
-// Copies the calling thread's last error message (UTF-8, empty after a success) into `buf`,
-// truncated to `cap - 1` bytes and NUL-terminated (nothing is written when `buf` is null or
-// `cap` is 0). Returns the message's full length in bytes, without the NUL.
-//
-// # Safety
-// `buf` is null or valid for `cap` byte writes.
+/**
+ * The baked-file format version the linked library reads (`TRISORT_FORMAT_VERSION` of the
+ * library actually linked; docs/FORMAT.md § Container says where a file stores its own).
+ */
+uint32_t trisort_format_version(void);
+
+/**
+ * The linked library's version (trisort's release, e.g. "0.1.0"), as a static NUL-terminated
+ * string: valid for the life of the program, never freed by the host.
+ */
+const char *trisort_version_string(void);
+
+/**
+ * Copies the calling thread's last error message (UTF-8, empty after a success) into `buf`,
+ * truncated to `cap - 1` bytes and NUL-terminated (nothing is written when `buf` is null or
+ * `cap` is 0). Returns the message's full length in bytes, without the NUL.
+ *
+ * # Safety
+ * `buf` is null or valid for `cap` byte writes.
+ */
 size_t trisort_last_error(char *buf, size_t cap);
 
-// Opens the baked file at `path` (NUL-terminated UTF-8) and stores its handle in `*out`.
-// The file is read, checked (magic, version, checksum, structure) and kept in memory.
-//
-// # Safety
-// `path` is a NUL-terminated string; `out` is valid for one write.
+/**
+ * Opens the baked file at `path` (NUL-terminated UTF-8) and stores its handle in `*out`.
+ * The file is read, checked (magic, version, checksum, structure) and kept in memory.
+ *
+ * # Safety
+ * `path` is a NUL-terminated string; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_open_path(const char *path, struct TrisortBaked **out);
 
-// Opens a baked file from `len` bytes at `data` (copied; the host may free them after the
-// call) and stores its handle in `*out`.
-//
-// # Safety
-// `data` is valid for `len` byte reads; `out` is valid for one write.
+/**
+ * Opens a baked file from `len` bytes at `data` (copied; the host may free them after the
+ * call) and stores its handle in `*out`.
+ *
+ * # Safety
+ * `data` is valid for `len` byte reads; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_open_bytes(const uint8_t *data, size_t len, struct TrisortBaked **out);
 
-// Closes a handle from `trisort_open_*` (null is ignored). The handle is invalid afterwards.
-//
-// # Safety
-// `h` is null or a handle not closed before.
+/**
+ * Closes a handle from `trisort_open_*` (null is ignored). The handle is invalid afterwards.
+ *
+ * # Safety
+ * `h` is null or a handle not closed before.
+ */
 void trisort_close(struct TrisortBaked *h);
 
-// Stores the file's figures in `*out`.
-//
-// # Safety
-// `h` is an open handle; `out` is valid for one write.
+/**
+ * Stores the file's figures in `*out`.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_info(const struct TrisortBaked *h, struct TrisortInfo *out);
 
-// Copies the sorted index buffer as u32 indices into the vertex streams: front to back, or
-// reversed (`back_to_front`, what [`TrisortMode::Blend`] draws; use the same flag for the
-// frame ranges). `len` counts indices.
-//
-// # Safety
-// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/**
+ * Copies the sorted index buffer as u32 indices into the vertex streams: front to back, or
+ * reversed (`back_to_front`, what `TRISORT_MODE_BLEND` draws; use the same flag for the
+ * frame ranges). `len` counts indices.
+ *
+ * # Safety
+ * `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_indices_u32(const struct TrisortBaked *h,
                                        bool back_to_front,
                                        uint32_t *out,
                                        size_t cap,
                                        size_t *len);
 
-// [`trisort_indices_u32`] as u16 indices; [`TrisortStatus::Unsupported`] when the file has
-// more than 65,536 vertices (see the info's `fits_u16`).
-//
-// # Safety
-// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/**
+ * `trisort_indices_u32()` as u16 indices; `TRISORT_STATUS_UNSUPPORTED` when the file has
+ * more than 65,536 vertices (see the info's `fits_u16`).
+ *
+ * # Safety
+ * `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_indices_u16(const struct TrisortBaked *h,
                                        bool back_to_front,
                                        uint16_t *out,
                                        size_t cap,
                                        size_t *len);
 
-// Copies frame `frame`'s draw ranges, in drawing order, over the index buffer of the same
-// `back_to_front` ([`trisort_indices_u32`]). `len` counts ranges.
-//
-// # Safety
-// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/**
+ * Copies frame `frame`'s draw ranges, in drawing order, over the index buffer of the same
+ * `back_to_front` (`trisort_indices_u32()`). `len` counts ranges.
+ *
+ * # Safety
+ * `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_frame_ranges(const struct TrisortBaked *h,
                                         uint32_t frame,
                                         bool back_to_front,
@@ -425,11 +766,13 @@ enum TrisortStatus trisort_frame_ranges(const struct TrisortBaked *h,
                                         size_t cap,
                                         size_t *len);
 
-// Copies frame `frame`'s draws as indirect-draw arguments (the same draws as
-// [`trisort_frame_ranges`], ready for `glMultiDrawElementsIndirect`/`vkCmdDrawIndexedIndirect`).
-//
-// # Safety
-// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/**
+ * Copies frame `frame`'s draws as indirect-draw arguments (the same draws as
+ * `trisort_frame_ranges()`, ready for `glMultiDrawElementsIndirect`/`vkCmdDrawIndexedIndirect`).
+ *
+ * # Safety
+ * `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_frame_draws(const struct TrisortBaked *h,
                                        uint32_t frame,
                                        bool back_to_front,
@@ -437,40 +780,51 @@ enum TrisortStatus trisort_frame_draws(const struct TrisortBaked *h,
                                        size_t cap,
                                        size_t *len);
 
-// Copies the vertex streams of G, interleaved (64 bytes per vertex).
-//
-// # Safety
-// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/**
+ * Copies the vertex streams of G, interleaved (64 bytes per vertex).
+ *
+ * # Safety
+ * `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_vertices(const struct TrisortBaked *h,
                                     struct TrisortVertex *out,
                                     size_t cap,
                                     size_t *len);
 
-// Writes frame `frame`'s camera view matrix (world to view; right handed, looking down −Z)
-// to `out[0..16]`.
-//
-// # Safety
-// `h` is an open handle; `out` is valid for 16 float writes.
+/**
+ * Writes frame `frame`'s camera view matrix (world to view; right handed, looking down −Z)
+ * to `out[0..16]`.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for 16 float writes.
+ */
 enum TrisortStatus trisort_frame_view(const struct TrisortBaked *h, uint32_t frame, float *out);
 
-// Writes frame `frame`'s projection matrix for an image of `aspect` (width / height) in the
-// clip-depth convention `depth` to `out[0..16]`. Built in f64 and rounded once, as trisort's
-// own pipelines do.
-//
-// # Safety
-// `h` is an open handle; `out` is valid for 16 float writes.
+/**
+ * Writes frame `frame`'s projection matrix for an image of `aspect` (width / height) in the
+ * clip-depth convention `depth` (a `TrisortDepthRange` value: `TRISORT_DEPTH_RANGE_ZERO_TO_ONE`
+ * or `TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE`; another is `TRISORT_STATUS_OUT_OF_RANGE`) to
+ * `out[0..16]`, column major. A right-handed perspective (the view looks down −Z): near maps
+ * to the low end of the depth range, far (or infinity, for a glTF camera without `zfar`) to
+ * the high end. Built in f64 and rounded once, as trisort's own pipelines do.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for 16 float writes.
+ */
 enum TrisortStatus trisort_frame_projection(const struct TrisortBaked *h,
                                             uint32_t frame,
                                             double aspect,
-                                            enum TrisortDepthRange depth,
+                                            uint32_t depth,
                                             float *out);
 
-// Copies frame `frame`'s node matrices, 16 floats per node: with `view_relative` the
-// camera-relative view × world matrices trisort's pipelines use (computed in f64, rounded
-// once: precise far from the origin), else the world matrices. `cap` and `len` count floats.
-//
-// # Safety
-// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/**
+ * Copies frame `frame`'s node matrices, 16 floats per node: with `view_relative` the
+ * camera-relative view × world matrices trisort's pipelines use (computed in f64, rounded
+ * once: precise far from the origin), else the world matrices. `cap` and `len` count floats.
+ *
+ * # Safety
+ * `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_frame_node_matrices(const struct TrisortBaked *h,
                                                uint32_t frame,
                                                bool view_relative,
@@ -478,22 +832,26 @@ enum TrisortStatus trisort_frame_node_matrices(const struct TrisortBaked *h,
                                                size_t cap,
                                                size_t *len);
 
-// Copies the materials.
-//
-// # Safety
-// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/**
+ * Copies the materials.
+ *
+ * # Safety
+ * `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_materials(const struct TrisortBaked *h,
                                      struct TrisortMaterial *out,
                                      size_t cap,
                                      size_t *len);
 
-// Stores texture `texture`'s size in `*width` and `*height` (either may be null) and copies
-// its level-0 texels (RGBA8, rows top to bottom, sRGB or linear as
-// [`trisort_texture_info`] says; `cap` and `len` count bytes).
-//
-// # Safety
-// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
-// `len` as in the module conventions.
+/**
+ * Stores texture `texture`'s size in `*width` and `*height` (either may be null) and copies
+ * its level-0 texels (RGBA8, rows top to bottom, sRGB or linear as
+ * `trisort_texture_info()` says; `cap` and `len` count bytes).
+ *
+ * # Safety
+ * `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
+ * `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_texture(const struct TrisortBaked *h,
                                    uint32_t texture,
                                    uint32_t *width,
@@ -502,21 +860,25 @@ enum TrisortStatus trisort_texture(const struct TrisortBaked *h,
                                    size_t cap,
                                    size_t *len);
 
-// Stores texture `texture`'s size, colour space and level count in `*out`.
-//
-// # Safety
-// `h` is an open handle; `out` is valid for one write.
+/**
+ * Stores texture `texture`'s size, colour space and level count in `*out`.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_texture_info(const struct TrisortBaked *h,
                                         uint32_t texture,
                                         struct TrisortTextureInfo *out);
 
-// Stores the size of mip level `level` of texture `texture` in `*width` and `*height`
-// (either may be null) and copies its texels (RGBA8, rows top to bottom; `cap` and `len`
-// count bytes). Level 0 is the texture itself; levels run to the info's `level_count`.
-//
-// # Safety
-// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
-// `len` as in the module conventions.
+/**
+ * Stores the size of mip level `level` of texture `texture` in `*width` and `*height`
+ * (either may be null) and copies its texels (RGBA8, rows top to bottom; `cap` and `len`
+ * count bytes). Level 0 is the texture itself; levels run to the info's `level_count`.
+ *
+ * # Safety
+ * `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
+ * `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_texture_level(const struct TrisortBaked *h,
                                          uint32_t texture,
                                          uint32_t level,
@@ -526,63 +888,75 @@ enum TrisortStatus trisort_texture_level(const struct TrisortBaked *h,
                                          size_t cap,
                                          size_t *len);
 
-// Stores the frame rate the file's path was recorded at (what a player plays at by default)
-// in `*out`. When the file stores none (its recordings did not know it), writes 0 to `*out`
-// and returns [`TrisortStatus::Absent`]; a stored rate is always finite and positive.
-//
-// # Safety
-// `h` is an open handle; `out` is valid for one write.
+/**
+ * Stores the frame rate the file's path was recorded at (what a player plays at by default)
+ * in `*out`. When the file stores none (its recordings did not know it), writes 0 to `*out`
+ * and returns `TRISORT_STATUS_ABSENT`; a stored rate is always finite and positive.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_fps(const struct TrisortBaked *h, double *out);
 
-// Stores the file's raster profile in `*out`.
-//
-// # Safety
-// `h` is an open handle; `out` is valid for one write.
+/**
+ * Stores the file's raster profile in `*out`.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_raster_profile(const struct TrisortBaked *h,
                                           struct TrisortRasterProfile *out);
 
-// Checks what the host's API reports about its device against the file's raster profile:
-// the sample count, the sub-pixel precision and whether the sample locations are the
-// standard ones (each where known). Returns [`TrisortStatus::Ok`] when nothing reported
-// differs, else [`TrisortStatus::ProfileMismatch`] with every difference in the last error
-// (`trisort_last_error`): a host that must refuse such a device (as `trisort play
-// --strict-profile` does) stops there; one that plays anyway should log it. The raster probe
-// of `trisort play` also measures the sample positions and snapping; this call takes the
-// API's word.
-//
-// # Safety
-// `h` is an open handle; `device` is valid for one read.
+/**
+ * Checks what the host's API reports about its device against the file's raster profile:
+ * the sample count, the sub-pixel precision and whether the sample locations are the
+ * standard ones (each where known). Returns `TRISORT_STATUS_OK` when nothing reported
+ * differs, else `TRISORT_STATUS_PROFILE_MISMATCH` with every difference in the last error
+ * (`trisort_last_error`): a host that must refuse such a device (as `trisort play
+ * --strict-profile` does) stops there; one that plays anyway should log it. The raster probe
+ * of `trisort play` also measures the sample positions and snapping; this call takes the
+ * API's word.
+ *
+ * # Safety
+ * `h` is an open handle; `device` is valid for one read.
+ */
 enum TrisortStatus trisort_check_device(const struct TrisortBaked *h,
                                         const struct TrisortDeviceRaster *device);
 
-// Stores the figures of the light the file is shaded with in `*out` (its name:
-// [`trisort_environment_name`]; its texels: [`trisort_environment_level`]).
-//
-// # Safety
-// `h` is an open handle; `out` is valid for one write.
+/**
+ * Stores the figures of the light the file is shaded with in `*out` (its name:
+ * `trisort_environment_name()`; its texels: `trisort_environment_level()`).
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_environment_info(const struct TrisortBaked *h,
                                             struct TrisortEnvironmentInfo *out);
 
-// Copies the environment's name (`studio` for the built-in light, else the HDR file's
-// name) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes (see the module
-// conventions on strings).
-//
-// # Safety
-// `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
-// valid for one write.
+/**
+ * Copies the environment's name (`studio` for the built-in light, else the HDR file's
+ * name) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes (the string convention,
+ * top of this header).
+ *
+ * # Safety
+ * `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
+ * valid for one write.
+ */
 enum TrisortStatus trisort_environment_name(const struct TrisortBaked *h,
                                             char *out,
                                             size_t cap,
                                             size_t *len);
 
-// Stores the size of prefiltered level `level` of the environment in `*width` and `*height`
-// (either may be null) and copies its texels: RGBA as IEEE binary16 bits (`uint16_t` each,
-// alpha 1; upload as `GL_RGBA16F` with `GL_HALF_FLOAT`), rows from the zenith down, layout as
-// on [`TrisortEnvironmentInfo`]. `cap` and `len` count `uint16_t` values (4 per texel).
-//
-// # Safety
-// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
-// `len` as in the module conventions.
+/**
+ * Stores the size of prefiltered level `level` of the environment in `*width` and `*height`
+ * (either may be null) and copies its texels: RGBA as IEEE binary16 bits (`uint16_t` each,
+ * alpha 1; upload as `GL_RGBA16F` with `GL_HALF_FLOAT`), rows from the zenith down, layout as
+ * on `TrisortEnvironmentInfo`. `cap` and `len` count `uint16_t` values (4 per texel).
+ *
+ * # Safety
+ * `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
+ * `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_environment_level(const struct TrisortBaked *h,
                                              uint32_t level,
                                              uint32_t *width,
@@ -591,98 +965,106 @@ enum TrisortStatus trisort_environment_level(const struct TrisortBaked *h,
                                              size_t cap,
                                              size_t *len);
 
-// Stores the number of material variants (glTF `KHR_materials_variants`) in `*out`: 0
-// without the extension.
-//
-// # Safety
-// `h` is an open handle; `out` is valid for one write.
+/**
+ * Stores the number of material variants (glTF `KHR_materials_variants`) in `*out`: 0
+ * without the extension.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_variant_count(const struct TrisortBaked *h, uint32_t *out);
 
-// Copies the name of material variant `variant` (file order, below
-// [`trisort_variant_count`]) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes
-// (see the module conventions on strings). Names come from the glTF file: they may be empty
-// and need not be unique.
-//
-// # Safety
-// `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
-// valid for one write.
+/**
+ * Copies the name of material variant `variant` (file order, below
+ * `trisort_variant_count()`) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes
+ * (the string convention, top of this header). Names come from the glTF file: they may be empty
+ * and need not be unique.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
+ * valid for one write.
+ */
 enum TrisortStatus trisort_variant_name(const struct TrisortBaked *h,
                                         uint32_t variant,
                                         char *out,
                                         size_t cap,
                                         size_t *len);
 
-// Copies the material table under the material variant named `name` (NUL-terminated UTF-8;
-// null: the default materials, as [`trisort_materials`]): entry k is what material slot k
-// (a vertex's `material`) shows under the variant, so a host switches variants by
-// re-uploading this table alone. Where names repeat, the first variant of the name is used
-// (as the player's `--variant`).
-//
-// Refusals, with a message naming the file and the variant: [`TrisortStatus::Absent`] when
-// no variant has this name (the message lists the file's variants);
-// [`TrisortStatus::Unsupported`] when the variant changes something that decides visibility
-// (alpha mode, double-sidedness, transmission, a cut-out or blended material's alpha or
-// cutoff...), so the baked order would not be exact for it.
-//
-// # Safety
-// `h` is an open handle; `name` is null or a NUL-terminated string; `out`, `cap`, `len` as
-// in the module conventions.
+/**
+ * Copies the material table under the material variant named `name` (NUL-terminated UTF-8;
+ * null: the default materials, as `trisort_materials()`): entry k is what material slot k
+ * (a vertex's `material`) shows under the variant, so a host switches variants by
+ * re-uploading this table alone. Where names repeat, the first variant of the name is used
+ * (as the player's `--variant`).
+ *
+ * Refusals, with a message naming the file and the variant: `TRISORT_STATUS_ABSENT` when
+ * no variant has this name (the message lists the file's variants);
+ * `TRISORT_STATUS_UNSUPPORTED` when the variant changes something that decides visibility
+ * (alpha mode, double-sidedness, transmission, a cut-out or blended material's alpha or
+ * cutoff...), so the baked order would not be exact for it.
+ *
+ * # Safety
+ * `h` is an open handle; `name` is null or a NUL-terminated string; `out`, `cap`, `len` as
+ * in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_variant_materials(const struct TrisortBaked *h,
                                              const char *name,
                                              struct TrisortMaterial *out,
                                              size_t cap,
                                              size_t *len);
 
-// Builds the order-only export of the baked file at `baked_path`, whose scene is the glTF
-// file `scene_path`, and writes it to `out_path` (atomically). The same as
-// `trisort export-order BAKED --scene SCENE -o OUT`.
-//
-// # Safety
-// The three paths are NUL-terminated strings.
-enum TrisortStatus trisort_export_order(const char *baked_path,
-                                        const char *scene_path,
-                                        const char *out_path);
-
-// Opens the ORDER file at `path` and stores its handle in `*out`.
-//
-// # Safety
-// `path` is a NUL-terminated string; `out` is valid for one write.
+/**
+ * Opens the ORDER file at `path` and stores its handle in `*out`.
+ *
+ * # Safety
+ * `path` is a NUL-terminated string; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_order_open_path(const char *path, struct TrisortOrder **out);
 
-// Opens an ORDER file from `len` bytes at `data` (copied) and stores its handle in `*out`.
-//
-// # Safety
-// `data` is valid for `len` byte reads; `out` is valid for one write.
+/**
+ * Opens an ORDER file from `len` bytes at `data` (copied) and stores its handle in `*out`.
+ *
+ * # Safety
+ * `data` is valid for `len` byte reads; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_order_open_bytes(const uint8_t *data,
                                             size_t len,
                                             struct TrisortOrder **out);
 
-// Closes a handle from `trisort_order_open_*` (null is ignored).
-//
-// # Safety
-// `h` is null or a handle not closed before.
+/**
+ * Closes a handle from `trisort_order_open_*` (null is ignored).
+ *
+ * # Safety
+ * `h` is null or a handle not closed before.
+ */
 void trisort_order_close(struct TrisortOrder *h);
 
-// Stores the ORDER file's figures in `*out`.
-//
-// # Safety
-// `h` is an open order handle; `out` is valid for one write.
+/**
+ * Stores the ORDER file's figures in `*out`.
+ *
+ * # Safety
+ * `h` is an open order handle; `out` is valid for one write.
+ */
 enum TrisortStatus trisort_order_info(const struct TrisortOrder *h, struct TrisortOrderInfo *out);
 
-// Copies frame `frame`'s ranges (first triangle, triangle count), front to back.
-//
-// # Safety
-// `h` is an open order handle; `out`, `cap`, `len` as in the module conventions.
+/**
+ * Copies frame `frame`'s ranges (first triangle, triangle count), front to back.
+ *
+ * # Safety
+ * `h` is an open order handle; `out`, `cap`, `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_order_frame_ranges(const struct TrisortOrder *h,
                                               uint32_t frame,
                                               struct TrisortOrderRange *out,
                                               size_t cap,
                                               size_t *len);
 
-// Copies every index-buffer triangle's source, front to back.
-//
-// # Safety
-// `h` is an open order handle; `out`, `cap`, `len` as in the module conventions.
+/**
+ * Copies every index-buffer triangle's source, front to back.
+ *
+ * # Safety
+ * `h` is an open order handle; `out`, `cap`, `len` as in the copy convention (top of this header).
+ */
 enum TrisortStatus trisort_order_triangles(const struct TrisortOrder *h,
                                            struct TrisortOrderSource *out,
                                            size_t cap,

@@ -44,6 +44,10 @@ fn sample_order() -> Order {
 #[test]
 fn abi_version_is_exported() {
     assert_eq!(trisort_abi_version(), TRISORT_ABI_VERSION);
+    assert_eq!(trisort_format_version(), trisort_format::FORMAT_VERSION);
+    assert_eq!(trisort_format_version(), TRISORT_FORMAT_VERSION);
+    let version = unsafe { std::ffi::CStr::from_ptr(trisort_version_string()) };
+    assert_eq!(version.to_str().unwrap(), env!("CARGO_PKG_VERSION"));
 }
 
 #[test]

@@ -214,7 +214,7 @@ fn check_matrices(h: *mut TrisortBaked, b: &Baked) {
         (TrisortDepthRange::MinusOneToOne, -1.0),
     ] {
         let mut p = [0f32; 16];
-        let s = unsafe { trisort_frame_projection(h, 0, 2.0, depth, p.as_mut_ptr()) };
+        let s = unsafe { trisort_frame_projection(h, 0, 2.0, depth as u32, p.as_mut_ptr()) };
         assert_eq!(s, TrisortStatus::Ok);
         let p = DMat4::from_cols_array(&p.map(f64::from));
         let ndc = |z: f64| {
@@ -226,9 +226,25 @@ fn check_matrices(h: *mut TrisortBaked, b: &Baked) {
     }
     let mut p = [0f32; 16];
     let bad_aspect = unsafe {
-        trisort_frame_projection(h, 0, 0.0, TrisortDepthRange::ZeroToOne, p.as_mut_ptr())
+        trisort_frame_projection(
+            h,
+            0,
+            0.0,
+            TrisortDepthRange::ZeroToOne as u32,
+            p.as_mut_ptr(),
+        )
     };
     assert_eq!(bad_aspect, TrisortStatus::OutOfRange);
+    // A depth range outside the enum (a C caller's 2) is refused, not undefined behaviour.
+    for bad in [2, u32::MAX] {
+        let s = unsafe { trisort_frame_projection(h, 0, 2.0, bad, p.as_mut_ptr()) };
+        assert_eq!(s, TrisortStatus::OutOfRange);
+        assert!(
+            last_error().contains(&format!("depth range {bad}")),
+            "{}",
+            last_error()
+        );
+    }
     let nodes: Vec<f32> =
         get(|o, c, l| unsafe { trisort_frame_node_matrices(h, 0, true, o, c, l) });
     assert_eq!(nodes.len(), 16);
@@ -360,24 +376,4 @@ fn a_structurally_broken_file_is_refused_with_its_problem() {
     assert_eq!(s, TrisortStatus::Format);
     assert!(h.is_null());
     assert!(last_error().contains("draw 0"), "{}", last_error());
-}
-
-#[test]
-fn export_order_refuses_a_structurally_broken_baked_file_before_reading_the_scene() {
-    let mut b = sample();
-    b.draws[0].index_count = 999;
-    let dir = tempfile::tempdir().unwrap();
-    let baked = dir.path().join("broken.baked");
-    let out = dir.path().join("broken.order");
-    std::fs::write(&baked, encode(FileKind::Baked, &b)).unwrap();
-    let c = |p: &std::path::Path| std::ffi::CString::new(p.to_str().unwrap()).unwrap();
-    let (baked_c, scene_c, out_c) = (c(&baked), c(&dir.path().join("none.glb")), c(&out));
-    let s = unsafe { trisort_export_order(baked_c.as_ptr(), scene_c.as_ptr(), out_c.as_ptr()) };
-    assert_eq!(s, TrisortStatus::Format);
-    let msg = last_error();
-    assert!(
-        msg.contains("broken.baked") && msg.contains("draw 0"),
-        "{msg}"
-    );
-    assert!(!out.exists(), "no output on failure");
 }

@@ -25,12 +25,26 @@ fn generate() -> String {
     String::from_utf8(out).expect("UTF-8 header")
 }
 
-#[test]
-fn header_is_current() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("include/trisort.h");
-    let fresh = generate();
+/// `include/trisort_export.h`: libtrisort_export's one addition (trisort-capi-export).
+fn generate_export() -> String {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("export");
+    let config = cbindgen::Config::from_file(dir.join("cbindgen.toml")).expect("cbindgen.toml");
+    let mut out = Vec::new();
+    cbindgen::Builder::new()
+        .with_config(config)
+        .with_src(dir.join("src/lib.rs"))
+        .generate()
+        .expect("cbindgen generates the export header")
+        .write(&mut out);
+    String::from_utf8(out).expect("UTF-8 header")
+}
+
+fn check_current(name: &str, fresh: &str) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("include")
+        .join(name);
     if std::env::var_os("TRISORT_BLESS").is_some() {
-        std::fs::write(&path, &fresh).unwrap();
+        std::fs::write(&path, fresh).unwrap();
     }
     let checked_in = std::fs::read_to_string(&path).unwrap_or_default();
     assert!(
@@ -42,11 +56,74 @@ fn header_is_current() {
 }
 
 #[test]
+fn header_is_current() {
+    check_current("trisort.h", &generate());
+    check_current("trisort_export.h", &generate_export());
+}
+
+/// The header reads as C: no Rust intra-doc links or paths, no undefined "module
+/// conventions", and the conventions it refers to are written at its top.
+#[test]
+fn header_documents_itself_in_c_terms() {
+    for (name, h) in [
+        ("trisort.h", generate()),
+        ("trisort_export.h", generate_export()),
+    ] {
+        for rust in ["[`", "Option<", "module conventions", "Self", "crate::"] {
+            assert!(!h.contains(rust), "{name} contains Rust wording `{rust}`");
+        }
+        // A Rust path to one of the API's own types (`TrisortStatus::Ok`); C++ and Vulkan
+        // names (`trisort::trisort`, `VkPhysicalDeviceLimits::…`) are fine.
+        for (i, _) in h.match_indices("::") {
+            let word = h[..i]
+                .rsplit(|c: char| !c.is_alphanumeric())
+                .next()
+                .unwrap();
+            assert!(
+                !(word.starts_with("Trisort") || word.starts_with("Order")),
+                "{name} names a Rust path: {word}::"
+            );
+        }
+    }
+    let h = generate();
+    for convention in [
+        "The copy convention (out, cap, len)",
+        "column major",
+        "Threads.",
+        "Lifetimes.",
+        "uint32_t",
+        "right handed, +Y up, metres",
+    ] {
+        assert!(h.contains(convention), "trisort.h lacks `{convention}`");
+    }
+    // Every enum argument is a uint32_t: no function takes a C enum by value.
+    for line in h
+        .lines()
+        .filter(|l| l.contains('(') || l.starts_with("    "))
+    {
+        for e in ["TrisortDepthRange ", "TrisortMode ", "TrisortAlphaMode "] {
+            assert!(
+                !line.trim_start().starts_with(e),
+                "an enum taken by value: {line}"
+            );
+        }
+    }
+    assert!(generate_export().contains(" trisort_export_order("));
+    assert!(
+        !h.contains(" trisort_export_order("),
+        "export_order is libtrisort_export's"
+    );
+}
+
+#[test]
 fn header_declares_the_abi_version_and_every_entry_point() {
     let h = generate();
-    assert!(h.contains("#define TRISORT_ABI_VERSION 4"), "{h}");
+    assert!(h.contains("#define TRISORT_ABI_VERSION 5"), "{h}");
+    assert!(h.contains("#define TRISORT_FORMAT_VERSION 5"), "{h}");
     for f in [
         "trisort_abi_version",
+        "trisort_format_version",
+        "trisort_version_string",
         "trisort_last_error",
         "trisort_open_path",
         "trisort_open_bytes",
@@ -64,7 +141,6 @@ fn header_declares_the_abi_version_and_every_entry_point() {
         "trisort_texture",
         "trisort_texture_info",
         "trisort_texture_level",
-        "trisort_export_order",
         "trisort_order_open_path",
         "trisort_order_triangles",
         "trisort_fps",

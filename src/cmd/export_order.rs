@@ -45,7 +45,7 @@ pub fn run(a: ExportOrderArgs) -> Result<ExitCode> {
             a.scene.display()
         );
     }
-    let order = trisort_capi::order::export(&a.baked, &a.scene, &a.output)?;
+    let order = trisort_export::export(&a.baked, &a.scene, &a.output)?;
     let repeated = order.triangles.windows(2).filter(|w| w[0] == w[1]).count();
     if a.json {
         print_json(&json!({

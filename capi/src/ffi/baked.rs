@@ -116,11 +116,11 @@ pub(super) fn ordered_copies(b: &Baked, back_to_front: bool) -> Vec<u32> {
 }
 
 /// Copies the sorted index buffer as u32 indices into the vertex streams: front to back, or
-/// reversed (`back_to_front`, what [`TrisortMode::Blend`] draws; use the same flag for the
+/// reversed (`back_to_front`, what `TRISORT_MODE_BLEND` draws; use the same flag for the
 /// frame ranges). `len` counts indices.
 ///
 /// # Safety
-/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/// `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_indices_u32(
     h: *const TrisortBaked,
@@ -139,11 +139,11 @@ pub unsafe extern "C" fn trisort_indices_u32(
     })
 }
 
-/// [`trisort_indices_u32`] as u16 indices; [`TrisortStatus::Unsupported`] when the file has
+/// `trisort_indices_u32()` as u16 indices; `TRISORT_STATUS_UNSUPPORTED` when the file has
 /// more than 65,536 vertices (see the info's `fits_u16`).
 ///
 /// # Safety
-/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/// `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_indices_u16(
     h: *const TrisortBaked,
@@ -193,10 +193,10 @@ pub(super) fn frame_ranges(b: &Baked, frame: usize, back_to_front: bool) -> Vec<
 }
 
 /// Copies frame `frame`'s draw ranges, in drawing order, over the index buffer of the same
-/// `back_to_front` ([`trisort_indices_u32`]). `len` counts ranges.
+/// `back_to_front` (`trisort_indices_u32()`). `len` counts ranges.
 ///
 /// # Safety
-/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/// `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_frame_ranges(
     h: *const TrisortBaked,
@@ -214,10 +214,10 @@ pub unsafe extern "C" fn trisort_frame_ranges(
 }
 
 /// Copies frame `frame`'s draws as indirect-draw arguments (the same draws as
-/// [`trisort_frame_ranges`], ready for `glMultiDrawElementsIndirect`/`vkCmdDrawIndexedIndirect`).
+/// `trisort_frame_ranges()`, ready for `glMultiDrawElementsIndirect`/`vkCmdDrawIndexedIndirect`).
 ///
 /// # Safety
-/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/// `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_frame_draws(
     h: *const TrisortBaked,
@@ -247,7 +247,7 @@ pub unsafe extern "C" fn trisort_frame_draws(
 /// Copies the vertex streams of G, interleaved (64 bytes per vertex).
 ///
 /// # Safety
-/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/// `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_vertices(
     h: *const TrisortBaked,
@@ -304,8 +304,11 @@ pub unsafe extern "C" fn trisort_frame_view(
 }
 
 /// Writes frame `frame`'s projection matrix for an image of `aspect` (width / height) in the
-/// clip-depth convention `depth` to `out[0..16]`. Built in f64 and rounded once, as trisort's
-/// own pipelines do.
+/// clip-depth convention `depth` (a `TrisortDepthRange` value: `TRISORT_DEPTH_RANGE_ZERO_TO_ONE`
+/// or `TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE`; another is `TRISORT_STATUS_OUT_OF_RANGE`) to
+/// `out[0..16]`, column major. A right-handed perspective (the view looks down −Z): near maps
+/// to the low end of the depth range, far (or infinity, for a glTF camera without `zfar`) to
+/// the high end. Built in f64 and rounded once, as trisort's own pipelines do.
 ///
 /// # Safety
 /// `h` is an open handle; `out` is valid for 16 float writes.
@@ -314,12 +317,25 @@ pub unsafe extern "C" fn trisort_frame_projection(
     h: *const TrisortBaked,
     frame: u32,
     aspect: f64,
-    depth: TrisortDepthRange,
+    depth: u32,
     out: *mut f32,
 ) -> TrisortStatus {
     guard(|| {
         let b = &handle(h, "handle")?.baked;
         let f = frame_index(b.frames.len(), frame)?;
+        let depth = match depth {
+            0 => TrisortDepthRange::ZeroToOne,
+            1 => TrisortDepthRange::MinusOneToOne,
+            _ => {
+                return Err(Failure(
+                    TrisortStatus::OutOfRange,
+                    format!(
+                        "depth range {depth} is not a TrisortDepthRange (0: zero to one, 1: \
+                         minus one to one)"
+                    ),
+                ))
+            }
+        };
         if !(aspect.is_finite() && aspect > 0.0) {
             return Err(Failure(
                 TrisortStatus::OutOfRange,
@@ -345,7 +361,7 @@ pub unsafe extern "C" fn trisort_frame_projection(
 /// once: precise far from the origin), else the world matrices. `cap` and `len` count floats.
 ///
 /// # Safety
-/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/// `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_frame_node_matrices(
     h: *const TrisortBaked,

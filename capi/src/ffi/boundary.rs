@@ -1,16 +1,17 @@
 //! What every entry point does at the C boundary: failures turned into a status and the
 //! thread's last error, panics caught, null and UTF-8 checks on host pointers, and the copy
-//! conventions of the module documentation.
+//! copy convention (top of the header).
 
 use std::cell::RefCell;
 use std::ffi::{c_char, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
-use super::types::{TrisortStatus, TRISORT_ABI_VERSION};
+use super::types::{TrisortStatus, TRISORT_ABI_VERSION, TRISORT_FORMAT_VERSION};
 
-/// What went wrong, for the status code and the thread's last error.
-pub(super) struct Failure(pub(super) TrisortStatus, pub(super) String);
+/// What went wrong, for the status code and the thread's last error: what an entry point's
+/// body returns to [`guard`].
+pub struct Failure(pub TrisortStatus, pub String);
 
 impl From<trisort_format::FormatError> for Failure {
     fn from(e: trisort_format::FormatError) -> Self {
@@ -33,19 +34,6 @@ impl From<crate::OrderError> for Failure {
     }
 }
 
-impl From<crate::ExportError> for Failure {
-    fn from(e: crate::ExportError) -> Self {
-        use crate::ExportError as E;
-        let status = match e {
-            E::Order(e) => return e.into(),
-            E::Format(e) => return e.into(),
-            E::MalformedBaked { .. } | E::Scene(_) => TrisortStatus::Format,
-            E::WrongScene { .. } => TrisortStatus::Unsupported,
-        };
-        Failure(status, e.to_string())
-    }
-}
-
 thread_local! {
     static LAST_ERROR: RefCell<String> = const { RefCell::new(String::new()) };
 }
@@ -55,7 +43,7 @@ pub(super) fn set_error(message: String) {
 }
 
 /// Runs `f` with panics caught, recording its failure as the thread's last error.
-pub(super) fn guard(f: impl FnOnce() -> Result<(), Failure>) -> TrisortStatus {
+pub fn guard(f: impl FnOnce() -> Result<(), Failure>) -> TrisortStatus {
     match catch_unwind(AssertUnwindSafe(f)) {
         Ok(Ok(())) => {
             set_error(String::new());
@@ -77,7 +65,8 @@ pub(super) fn guard(f: impl FnOnce() -> Result<(), Failure>) -> TrisortStatus {
     }
 }
 
-pub(super) fn null(what: &str) -> Failure {
+/// A null-argument failure naming the argument.
+pub fn null(what: &str) -> Failure {
     Failure(TrisortStatus::NullArgument, format!("{what} is null"))
 }
 
@@ -93,7 +82,7 @@ pub(super) unsafe fn handle<'a, T>(ptr: *const T, what: &str) -> Result<&'a T, F
 ///
 /// # Safety
 /// `s` is null or a NUL-terminated string.
-pub(super) unsafe fn c_path(s: *const c_char, what: &str) -> Result<PathBuf, Failure> {
+pub unsafe fn c_path(s: *const c_char, what: &str) -> Result<PathBuf, Failure> {
     if s.is_null() {
         return Err(null(what));
     }
@@ -106,7 +95,7 @@ pub(super) unsafe fn c_path(s: *const c_char, what: &str) -> Result<PathBuf, Fai
     Ok(PathBuf::from(s))
 }
 
-/// The length half of the copy conventions of the module documentation: writes `n` to `*len`
+/// The length half of the copy copy convention (top of the header): writes `n` to `*len`
 /// when `len` is given, and says whether to copy (`out` is given). Both null is a failure.
 ///
 /// # Safety
@@ -125,7 +114,7 @@ pub(super) unsafe fn report_len<T>(
     Ok(!out.is_null())
 }
 
-/// Copies `src` to the host's buffer under the conventions of the module documentation.
+/// Copies `src` to the host's buffer under the copy convention (top of the header).
 ///
 /// # Safety
 /// `out` is null or valid for `cap` writes of `T`; `len` is null or valid for one write.
@@ -160,7 +149,7 @@ pub(super) unsafe fn store<T>(out: *mut T, value: T, what: &str) -> Result<(), F
     Ok(())
 }
 
-/// Copies `s` as a NUL-terminated string under the conventions of the module documentation
+/// Copies `s` as a NUL-terminated string under the copy convention (top of the header)
 /// (`*len`: bytes without the NUL; `cap` must hold them and the NUL).
 ///
 /// # Safety
@@ -232,10 +221,25 @@ pub(super) unsafe fn close_handle<T>(h: *mut T) {
     }
 }
 
-/// The library's ABI version ([`TRISORT_ABI_VERSION`] of the library actually linked).
+/// The library's ABI version (`TRISORT_ABI_VERSION` of the library actually linked): a host
+/// built with this header needs at least its `TRISORT_ABI_VERSION`.
 #[no_mangle]
 pub extern "C" fn trisort_abi_version() -> u32 {
     TRISORT_ABI_VERSION
+}
+
+/// The baked-file format version the linked library reads (`TRISORT_FORMAT_VERSION` of the
+/// library actually linked; docs/FORMAT.md § Container says where a file stores its own).
+#[no_mangle]
+pub extern "C" fn trisort_format_version() -> u32 {
+    TRISORT_FORMAT_VERSION
+}
+
+/// The linked library's version (trisort's release, e.g. "0.1.0"), as a static NUL-terminated
+/// string: valid for the life of the program, never freed by the host.
+#[no_mangle]
+pub extern "C" fn trisort_version_string() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
 }
 
 /// Copies the calling thread's last error message (UTF-8, empty after a success) into `buf`,

@@ -9,7 +9,7 @@ use super::materials::material_of;
 use super::types::*;
 
 /// Stores the figures of the light the file is shaded with in `*out` (its name:
-/// [`trisort_environment_name`]; its texels: [`trisort_environment_level`]).
+/// `trisort_environment_name()`; its texels: `trisort_environment_level()`).
 ///
 /// # Safety
 /// `h` is an open handle; `out` is valid for one write.
@@ -35,8 +35,8 @@ pub unsafe extern "C" fn trisort_environment_info(
 }
 
 /// Copies the environment's name (`studio` for the built-in light, else the HDR file's
-/// name) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes (see the module
-/// conventions on strings).
+/// name) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes (the string convention,
+/// top of this header).
 ///
 /// # Safety
 /// `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
@@ -57,11 +57,11 @@ pub unsafe extern "C" fn trisort_environment_name(
 /// Stores the size of prefiltered level `level` of the environment in `*width` and `*height`
 /// (either may be null) and copies its texels: RGBA as IEEE binary16 bits (`uint16_t` each,
 /// alpha 1; upload as `GL_RGBA16F` with `GL_HALF_FLOAT`), rows from the zenith down, layout as
-/// on [`TrisortEnvironmentInfo`]. `cap` and `len` count `uint16_t` values (4 per texel).
+/// on `TrisortEnvironmentInfo`. `cap` and `len` count `uint16_t` values (4 per texel).
 ///
 /// # Safety
 /// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
-/// `len` as in the module conventions.
+/// `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_environment_level(
     h: *const TrisortBaked,
@@ -112,8 +112,8 @@ pub unsafe extern "C" fn trisort_variant_count(
 }
 
 /// Copies the name of material variant `variant` (file order, below
-/// [`trisort_variant_count`]) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes
-/// (see the module conventions on strings). Names come from the glTF file: they may be empty
+/// `trisort_variant_count()`) as a NUL-terminated UTF-8 string; `cap` and `len` count bytes
+/// (the string convention, top of this header). Names come from the glTF file: they may be empty
 /// and need not be unique.
 ///
 /// # Safety
@@ -145,20 +145,20 @@ pub unsafe extern "C" fn trisort_variant_name(
 }
 
 /// Copies the material table under the material variant named `name` (NUL-terminated UTF-8;
-/// null: the default materials, as [`trisort_materials`]): entry k is what material slot k
+/// null: the default materials, as `trisort_materials()`): entry k is what material slot k
 /// (a vertex's `material`) shows under the variant, so a host switches variants by
 /// re-uploading this table alone. Where names repeat, the first variant of the name is used
 /// (as the player's `--variant`).
 ///
-/// Refusals, with a message naming the file and the variant: [`TrisortStatus::Absent`] when
+/// Refusals, with a message naming the file and the variant: `TRISORT_STATUS_ABSENT` when
 /// no variant has this name (the message lists the file's variants);
-/// [`TrisortStatus::Unsupported`] when the variant changes something that decides visibility
+/// `TRISORT_STATUS_UNSUPPORTED` when the variant changes something that decides visibility
 /// (alpha mode, double-sidedness, transmission, a cut-out or blended material's alpha or
 /// cutoff...), so the baked order would not be exact for it.
 ///
 /// # Safety
 /// `h` is an open handle; `name` is null or a NUL-terminated string; `out`, `cap`, `len` as
-/// in the module conventions.
+/// in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_variant_materials(
     h: *const TrisortBaked,

@@ -58,7 +58,7 @@ pub(super) fn material_of(m: &Material) -> TrisortMaterial {
 /// Copies the materials.
 ///
 /// # Safety
-/// `h` is an open handle; `out`, `cap`, `len` as in the module conventions.
+/// `h` is an open handle; `out`, `cap`, `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_materials(
     h: *const TrisortBaked,
@@ -87,11 +87,11 @@ pub(super) fn texture_of(b: &Baked, texture: u32) -> Result<&Texture, Failure> {
 
 /// Stores texture `texture`'s size in `*width` and `*height` (either may be null) and copies
 /// its level-0 texels (RGBA8, rows top to bottom, sRGB or linear as
-/// [`trisort_texture_info`] says; `cap` and `len` count bytes).
+/// `trisort_texture_info()` says; `cap` and `len` count bytes).
 ///
 /// # Safety
 /// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
-/// `len` as in the module conventions.
+/// `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_texture(
     h: *const TrisortBaked,
@@ -136,7 +136,7 @@ pub unsafe extern "C" fn trisort_texture_info(
 ///
 /// # Safety
 /// `h` is an open handle; `width` and `height` are null or valid for one write; `out`, `cap`,
-/// `len` as in the module conventions.
+/// `len` as in the copy convention (top of this header).
 #[no_mangle]
 #[allow(
     clippy::too_many_arguments,

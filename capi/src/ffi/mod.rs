@@ -1,22 +1,12 @@
 //! The `extern "C"` functions of `include/trisort.h`.
 //!
-//! Conventions (also in the header):
-//! - Every function returns a [`TrisortStatus`] (except [`trisort_abi_version`],
-//!   [`trisort_last_error`] and the `close` functions). On failure, [`trisort_last_error`]
-//!   copies a message naming the file and the problem (per thread, until the next call).
-//! - No panic crosses the boundary: each entry point runs under `catch_unwind` and reports one
-//!   as [`TrisortStatus::Panic`].
-//! - Handles are opened and closed by the library (`trisort_open_*` / `trisort_close`). The
-//!   host never frees library memory: arrays are copied into host buffers. Each copy function
-//!   takes `out`, its capacity `cap` in elements and `len`: it stores the element count in
-//!   `*len` (when `len` is not null); with `out` null it only reports it, with `cap` too small
-//!   it returns [`TrisortStatus::BufferTooSmall`] and copies nothing.
-//! - Strings (names) are copied the same way as UTF-8 bytes plus a terminating NUL: `*len`
-//!   is the length in bytes without the NUL, and `cap` must be at least `*len + 1`.
-//! - Matrices are 16 floats, column major.
+//! The conventions every function follows (status and last error, out parameters, the
+//! out/cap/len copy convention, strings, enums as `uint32_t`, column-major matrices, units and
+//! coordinates, handles, lifetimes, threads, panics, versions) are written once, in C terms, at
+//! the top of `include/trisort.h`: `capi/cbindgen.toml`'s `header`.
 
 mod baked;
-mod boundary;
+pub mod boundary;
 mod environment;
 mod materials;
 mod order;
@@ -24,7 +14,9 @@ mod playback;
 mod types;
 
 pub use baked::*;
-pub use boundary::{trisort_abi_version, trisort_last_error};
+pub use boundary::{
+    trisort_abi_version, trisort_format_version, trisort_last_error, trisort_version_string,
+};
 pub use environment::*;
 pub use materials::*;
 pub use order::*;

@@ -1,4 +1,4 @@
-//! Exporting, opening and reading ORDER files.
+//! Opening and reading ORDER files (writing them: trisort-capi-export).
 
 use std::ffi::c_char;
 use std::path::Path;
@@ -7,27 +7,6 @@ use crate::order::{Order, OrderRange, OrderSource};
 
 use super::boundary::*;
 use super::types::*;
-
-/// Builds the order-only export of the baked file at `baked_path`, whose scene is the glTF
-/// file `scene_path`, and writes it to `out_path` (atomically). The same as
-/// `trisort export-order BAKED --scene SCENE -o OUT`.
-///
-/// # Safety
-/// The three paths are NUL-terminated strings.
-#[no_mangle]
-pub unsafe extern "C" fn trisort_export_order(
-    baked_path: *const c_char,
-    scene_path: *const c_char,
-    out_path: *const c_char,
-) -> TrisortStatus {
-    guard(|| {
-        let baked_path = c_path(baked_path, "baked_path")?;
-        let scene_path = c_path(scene_path, "scene_path")?;
-        let out_path = c_path(out_path, "out_path")?;
-        crate::order::export(&baked_path, &scene_path, &out_path)?;
-        Ok(())
-    })
-}
 
 pub(super) fn open_order(bytes: &[u8], path: &Path) -> Result<*mut TrisortOrder, Failure> {
     let order = Order::decode(bytes, path)?;
@@ -98,7 +77,7 @@ pub unsafe extern "C" fn trisort_order_info(
 /// Copies frame `frame`'s ranges (first triangle, triangle count), front to back.
 ///
 /// # Safety
-/// `h` is an open order handle; `out`, `cap`, `len` as in the module conventions.
+/// `h` is an open order handle; `out`, `cap`, `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_order_frame_ranges(
     h: *const TrisortOrder,
@@ -117,7 +96,7 @@ pub unsafe extern "C" fn trisort_order_frame_ranges(
 /// Copies every index-buffer triangle's source, front to back.
 ///
 /// # Safety
-/// `h` is an open order handle; `out`, `cap`, `len` as in the module conventions.
+/// `h` is an open order handle; `out`, `cap`, `len` as in the copy convention (top of this header).
 #[no_mangle]
 pub unsafe extern "C" fn trisort_order_triangles(
     h: *const TrisortOrder,

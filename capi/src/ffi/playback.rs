@@ -6,7 +6,7 @@ use super::types::*;
 
 /// Stores the frame rate the file's path was recorded at (what a player plays at by default)
 /// in `*out`. When the file stores none (its recordings did not know it), writes 0 to `*out`
-/// and returns [`TrisortStatus::Absent`]; a stored rate is always finite and positive.
+/// and returns `TRISORT_STATUS_ABSENT`; a stored rate is always finite and positive.
 ///
 /// # Safety
 /// `h` is an open handle; `out` is valid for one write.
@@ -57,8 +57,8 @@ pub unsafe extern "C" fn trisort_raster_profile(
 
 /// Checks what the host's API reports about its device against the file's raster profile:
 /// the sample count, the sub-pixel precision and whether the sample locations are the
-/// standard ones (each where known). Returns [`TrisortStatus::Ok`] when nothing reported
-/// differs, else [`TrisortStatus::ProfileMismatch`] with every difference in the last error
+/// standard ones (each where known). Returns `TRISORT_STATUS_OK` when nothing reported
+/// differs, else `TRISORT_STATUS_PROFILE_MISMATCH` with every difference in the last error
 /// (`trisort_last_error`): a host that must refuse such a device (as `trisort play
 /// --strict-profile` does) stops there; one that plays anyway should log it. The raster probe
 /// of `trisort play` also measures the sample positions and snapping; this call takes the

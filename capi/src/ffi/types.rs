@@ -7,26 +7,37 @@ use trisort_format::Baked;
 
 use crate::order::Order;
 
-/// The ABI version of this library: bumped whenever a function, a struct or an enum of the
-/// header changes incompatibly. Hosts compare [`trisort_abi_version`] with the header's
-/// `TRISORT_ABI_VERSION`.
+/// The ABI version of this header. A host compares it with `trisort_abi_version()`, the
+/// version of the library it actually loaded: a library of a higher version keeps every
+/// function, struct and enum of the lower ones unchanged (each version only added), so a host
+/// needs `trisort_abi_version() >= TRISORT_ABI_VERSION`. A change that is not an addition
+/// renames the shared library (its SONAME, `libtrisort.so.0`).
 ///
-/// 3 added [`TrisortStatus::Absent`], the environment ([`trisort_environment_info`],
-/// [`trisort_environment_name`], [`trisort_environment_level`]), material variants
-/// ([`trisort_variant_count`], [`trisort_variant_name`], [`trisort_variant_materials`]) and
-/// the frame rate ([`trisort_fps`]); the functions of 2 are unchanged. 4 added the raster
-/// profile ([`trisort_raster_profile`], [`trisort_check_device`],
-/// [`TrisortStatus::ProfileMismatch`]); the functions of 3 are unchanged.
-pub const TRISORT_ABI_VERSION: u32 = 4;
+/// 3 added `TRISORT_STATUS_ABSENT`, the environment (`trisort_environment_info()`,
+/// `trisort_environment_name()`, `trisort_environment_level()`), material variants
+/// (`trisort_variant_count()`, `trisort_variant_name()`, `trisort_variant_materials()`) and
+/// the frame rate (`trisort_fps()`). 4 added the raster profile (`trisort_raster_profile()`,
+/// `trisort_check_device()`, `TRISORT_STATUS_PROFILE_MISMATCH`). 5 added
+/// `trisort_format_version()` and `trisort_version_string()`, and takes the projection's depth
+/// range as a `uint32_t` (the same values and calling convention as the enum it was; an
+/// out-of-range value is now `TRISORT_STATUS_OUT_OF_RANGE` instead of undefined behaviour);
+/// `trisort_export_order()` moved to `libtrisort_export` (`trisort_export.h`).
+pub const TRISORT_ABI_VERSION: u32 = 5;
 
-/// [`TrisortRasterProfile::name`]: the recorded pattern only (`--raster-profile exact`).
+/// The baked-file format version this header's library reads (`trisort_format_version()`
+/// says what the loaded library reads): a file of another version is refused with
+/// `TRISORT_STATUS_FORMAT` and a message saying to bake it again.
+pub const TRISORT_FORMAT_VERSION: u32 = 5;
+const _: () = assert!(TRISORT_FORMAT_VERSION == trisort_format::FORMAT_VERSION);
+
+/// `TrisortRasterProfile.name`: the recorded pattern only (`--raster-profile exact`).
 pub const TRISORT_PROFILE_EXACT: u32 = 0;
-/// [`TrisortRasterProfile::name`]: a conformant GPU (the default): standard sample
+/// `TrisortRasterProfile.name`: a conformant GPU (the default): standard sample
 /// locations, 8 sub-pixel bits, depth at the sample.
 pub const TRISORT_PROFILE_CONFORMANT: u32 = 1;
-/// [`TrisortRasterProfile::name`]: as conformant, snapping to 4 to 8 sub-pixel bits.
+/// `TrisortRasterProfile.name`: as conformant, snapping to 4 to 8 sub-pixel bits.
 pub const TRISORT_PROFILE_SNAP4: u32 = 2;
-/// [`TrisortRasterProfile::name`]: SwiftShader's rules (the web build).
+/// `TrisortRasterProfile.name`: SwiftShader's rules (the web build).
 pub const TRISORT_PROFILE_BROWSER: u32 = 3;
 
 /// The result of a call.
@@ -50,10 +61,10 @@ pub enum TrisortStatus {
     Unsupported = 6,
     /// An internal error (a panic, caught): please report it.
     Panic = 7,
-    /// The file holds no such thing: no frame rate ([`trisort_fps`]), no material variant of
-    /// that name ([`trisort_variant_materials`]). The message says what is missing.
+    /// The file holds no such thing: no frame rate (`trisort_fps()`), no material variant of
+    /// that name (`trisort_variant_materials()`). The message says what is missing.
     Absent = 8,
-    /// The device is outside the bake's raster profile ([`trisort_check_device`]); the
+    /// The device is outside the bake's raster profile (`trisort_check_device()`); the
     /// message names each difference.
     ProfileMismatch = 9,
 }
@@ -83,7 +94,7 @@ pub struct TrisortRasterProfile {
 }
 
 /// What the host's graphics API reports about the device it plays on, for
-/// [`trisort_check_device`].
+/// `trisort_check_device()`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TrisortDeviceRaster {
@@ -97,14 +108,14 @@ pub struct TrisortDeviceRaster {
     pub samples: u32,
 }
 
-/// A baked file opened by [`trisort_open_path`] or [`trisort_open_bytes`].
+/// A baked file opened by `trisort_open_path()` or `trisort_open_bytes()`.
 pub struct TrisortBaked {
     pub(super) baked: Baked,
-    /// Where it was opened from (`<bytes>` for [`trisort_open_bytes`]), for messages.
+    /// Where it was opened from (`<bytes>` for `trisort_open_bytes()`), for messages.
     pub(super) path: PathBuf,
 }
 
-/// An ORDER file opened by [`trisort_order_open_path`] or [`trisort_order_open_bytes`].
+/// An ORDER file opened by `trisort_order_open_path()` or `trisort_order_open_bytes()`.
 pub struct TrisortOrder {
     pub(super) order: Order,
 }
@@ -139,12 +150,12 @@ pub struct TrisortInfo {
     pub glass_opacity: f32,
     /// Whether u16 indices suffice (at most 65,536 vertices).
     pub fits_u16: bool,
-    /// Whether the file plays only with the depth test ([`TrisortMode::Depth`]).
+    /// Whether the file plays only with the depth test (`TRISORT_MODE_DEPTH`).
     pub depth_only: bool,
     /// Whether intersecting triangles were split before recording.
     pub split_intersections: bool,
-    /// The mode the file plays best in: [`TrisortMode::Depth`] when `depth_only`, else
-    /// [`TrisortMode::Blend`].
+    /// The mode the file plays best in: `TRISORT_MODE_DEPTH` when `depth_only`, else
+    /// `TRISORT_MODE_BLEND`.
     pub recommended_mode: TrisortMode,
 }
 
@@ -234,7 +245,7 @@ pub struct TrisortMaterial {
     pub base_color: [f32; 4],
     /// Linear RGB emissive colour (factor × `KHR_materials_emissive_strength`).
     pub emissive: [f32; 3],
-    /// Alpha cutoff (for [`TrisortAlphaMode::Mask`]).
+    /// Alpha cutoff (for `TRISORT_ALPHA_MODE_MASK`).
     pub alpha_cutoff: f32,
     /// `KHR_materials_transmission` factor; > 0 marks glass, drawn at the info's
     /// `glass_opacity`.
@@ -290,7 +301,7 @@ pub struct TrisortTextureInfo {
 /// The light a baked file is shaded with (trisort's image-based light and optional sun), in
 /// world space (+Y up, glTF's convention).
 ///
-/// The radiance is an equirectangular image ([`trisort_environment_level`]): texel (x, y) of
+/// The radiance is an equirectangular image (`trisort_environment_level()`): texel (x, y) of
 /// level 0 looks along `(sin θ cos φ, cos θ, sin θ sin φ)` with `φ = 2π (x + 0.5) / width`
 /// and `θ = π (y + 0.5) / height` (row 0 at the zenith). Level k has `max(1, width >> k)` ×
 /// `max(1, height >> k)` texels and holds the radiance prefiltered for GGX perceptual
@@ -335,7 +346,8 @@ pub enum TrisortAlphaMode {
     Blend = 2,
 }
 
-/// Clip-space depth convention of a projection matrix.
+/// Clip-space depth convention of a projection matrix: the values of
+/// `trisort_frame_projection()`'s `depth` argument (a `uint32_t`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TrisortDepthRange {
