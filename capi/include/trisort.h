@@ -115,6 +115,62 @@
 #define TRISORT_PROFILE_BROWSER 3
 
 /**
+ * Texels per row of the player's data textures (material and node texels): `DATA_WIDTH` in
+ * the exported GLSL. Added in ABI 5.
+ */
+#define TRISORT_GPU_DATA_WIDTH 1024
+
+/**
+ * RGBA32F texels a material takes in the material texels (the fields of the shaders'
+ * `MaterialGpu`, in order). Added in ABI 5.
+ */
+#define TRISORT_GPU_MATERIAL_TEXELS 20
+
+/**
+ * Bytes of the `Frame` uniform block (std140). Added in ABI 5.
+ */
+#define TRISORT_GPU_FRAME_UNIFORM_SIZE 144
+
+/**
+ * Bytes of the `Lighting` uniform block (std140). Added in ABI 5.
+ */
+#define TRISORT_GPU_LIGHTING_UNIFORM_SIZE 192
+
+/**
+ * The `shading` argument of `trisort_gpu_lighting_uniform()`: one light plus ambient.
+ */
+#define TRISORT_SHADING_BASIC 0
+
+/**
+ * The `shading` argument of `trisort_gpu_lighting_uniform()`: glTF metallic-roughness lit by
+ * the file's environment (what `trisort play` draws by default).
+ */
+#define TRISORT_SHADING_PBR 1
+
+/**
+ * The `tone_map` argument of `trisort_gpu_lighting_uniform()`: Khronos PBR Neutral (the
+ * player's default).
+ */
+#define TRISORT_TONE_MAP_NEUTRAL 0
+
+/**
+ * The `tone_map` argument of `trisort_gpu_lighting_uniform()`: ACES (Narkowicz's fit).
+ */
+#define TRISORT_TONE_MAP_ACES 1
+
+/**
+ * The `array` argument of the texture array functions: base-colour and emissive textures,
+ * uploaded as sRGB (`GL_SRGB8_ALPHA8`).
+ */
+#define TRISORT_TEXTURE_ARRAY_SRGB 0
+
+/**
+ * The `array` argument of the texture array functions: metallic-roughness, normal and
+ * occlusion textures, uploaded as linear (`GL_RGBA8`).
+ */
+#define TRISORT_TEXTURE_ARRAY_LINEAR 1
+
+/**
  * The ORDER file version this build writes and reads.
  */
 #define TRISORT_ORDER_VERSION 1
@@ -203,6 +259,21 @@ typedef enum TrisortAlphaMode {
    */
   TRISORT_ALPHA_MODE_BLEND = 2,
 } TrisortAlphaMode;
+
+/**
+ * Clip-space depth convention of a projection matrix: the values of
+ * `trisort_frame_projection()`'s `depth` argument (a `uint32_t`).
+ */
+typedef enum TrisortDepthRange {
+  /**
+   * Depth in [0, 1] (Vulkan, Direct3D, Metal, WebGPU: what trisort renders with).
+   */
+  TRISORT_DEPTH_RANGE_ZERO_TO_ONE = 0,
+  /**
+   * Depth in [-1, 1] (OpenGL and OpenGL ES defaults).
+   */
+  TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE = 1,
+} TrisortDepthRange;
 
 /**
  * A baked file opened by `trisort_open_path()` or `trisort_open_bytes()`.
@@ -598,6 +669,30 @@ typedef struct TrisortEnvironmentInfo {
    */
   float exposure;
 } TrisortEnvironmentInfo;
+
+/**
+ * The size of a texture the player uploads: a material texture array
+ * (`trisort_gpu_texture_array()`) or the environment (`trisort_gpu_environment()`, one
+ * layer). Added in ABI 5.
+ */
+typedef struct TrisortGpuTexture {
+  /**
+   * Level 0 width in texels.
+   */
+  uint32_t width;
+  /**
+   * Level 0 height in texels.
+   */
+  uint32_t height;
+  /**
+   * Layers (1 for the environment).
+   */
+  uint32_t layers;
+  /**
+   * Mip levels, level 0 included (level k is max(1, width >> k) × max(1, height >> k)).
+   */
+  uint32_t levels;
+} TrisortGpuTexture;
 
 /**
  * Figures of an ORDER file.
@@ -1012,6 +1107,144 @@ enum TrisortStatus trisort_variant_materials(const struct TrisortBaked *h,
                                              struct TrisortMaterial *out,
                                              size_t cap,
                                              size_t *len);
+
+/**
+ * Copies frame `frame`'s `Frame` uniform as the player uploads it for an image of `width` ×
+ * `height` pixels (0 and 0: the recorded size): `TRISORT_GPU_FRAME_UNIFORM_SIZE` bytes in the
+ * std140 layout of the exported shaders' `Frame` block (the projection with clip depth 0 to
+ * 1, the basic model's light, glass opacity, size and sample count, the view-to-world
+ * rotation). `cap` and `len` count bytes. Added in ABI 5.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or valid
+ * for one write.
+ */
+enum TrisortStatus trisort_gpu_frame_uniform(const struct TrisortBaked *h,
+                                             uint32_t frame,
+                                             uint32_t width,
+                                             uint32_t height,
+                                             uint8_t *out,
+                                             size_t cap,
+                                             size_t *len);
+
+/**
+ * Copies the `Lighting` uniform as the player uploads it for surface model `shading`
+ * (`TRISORT_SHADING_BASIC` or `TRISORT_SHADING_PBR`) and tone map `tone_map`
+ * (`TRISORT_TONE_MAP_NEUTRAL` or `TRISORT_TONE_MAP_ACES`), for an environment uploaded as
+ * `trisort_gpu_environment()` gives it at `max_texture_size` (the device's largest 2D
+ * texture; 0: no limit): `TRISORT_GPU_LIGHTING_UNIFORM_SIZE` bytes, std140. `cap` and `len`
+ * count bytes. Other values of `shading` or `tone_map` return `TRISORT_STATUS_OUT_OF_RANGE`.
+ * Added in ABI 5.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or valid
+ * for one write.
+ */
+enum TrisortStatus trisort_gpu_lighting_uniform(const struct TrisortBaked *h,
+                                                uint32_t shading,
+                                                uint32_t tone_map,
+                                                uint32_t max_texture_size,
+                                                uint8_t *out,
+                                                size_t cap,
+                                                size_t *len);
+
+/**
+ * Copies the material texels as the player uploads them (its data texture for GLES 3.0):
+ * `TRISORT_GPU_MATERIAL_TEXELS` RGBA32F texels per material in material order (one zero
+ * material when the file has none), with texture layers placed as the texture arrays at
+ * `max_texture_size` place them (0: no limit), padded with zeros to whole rows of
+ * `TRISORT_GPU_DATA_WIDTH` texels. Upload as a `TRISORT_GPU_DATA_WIDTH` × (`*len` / 4 /
+ * `TRISORT_GPU_DATA_WIDTH`) `GL_RGBA32F` texture. `cap` and `len` count floats. Added in ABI 5.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is null or valid for `cap` float writes; `len` is null or
+ * valid for one write.
+ */
+enum TrisortStatus trisort_gpu_material_texels(const struct TrisortBaked *h,
+                                               uint32_t max_texture_size,
+                                               float *out,
+                                               size_t cap,
+                                               size_t *len);
+
+/**
+ * Copies the node texels as the player uploads them (its data texture for GLES 3.0): every
+ * frame's camera-relative node matrices (view × world, built in f64 and rounded once, column
+ * major), frame after frame, max(1, node count) matrices of 4 RGBA32F texels a frame, padded
+ * with zeros to whole rows of `TRISORT_GPU_DATA_WIDTH` texels. Frame f's first node is
+ * f × max(1, node count): the `x` the exported vertex stage's node-base uniform takes. `cap`
+ * and `len` count floats. Added in ABI 5.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is null or valid for `cap` float writes; `len` is null or
+ * valid for one write.
+ */
+enum TrisortStatus trisort_gpu_node_texels(const struct TrisortBaked *h,
+                                           float *out,
+                                           size_t cap,
+                                           size_t *len);
+
+/**
+ * Stores the size of material texture array `array` (`TRISORT_TEXTURE_ARRAY_SRGB` or
+ * `TRISORT_TEXTURE_ARRAY_LINEAR`) as the player uploads it on a device whose largest 2D
+ * texture is `max_texture_size` (0: no limit) in `*out`: every layer as large as the array's
+ * largest texture, a full mip chain; an array without textures is one white texel. Added in
+ * ABI 5.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
+enum TrisortStatus trisort_gpu_texture_array(const struct TrisortBaked *h,
+                                             uint32_t array,
+                                             uint32_t max_texture_size,
+                                             struct TrisortGpuTexture *out);
+
+/**
+ * Copies level `level` of layer `layer` of texture array `array` as the player uploads it
+ * (see `trisort_gpu_texture_array()`): RGBA8 texels, rows top to bottom, the layer's texture
+ * at its own level of the same index repeated from the top-left corner over the whole level.
+ * `cap` and `len` count bytes. Added in ABI 5.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or valid
+ * for one write.
+ */
+enum TrisortStatus trisort_gpu_texture_array_level(const struct TrisortBaked *h,
+                                                   uint32_t array,
+                                                   uint32_t layer,
+                                                   uint32_t level,
+                                                   uint32_t max_texture_size,
+                                                   uint8_t *out,
+                                                   size_t cap,
+                                                   size_t *len);
+
+/**
+ * Stores the size of the prefiltered environment as the player uploads it on a device whose
+ * largest 2D texture is `max_texture_size` (0: no limit) in `*out` (`layers` 1): the file's
+ * levels that fit, as many as a full chain holds. Sample it with `GL_TEXTURE_MAX_LEVEL` =
+ * `levels` − 1. Added in ABI 5.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
+enum TrisortStatus trisort_gpu_environment(const struct TrisortBaked *h,
+                                           uint32_t max_texture_size,
+                                           struct TrisortGpuTexture *out);
+
+/**
+ * Copies level `level` of the prefiltered environment as the player uploads it (see
+ * `trisort_gpu_environment()`): RGBA IEEE binary16 bits (`GL_RGBA16F`, `GL_HALF_FLOAT`), rows
+ * from the zenith down. `cap` and `len` count `uint16_t` values (4 a texel). Added in ABI 5.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is null or valid for `cap` writes; `len` is null or valid for
+ * one write.
+ */
+enum TrisortStatus trisort_gpu_environment_level(const struct TrisortBaked *h,
+                                                 uint32_t level,
+                                                 uint32_t max_texture_size,
+                                                 uint16_t *out,
+                                                 size_t cap,
+                                                 size_t *len);
 
 /**
  * Opens the ORDER file at `path` and stores its handle in `*out`.

@@ -16,6 +16,7 @@ fn generate() -> String {
         .with_src(dir.join("src/ffi/materials.rs"))
         .with_src(dir.join("src/ffi/playback.rs"))
         .with_src(dir.join("src/ffi/environment.rs"))
+        .with_src(dir.join("src/ffi/gpu_data.rs"))
         .with_src(dir.join("src/ffi/order.rs"))
         // The ORDER file's types (`TrisortOrderRange`, `TrisortOrderSource`).
         .with_src(dir.join("../format/src/order.rs"))
@@ -120,6 +121,8 @@ fn header_declares_the_abi_version_and_every_entry_point() {
     let h = generate();
     assert!(h.contains("#define TRISORT_ABI_VERSION 5"), "{h}");
     assert!(h.contains("#define TRISORT_FORMAT_VERSION 5"), "{h}");
+    // Taken as uint32_t, so no function names the enum: its values must still be there.
+    assert!(h.contains("TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE = 1"), "{h}");
     for f in [
         "trisort_abi_version",
         "trisort_format_version",
@@ -152,6 +155,14 @@ fn header_declares_the_abi_version_and_every_entry_point() {
         "trisort_variant_materials",
         "trisort_raster_profile",
         "trisort_check_device",
+        "trisort_gpu_frame_uniform",
+        "trisort_gpu_lighting_uniform",
+        "trisort_gpu_material_texels",
+        "trisort_gpu_node_texels",
+        "trisort_gpu_texture_array",
+        "trisort_gpu_texture_array_level",
+        "trisort_gpu_environment",
+        "trisort_gpu_environment_level",
     ] {
         assert!(h.contains(&format!(" {f}(")), "{f} missing from the header");
     }
