@@ -17,6 +17,7 @@ pub mod camera;
 pub mod container;
 pub mod environment;
 pub mod geometry;
+pub mod gpu_layout;
 pub mod options;
 pub mod order;
 pub mod recording;

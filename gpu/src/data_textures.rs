@@ -60,17 +60,14 @@ fn data_texture(
     label: &str,
     bytes: &[u8],
 ) -> (wgpu::Texture, wgpu::TextureView) {
-    let row = DATA_WIDTH as usize * 16;
-    let rows = bytes.len().div_ceil(row).max(1);
-    let mut padded = bytes.to_vec();
-    padded.resize(rows * row, 0);
+    let (padded, rows) = trisort_format::gpu_layout::data_texture_bytes(bytes);
     let texture = device.create_texture_with_data(
         queue,
         &wgpu::TextureDescriptor {
             label: Some(label),
             size: wgpu::Extent3d {
                 width: DATA_WIDTH,
-                height: rows as u32,
+                height: rows,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -91,21 +88,18 @@ fn data_texture(
 /// Rewrites the first texels of a data texture made by `data_texture` with `bytes` (a whole
 /// number of 16-byte texels, no more than it holds), the last row padded with zeros.
 pub(crate) fn write_data_texture(queue: &wgpu::Queue, texture: &wgpu::Texture, bytes: &[u8]) {
-    let row = DATA_WIDTH as usize * 16;
-    let rows = bytes.len().div_ceil(row).max(1);
-    let mut padded = bytes.to_vec();
-    padded.resize(rows * row, 0);
+    let (padded, rows) = trisort_format::gpu_layout::data_texture_bytes(bytes);
     queue.write_texture(
         texture.as_image_copy(),
         &padded,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
-            bytes_per_row: Some(row as u32),
-            rows_per_image: Some(rows as u32),
+            bytes_per_row: Some(DATA_WIDTH * 16),
+            rows_per_image: Some(rows),
         },
         wgpu::Extent3d {
             width: DATA_WIDTH,
-            height: rows as u32,
+            height: rows,
             depth_or_array_layers: 1,
         },
     );

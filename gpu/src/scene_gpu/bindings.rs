@@ -92,7 +92,7 @@ impl Bindings {
 }
 
 /// Texels per row of the data textures of [`Bindings::Textures`] (`DATA_WIDTH` in the WGSL).
-pub const DATA_WIDTH: u32 = 1024;
+pub use trisort_format::gpu_layout::DATA_WIDTH;
 
 /// Creates the bind group layout of group 0 on the storage tier.
 pub fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {

@@ -1,8 +1,7 @@
 //! The prefiltered environment radiance on the GPU.
 
+use trisort_format::gpu_layout::environment_levels;
 use trisort_format::Environment;
-
-use super::textures::chain_levels;
 
 /// The prefiltered environment on the GPU.
 pub(super) struct EnvironmentGpu {
@@ -12,34 +11,17 @@ pub(super) struct EnvironmentGpu {
     pub(super) bytes: u64,
 }
 
-/// Uploads an environment's prefiltered radiance as an `Rgba16Float` texture with one mip
-/// level per stored level (as many as a full chain of its size holds; levels larger than the
-/// device allows are left out from the top).
+/// Uploads an environment's prefiltered radiance as an `Rgba16Float` texture, its levels as
+/// [`environment_levels`] gives them for the device's largest texture.
 pub(super) fn upload_environment(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     env: &Environment,
 ) -> EnvironmentGpu {
     let max_dim = device.limits().max_texture_dimension_2d;
-    let first = (0..env.levels.len())
-        .find(|&k| {
-            let (w, h) = env.level_size(k);
-            w <= max_dim && h <= max_dim
-        })
-        .unwrap_or(env.levels.len());
-    let white = [0x3c00u16; 4];
-    let mut stored: Vec<(u32, u32, &[u16])> = (first..env.levels.len())
-        .map(|k| {
-            let (w, h) = env.level_size(k);
-            (w, h, env.levels[k].as_slice())
-        })
-        .filter(|(w, h, l)| l.len() as u64 == *w as u64 * *h as u64 * 4)
-        .collect();
-    if stored.is_empty() {
-        stored.push((1, 1, &white));
-    }
-    let (w0, h0) = (stored[0].0, stored[0].1);
-    let levels = (stored.len() as u32).min(chain_levels(w0, h0));
+    let stored = environment_levels(env, max_dim);
+    let levels = stored.len() as u32;
+    let (w0, h0) = (stored[0].width, stored[0].height);
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("environment"),
         size: wgpu::Extent3d {
@@ -55,14 +37,8 @@ pub(super) fn upload_environment(
         view_formats: &[],
     });
     let mut bytes = 0;
-    for (k, &(sw, sh, texels)) in stored.iter().take(levels as usize).enumerate() {
-        // A level's size is that of the chain (`max(1, w0 >> k)`): the file's sizes agree.
-        let (w, h) = (sw.min((w0 >> k).max(1)), sh.min((h0 >> k).max(1)));
-        let row = w as usize * 4;
-        let mut data: Vec<u16> = Vec::with_capacity(row * h as usize);
-        for y in 0..h as usize {
-            data.extend_from_slice(&texels[y * sw as usize * 4..][..row]);
-        }
+    for (k, level) in stored.iter().enumerate() {
+        let (w, h) = (level.width, level.height);
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &texture,
@@ -70,7 +46,7 @@ pub(super) fn upload_environment(
                 origin: wgpu::Origin3d::ZERO,
                 aspect: wgpu::TextureAspect::All,
             },
-            bytemuck::cast_slice(&data),
+            bytemuck::cast_slice(&level.texels),
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
                 bytes_per_row: Some(w * 8),

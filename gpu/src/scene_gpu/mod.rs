@@ -36,18 +36,7 @@ use trisort_format::{FrameState, Geometry, Material, Vertex};
 use uniforms::{frame_data, projection};
 use wgpu::util::DeviceExt;
 
-/// How frames are drawn: image size, sample count and glass opacity.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct View {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// MSAA samples.
-    pub samples: u32,
-    /// Opacity of transmissive glass.
-    pub glass_opacity: f32,
-}
+pub use trisort_format::gpu_layout::View;
 
 /// What [`SceneGpu::upload`] puts on the GPU, and how: the scene and its frames at a view, the
 /// binding tier and the light.
