@@ -8,6 +8,7 @@
 mod baked;
 pub mod boundary;
 mod environment;
+mod gpu_data;
 mod materials;
 mod order;
 mod playback;
@@ -18,6 +19,7 @@ pub use boundary::{
     trisort_abi_version, trisort_format_version, trisort_last_error, trisort_version_string,
 };
 pub use environment::*;
+pub use gpu_data::*;
 pub use materials::*;
 pub use order::*;
 pub use playback::*;
