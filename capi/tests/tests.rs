@@ -2,5 +2,6 @@
 
 mod api;
 mod baked;
+mod cpp_wrapper;
 mod header;
 mod light_variants;
