@@ -14,6 +14,10 @@
 
 mod data_textures;
 pub mod device;
+#[cfg(not(target_arch = "wasm32"))]
+mod export_layout;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod export_shaders;
 pub mod pipeline;
 pub mod present;
 pub mod raster_probe;

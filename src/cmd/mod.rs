@@ -4,6 +4,7 @@ mod bake;
 mod bench;
 mod demo;
 mod export_order;
+mod export_shaders;
 mod inspect;
 pub mod merge;
 mod play;
@@ -50,6 +51,9 @@ enum Command {
     Demo(demo::DemoArgs),
     /// Write the order-only export of a baked file: each sorted triangle's glTF source.
     ExportOrder(export_order::ExportOrderArgs),
+    /// Write the player's vertex and fragment shaders for hosts (GLSL ES 3.00, SPIR-V or
+    /// WGSL) with their binding layout.
+    ExportShaders(export_shaders::ExportShadersArgs),
 }
 
 /// Recording options shared by `record` and `bake`.
@@ -163,5 +167,6 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Bench(a) => bench::run(a),
         Command::Demo(a) => demo::run(a),
         Command::ExportOrder(a) => export_order::run(a),
+        Command::ExportShaders(a) => export_shaders::run(a),
     }
 }
