@@ -27,9 +27,10 @@
  *
  * Conventions, thread safety and lifetimes are the C API's (the top of trisort.h): a handle
  * may be read from several threads at once; an Error reads the calling thread's last error
- * right after the call that failed. What is wrapped is what trisort.h declares; functions of
- * ABI 5 (format_version(), version_string()) only when the included trisort.h is of ABI 5 or
- * later. Writing ORDER files (trisort_export_order(), libtrisort_export) is not wrapped.
+ * right after the call that failed. Wrapped: the functions of ABI 4, and format_version()
+ * and version_string() when the included trisort.h is of ABI 5 or later. Not wrapped: the
+ * `trisort_gpu_*` functions of ABI 5 (call them with Baked::get()) and writing ORDER files
+ * (trisort_export_order(), libtrisort_export).
  *
  * @code
  * #include <trisort.hpp>
@@ -97,6 +98,12 @@ enum class DepthRange : std::uint32_t {
     /** Depth in [-1, 1] (OpenGL and OpenGL ES defaults). */
     MinusOneToOne = 1,
 };
+static_assert(static_cast<std::uint32_t>(DepthRange::ZeroToOne) ==
+                  static_cast<std::uint32_t>(TRISORT_DEPTH_RANGE_ZERO_TO_ONE),
+              "DepthRange follows trisort.h");
+static_assert(static_cast<std::uint32_t>(DepthRange::MinusOneToOne) ==
+                  static_cast<std::uint32_t>(TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE),
+              "DepthRange follows trisort.h");
 
 /**
  * A short English name of a status ("io", "out of range"...), for messages; "unknown status"
