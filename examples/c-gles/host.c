@@ -2,7 +2,12 @@
  * A host in C: plays a trisort baked file with OpenGL ES 3.0 through EGL (no window), with its
  * own small shaders, one glDrawElements per range, and writes each frame as a PNG.
  *
- *   host BAKED OUT_DIR [blend|depth|saturate]
+ *   host BAKED OUT_DIR [blend|depth|saturate] [--shading basic|pbr] [--shaders DIR]
+ *
+ * `--shading basic` (the default) draws with this file's own small shaders (one light plus
+ * ambient); `--shading pbr` draws with the player's own shaders as `trisort export-shaders
+ * --lang glsl-es-300 -o DIR` writes them (physically based, lit by the file's environment,
+ * tone mapped), loaded from DIR, fed the bytes the player uploads (trisort_gpu_*()).
  *
  * Frames are drawn at the size and MSAA sample count the file was recorded at, into a linear
  * RGBA16F target, and quantized once to 8-bit sRGB as trisort's own player does; so on the same
@@ -235,6 +240,7 @@ static GLuint compile(GLenum type, const char *src) {
 
 /* ---- EGL ---- */
 
+
 static void open_gles(void) {
     PFNEGLGETPLATFORMDISPLAYEXTPROC get_platform_display;
     EGLDisplay dpy = EGL_NO_DISPLAY;
@@ -276,6 +282,215 @@ static GLuint data_texture(GLsizei width, GLsizei height, const float *texels) {
     return t;
 }
 
+/* ---- --shading pbr: the player's exported shaders (trisort export-shaders) ---- */
+
+/* The whole of file `dir`/`name`, NUL-terminated. */
+static char *read_text(const char *dir, const char *name) {
+    char path[4096];
+    FILE *f;
+    long n;
+    char *text;
+    if (snprintf(path, sizeof path, "%s/%s", dir, name) >= (int)sizeof path) die("shader path too long");
+    f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "host: error: cannot open %s (write it with trisort export-shaders)\n", path);
+        exit(1);
+    }
+    if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0)
+        die("cannot read a shader file");
+    text = xmalloc((size_t)n + 1);
+    if (fread(text, 1, (size_t)n, f) != (size_t)n) die("cannot read a shader file");
+    text[n] = 0;
+    fclose(f);
+    return text;
+}
+
+/* Binds the program's uniform blocks and samplers as bindings.txt names them for the stage
+ * files `vert` and `frag`: uniform block of WGSL binding B at binding point B, the sampler of
+ * texture binding B at texture unit B. */
+static void bind_exported_names(GLuint prog, const char *dir, const char *vert, const char *frag) {
+    char *text = read_text(dir, "bindings.txt"), *line = text, *next;
+    for (; line && *line; line = next) {
+        char file[256], kind[32], name[256];
+        unsigned group, binding;
+        next = strchr(line, '\n');
+        if (next) *next++ = 0;
+        if (line[0] == '#' ||
+            sscanf(line, "%255s %31s %u %u %255s", file, kind, &group, &binding, name) != 5)
+            continue;
+        if (strcmp(file, vert) != 0 && strcmp(file, frag) != 0) continue;
+        if (!strcmp(kind, "uniform")) {
+            GLuint index = glGetUniformBlockIndex(prog, name);
+            if (index != GL_INVALID_INDEX) glUniformBlockBinding(prog, index, binding);
+        } else if (!strcmp(kind, "texture")) {
+            GLint location = glGetUniformLocation(prog, name);
+            if (location >= 0) glUniform1i(location, (GLint)binding);
+        }
+    }
+    free(text);
+    check_gl("exported bindings");
+}
+
+/* A uniform buffer of `size` bytes bound at binding point `point`. */
+static GLuint uniform_buffer(GLuint point, size_t size, const void *data) {
+    GLuint b;
+    glGenBuffers(1, &b);
+    glBindBuffer(GL_UNIFORM_BUFFER, b);
+    glBufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)size, data, GL_DYNAMIC_DRAW);
+    glBindBufferBase(GL_UNIFORM_BUFFER, point, b);
+    return b;
+}
+
+/* Trilinear filtering on the texture bound to `target`, wrapping s as `wrap_s`. */
+static void trilinear(GLenum target, GLint wrap_s) {
+    glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(target, GL_TEXTURE_WRAP_S, wrap_s);
+    glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+/* Material texture array `array` as the player uploads it, on texture unit `unit`. */
+static void upload_texture_array(TrisortBaked *h, uint32_t array, GLuint unit, uint32_t max_size) {
+    TrisortGpuTexture t;
+    GLuint tex;
+    uint32_t layer, level;
+    size_t n = 0;
+    unsigned char *texels;
+    check(trisort_gpu_texture_array(h, array, max_size, &t), "trisort_gpu_texture_array");
+    glActiveTexture(GL_TEXTURE0 + unit);
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, tex);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, (GLsizei)t.levels,
+                   array == TRISORT_TEXTURE_ARRAY_SRGB ? GL_SRGB8_ALPHA8 : GL_RGBA8,
+                   (GLsizei)t.width, (GLsizei)t.height, (GLsizei)t.layers);
+    texels = xmalloc((size_t)t.width * t.height * 4);
+    for (layer = 0; layer < t.layers; layer++) {
+        for (level = 0; level < t.levels; level++) {
+            uint32_t lw = t.width >> level ? t.width >> level : 1;
+            uint32_t lh = t.height >> level ? t.height >> level : 1;
+            check(trisort_gpu_texture_array_level(h, array, layer, level, max_size, texels,
+                                                  (size_t)t.width * t.height * 4, &n),
+                  "trisort_gpu_texture_array_level");
+            glTexSubImage3D(GL_TEXTURE_2D_ARRAY, (GLint)level, 0, 0, (GLint)layer, (GLsizei)lw,
+                            (GLsizei)lh, 1, GL_RGBA, GL_UNSIGNED_BYTE, texels);
+        }
+    }
+    free(texels);
+    trilinear(GL_TEXTURE_2D_ARRAY, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, (GLint)t.levels - 1);
+}
+
+/* The prefiltered environment as the player uploads it, on texture unit `unit`. */
+static void upload_environment(TrisortBaked *h, GLuint unit, uint32_t max_size) {
+    TrisortGpuTexture t;
+    GLuint tex;
+    uint32_t level;
+    size_t n = 0;
+    uint16_t *texels;
+    check(trisort_gpu_environment(h, max_size, &t), "trisort_gpu_environment");
+    glActiveTexture(GL_TEXTURE0 + unit);
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexStorage2D(GL_TEXTURE_2D, (GLsizei)t.levels, GL_RGBA16F, (GLsizei)t.width,
+                   (GLsizei)t.height);
+    texels = xmalloc((size_t)t.width * t.height * 4 * sizeof *texels);
+    for (level = 0; level < t.levels; level++) {
+        uint32_t lw = t.width >> level ? t.width >> level : 1;
+        uint32_t lh = t.height >> level ? t.height >> level : 1;
+        check(trisort_gpu_environment_level(h, level, max_size, texels,
+                                            (size_t)t.width * t.height * 4, &n),
+              "trisort_gpu_environment_level");
+        glTexSubImage2D(GL_TEXTURE_2D, (GLint)level, 0, 0, (GLsizei)lw, (GLsizei)lh, GL_RGBA,
+                        GL_HALF_FLOAT, texels);
+    }
+    free(texels);
+    /* The environment wraps around in longitude (s) and stops at the poles (t). */
+    trilinear(GL_TEXTURE_2D, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, (GLint)t.levels - 1);
+}
+
+/* A data texture (RGBA32F, TRISORT_GPU_DATA_WIDTH texels a row) of `floats` floats on unit
+ * `unit`. */
+static void upload_data_texture(GLuint unit, const float *floats, size_t n) {
+    glActiveTexture(GL_TEXTURE0 + unit);
+    data_texture(TRISORT_GPU_DATA_WIDTH, (GLsizei)(n / 4 / TRISORT_GPU_DATA_WIDTH), floats);
+}
+
+/* What --shading pbr keeps per frame: the Frame and node-base uniform buffers. */
+typedef struct {
+    GLuint frame_ubo, node_base_ubo;
+    uint32_t nodes_per_frame;
+} Pbr;
+
+/* Builds the program from the exported GLSL in `dir` (the straight- or premultiplied-alpha
+ * fragment stage for `mode`) and uploads everything it reads, each WGSL binding B at texture
+ * unit B or uniform binding point B. Leaves the program in use. */
+static Pbr setup_pbr(TrisortBaked *h, const TrisortInfo *info, const char *dir, TrisortMode mode) {
+    const char *frag = mode == TRISORT_MODE_SATURATE ? "pbr_premultiplied.frag" : "pbr_straight.frag";
+    char *vs = read_text(dir, "player.vert"), *fs = read_text(dir, frag);
+    GLuint prog = glCreateProgram();
+    GLint ok = 0, max_size = 0;
+    unsigned char uniform[TRISORT_GPU_LIGHTING_UNIFORM_SIZE];
+    uint32_t zero[4] = {0, 0, 0, 0};
+    float *floats;
+    size_t n = 0;
+    Pbr p;
+    glAttachShader(prog, compile(GL_VERTEX_SHADER, vs));
+    glAttachShader(prog, compile(GL_FRAGMENT_SHADER, fs));
+    glLinkProgram(prog);
+    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[4096];
+        glGetProgramInfoLog(prog, sizeof log, NULL, log);
+        fprintf(stderr, "host: error: the exported shaders do not link: %s\n", log);
+        exit(1);
+    }
+    free(vs);
+    free(fs);
+    glUseProgram(prog);
+    bind_exported_names(prog, dir, "player.vert", frag);
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+
+    p.frame_ubo = uniform_buffer(0, TRISORT_GPU_FRAME_UNIFORM_SIZE, NULL);
+    p.node_base_ubo = uniform_buffer(1, sizeof zero, zero);
+    p.nodes_per_frame = info->node_count ? info->node_count : 1;
+    check(trisort_gpu_lighting_uniform(h, TRISORT_SHADING_PBR, TRISORT_TONE_MAP_NEUTRAL,
+                                       (uint32_t)max_size, uniform, sizeof uniform, &n),
+          "trisort_gpu_lighting_uniform");
+    uniform_buffer(7, n, uniform);
+
+    check(trisort_gpu_material_texels(h, (uint32_t)max_size, NULL, 0, &n), "trisort_gpu_material_texels");
+    floats = xmalloc(n * sizeof *floats);
+    check(trisort_gpu_material_texels(h, (uint32_t)max_size, floats, n, &n), "trisort_gpu_material_texels");
+    upload_data_texture(2, floats, n);
+    free(floats);
+    check(trisort_gpu_node_texels(h, NULL, 0, &n), "trisort_gpu_node_texels");
+    floats = xmalloc(n * sizeof *floats);
+    check(trisort_gpu_node_texels(h, floats, n, &n), "trisort_gpu_node_texels");
+    upload_data_texture(5, floats, n);
+    free(floats);
+    upload_texture_array(h, TRISORT_TEXTURE_ARRAY_SRGB, 3, (uint32_t)max_size);
+    upload_texture_array(h, TRISORT_TEXTURE_ARRAY_LINEAR, 6, (uint32_t)max_size);
+    upload_environment(h, 8, (uint32_t)max_size);
+    glActiveTexture(GL_TEXTURE0);
+    check_gl("pbr set-up");
+    return p;
+}
+
+/* Frame `f`'s uniforms for --shading pbr: the Frame uniform at the recorded size and the
+ * frame's first node in the node texels. */
+static void pbr_frame(TrisortBaked *h, const Pbr *p, uint32_t f) {
+    unsigned char frame[TRISORT_GPU_FRAME_UNIFORM_SIZE];
+    uint32_t base[4] = {0, 0, 0, 0};
+    size_t n = 0;
+    check(trisort_gpu_frame_uniform(h, f, 0, 0, frame, sizeof frame, &n), "trisort_gpu_frame_uniform");
+    glBindBuffer(GL_UNIFORM_BUFFER, p->frame_ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, (GLsizeiptr)n, frame);
+    base[0] = f * p->nodes_per_frame;
+    glBindBuffer(GL_UNIFORM_BUFFER, p->node_base_ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof base, base);
+}
+
 static float linear_to_srgb(float c) {
     c = c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
     return c <= 0.0031308f ? 12.92f * c : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
@@ -290,24 +505,41 @@ int main(int argc, char **argv) {
     TrisortRange *ranges;
     float *node_texels, *material_texels, *pixels, proj[16];
     unsigned char *rgba;
-    size_t nv, nidx, nm, nn, nr, k;
+    size_t nv, nidx, nm, nn = 0, nr, k;
     uint32_t f, tw = 1, th = 1, t, w, hgt, samples, x, y;
-    GLuint prog, vao, vbo, ibo, nodes_tex, materials_tex, array_tex, fbo[2], rb[3];
-    int bytes_per_index, back_to_front;
+    GLuint prog = 0, vao, vbo, ibo, nodes_tex = 0, materials_tex, array_tex, fbo[2], rb[3];
+    int bytes_per_index, back_to_front, pbr = 0, a;
+    const char *mode_name = NULL, *shaders = NULL;
     char path[4096];
+    Pbr pbr_state = {0, 0, 1};
 
-    if (argc < 3 || argc > 4) {
-        fprintf(stderr, "usage: host BAKED OUT_DIR [blend|depth|saturate]\n");
+    for (a = 3; a < argc; a++) {
+        if (!strcmp(argv[a], "--shading") && a + 1 < argc) {
+            a++;
+            if (!strcmp(argv[a], "pbr")) pbr = 1;
+            else if (strcmp(argv[a], "basic") != 0) die("--shading must be basic or pbr");
+        } else if (!strcmp(argv[a], "--shaders") && a + 1 < argc) {
+            shaders = argv[++a];
+        } else if (!mode_name && argv[a][0] != '-') {
+            mode_name = argv[a];
+        } else {
+            argc = 0; /* usage */
+        }
+    }
+    if (argc < 3) {
+        fprintf(stderr, "usage: host BAKED OUT_DIR [blend|depth|saturate] [--shading basic|pbr] "
+                        "[--shaders DIR]\n");
         return 2;
     }
+    if (pbr && !shaders) die("--shading pbr needs --shaders DIR (trisort export-shaders --lang glsl-es-300 -o DIR)");
     if (trisort_abi_version() != TRISORT_ABI_VERSION) die("libtrisort_capi's ABI differs from trisort.h");
     check(trisort_open_path(argv[1], &h), "trisort_open_path");
     check(trisort_info(h, &info), "trisort_info");
     mode = info.recommended_mode;
-    if (argc == 4) {
-        if (!strcmp(argv[3], "blend")) mode = TRISORT_MODE_BLEND;
-        else if (!strcmp(argv[3], "depth")) mode = TRISORT_MODE_DEPTH;
-        else if (!strcmp(argv[3], "saturate")) mode = TRISORT_MODE_SATURATE;
+    if (mode_name) {
+        if (!strcmp(mode_name, "blend")) mode = TRISORT_MODE_BLEND;
+        else if (!strcmp(mode_name, "depth")) mode = TRISORT_MODE_DEPTH;
+        else if (!strcmp(mode_name, "saturate")) mode = TRISORT_MODE_SATURATE;
         else die("mode must be blend, depth or saturate");
     }
     back_to_front = mode == TRISORT_MODE_BLEND;
@@ -336,9 +568,17 @@ int main(int argc, char **argv) {
     glVertexAttribIPointer(3, 1, GL_UNSIGNED_INT, sizeof(TrisortVertex), (void *)32);
     glEnableVertexAttribArray(4);
     glVertexAttribIPointer(4, 1, GL_UNSIGNED_INT, sizeof(TrisortVertex), (void *)36);
-    /* The tangent at byte 40 is not used: this host shades with its normals alone. */
-    glEnableVertexAttribArray(5);
-    glVertexAttribPointer(5, 2, GL_FLOAT, GL_FALSE, sizeof(TrisortVertex), (void *)56);
+    if (pbr) {
+        /* The exported vertex stage reads the tangent (location 5) and uv1 (location 6). */
+        glEnableVertexAttribArray(5);
+        glVertexAttribPointer(5, 4, GL_FLOAT, GL_FALSE, sizeof(TrisortVertex), (void *)40);
+        glEnableVertexAttribArray(6);
+        glVertexAttribPointer(6, 2, GL_FLOAT, GL_FALSE, sizeof(TrisortVertex), (void *)56);
+    } else {
+        /* The tangent at byte 40 is not used: the basic shaders shade with normals alone. */
+        glEnableVertexAttribArray(5);
+        glVertexAttribPointer(5, 2, GL_FLOAT, GL_FALSE, sizeof(TrisortVertex), (void *)56);
+    }
     free(vertices);
 
     /* The sorted index buffer, reversed for back-to-front blending; u16 where it fits. */
@@ -362,100 +602,105 @@ int main(int argc, char **argv) {
         bytes_per_index = 4;
     }
 
-    /* Base-colour textures in one sRGB array, each layer as large as the largest texture,
-     * smaller ones in the top-left corner (as trisort's player does). */
-    for (t = 0; t < info.texture_count; t++) {
-        uint32_t tx, ty;
-        check(trisort_texture(h, t, &tx, &ty, NULL, 0, &k), "trisort_texture");
-        if (tx > tw) tw = tx;
-        if (ty > th) th = ty;
-    }
-    glGenTextures(1, &array_tex);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, array_tex);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_SRGB8_ALPHA8, (GLsizei)tw, (GLsizei)th,
-                 (GLsizei)(info.texture_count ? info.texture_count : 1), 0, GL_RGBA,
-                 GL_UNSIGNED_BYTE, NULL);
-    for (t = 0; t < info.texture_count; t++) {
-        uint32_t tx, ty;
-        unsigned char *texels;
-        check(trisort_texture(h, t, &tx, &ty, NULL, 0, &k), "trisort_texture");
-        texels = xmalloc(k);
-        check(trisort_texture(h, t, &tx, &ty, texels, k, &k), "trisort_texture");
-        glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, (GLint)t, (GLsizei)tx, (GLsizei)ty, 1,
-                        GL_RGBA, GL_UNSIGNED_BYTE, texels);
-        free(texels);
-    }
-    check_gl("textures");
-
-    /* Materials: 6 texels each. */
-    check(trisort_materials(h, NULL, 0, &nm), "trisort_materials");
-    materials = xmalloc(nm * sizeof *materials);
-    check(trisort_materials(h, materials, nm, &nm), "trisort_materials");
-    material_texels = xmalloc(nm * 24 * sizeof(float));
-    for (k = 0; k < nm; k++) {
-        const TrisortMaterial *m = &materials[k];
-        float *p = material_texels + 24 * k;
-        float sx = 1.0f, sy = 1.0f;
-        if (m->base_color_texture >= 0) {
+    if (pbr) {
+        pbr_state = setup_pbr(h, &info, shaders, mode);
+        node_texels = NULL;
+    } else {
+        /* Base-colour textures in one sRGB array, each layer as large as the largest texture,
+         * smaller ones in the top-left corner (as trisort's player does). */
+        for (t = 0; t < info.texture_count; t++) {
             uint32_t tx, ty;
-            size_t bytes;
-            check(trisort_texture(h, (uint32_t)m->base_color_texture, &tx, &ty, NULL, 0, &bytes),
-                  "trisort_texture");
-            sx = (float)tx / (float)tw;
-            sy = (float)ty / (float)th;
+            check(trisort_texture(h, t, &tx, &ty, NULL, 0, &k), "trisort_texture");
+            if (tx > tw) tw = tx;
+            if (ty > th) th = ty;
         }
-        memcpy(p, m->base_color, 4 * sizeof(float));
-        memcpy(p + 4, m->emissive, 3 * sizeof(float));
-        p[7] = m->transmission;
-        p[8] = (float)m->alpha_mode;
-        p[9] = m->alpha_cutoff;
-        p[10] = m->double_sided ? 1.0f : 0.0f;
-        p[11] = (float)m->base_color_texture;
-        p[12] = sx;
-        p[13] = sy;
-        p[14] = 0.0f;
-        p[15] = 0.0f;
-        memcpy(p + 16, m->base_color_slot.transform, 3 * sizeof(float));
-        p[19] = (float)m->base_color_slot.tex_coord;
-        memcpy(p + 20, m->base_color_slot.transform + 3, 3 * sizeof(float));
-        p[23] = 0.0f;
-    }
-    materials_tex = data_texture(6, (GLsizei)nm, material_texels);
-    free(material_texels);
-    free(materials);
+        glGenTextures(1, &array_tex);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, array_tex);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_SRGB8_ALPHA8, (GLsizei)tw, (GLsizei)th,
+                     (GLsizei)(info.texture_count ? info.texture_count : 1), 0, GL_RGBA,
+                     GL_UNSIGNED_BYTE, NULL);
+        for (t = 0; t < info.texture_count; t++) {
+            uint32_t tx, ty;
+            unsigned char *texels;
+            check(trisort_texture(h, t, &tx, &ty, NULL, 0, &k), "trisort_texture");
+            texels = xmalloc(k);
+            check(trisort_texture(h, t, &tx, &ty, texels, k, &k), "trisort_texture");
+            glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, (GLint)t, (GLsizei)tx, (GLsizei)ty, 1,
+                            GL_RGBA, GL_UNSIGNED_BYTE, texels);
+            free(texels);
+        }
+        check_gl("textures");
 
-    check(trisort_frame_node_matrices(h, 0, true, NULL, 0, &nn), "trisort_frame_node_matrices");
-    node_texels = xmalloc(nn * sizeof(float));
-    check(trisort_frame_node_matrices(h, 0, true, node_texels, nn, &nn), "trisort_frame_node_matrices");
-    nodes_tex = data_texture(4, (GLsizei)(nn / 16), node_texels);
+        /* Materials: 6 texels each. */
+        check(trisort_materials(h, NULL, 0, &nm), "trisort_materials");
+        materials = xmalloc(nm * sizeof *materials);
+        check(trisort_materials(h, materials, nm, &nm), "trisort_materials");
+        material_texels = xmalloc(nm * 24 * sizeof(float));
+        for (k = 0; k < nm; k++) {
+            const TrisortMaterial *m = &materials[k];
+            float *p = material_texels + 24 * k;
+            float sx = 1.0f, sy = 1.0f;
+            if (m->base_color_texture >= 0) {
+                uint32_t tx, ty;
+                size_t bytes;
+                check(trisort_texture(h, (uint32_t)m->base_color_texture, &tx, &ty, NULL, 0, &bytes),
+                      "trisort_texture");
+                sx = (float)tx / (float)tw;
+                sy = (float)ty / (float)th;
+            }
+            memcpy(p, m->base_color, 4 * sizeof(float));
+            memcpy(p + 4, m->emissive, 3 * sizeof(float));
+            p[7] = m->transmission;
+            p[8] = (float)m->alpha_mode;
+            p[9] = m->alpha_cutoff;
+            p[10] = m->double_sided ? 1.0f : 0.0f;
+            p[11] = (float)m->base_color_texture;
+            p[12] = sx;
+            p[13] = sy;
+            p[14] = 0.0f;
+            p[15] = 0.0f;
+            memcpy(p + 16, m->base_color_slot.transform, 3 * sizeof(float));
+            p[19] = (float)m->base_color_slot.tex_coord;
+            memcpy(p + 20, m->base_color_slot.transform + 3, 3 * sizeof(float));
+            p[23] = 0.0f;
+        }
+        materials_tex = data_texture(6, (GLsizei)nm, material_texels);
+        free(material_texels);
+        free(materials);
 
-    prog = glCreateProgram();
-    glAttachShader(prog, compile(GL_VERTEX_SHADER, VS));
-    glAttachShader(prog, compile(GL_FRAGMENT_SHADER, FS));
-    glLinkProgram(prog);
-    {
-        GLint ok = 0;
-        glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-        if (!ok) die("shader program does not link");
+        check(trisort_frame_node_matrices(h, 0, true, NULL, 0, &nn), "trisort_frame_node_matrices");
+        node_texels = xmalloc(nn * sizeof(float));
+        check(trisort_frame_node_matrices(h, 0, true, node_texels, nn, &nn), "trisort_frame_node_matrices");
+        nodes_tex = data_texture(4, (GLsizei)(nn / 16), node_texels);
+
+        prog = glCreateProgram();
+        glAttachShader(prog, compile(GL_VERTEX_SHADER, VS));
+        glAttachShader(prog, compile(GL_FRAGMENT_SHADER, FS));
+        glLinkProgram(prog);
+        {
+            GLint ok = 0;
+            glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+            if (!ok) die("shader program does not link");
+        }
+        glUseProgram(prog);
+        glUniform1i(glGetUniformLocation(prog, "u_nodes"), 0);
+        glUniform1i(glGetUniformLocation(prog, "u_materials"), 1);
+        glUniform1i(glGetUniformLocation(prog, "u_textures"), 2);
+        glUniform4fv(glGetUniformLocation(prog, "u_light"), 1, LIGHT);
+        glUniform1f(glGetUniformLocation(prog, "u_glass_opacity"), info.glass_opacity);
+        glUniform1i(glGetUniformLocation(prog, "u_premultiplied"), mode == TRISORT_MODE_SATURATE);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, nodes_tex);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, materials_tex);
+        glActiveTexture(GL_TEXTURE2);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, array_tex);
+        glActiveTexture(GL_TEXTURE0);
     }
-    glUseProgram(prog);
-    glUniform1i(glGetUniformLocation(prog, "u_nodes"), 0);
-    glUniform1i(glGetUniformLocation(prog, "u_materials"), 1);
-    glUniform1i(glGetUniformLocation(prog, "u_textures"), 2);
-    glUniform4fv(glGetUniformLocation(prog, "u_light"), 1, LIGHT);
-    glUniform1f(glGetUniformLocation(prog, "u_glass_opacity"), info.glass_opacity);
-    glUniform1i(glGetUniformLocation(prog, "u_premultiplied"), mode == TRISORT_MODE_SATURATE);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, nodes_tex);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, materials_tex);
-    glActiveTexture(GL_TEXTURE2);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, array_tex);
-    glActiveTexture(GL_TEXTURE0);
 
     /* Target: multisampled linear RGBA16F (and depth in depth mode), resolved into a
      * single-sample RGBA16F that is read back as floats. */
@@ -507,12 +752,18 @@ int main(int argc, char **argv) {
          * the image's top row, and MSAA sample positions, which GL gives from a pixel's lower
          * corner, fall where Vulkan's (from its upper corner) do. */
         for (k = 0; k < 4; k++) proj[4 * k + 1] = -proj[4 * k + 1];
-        glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_FALSE, proj);
-        check(trisort_frame_node_matrices(h, f, true, node_texels, nn, &nn),
-              "trisort_frame_node_matrices");
-        glBindTexture(GL_TEXTURE_2D, nodes_tex);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 4, (GLsizei)(nn / 16), GL_RGBA, GL_FLOAT,
-                        node_texels);
+        if (pbr) {
+            /* The exported vertex stage negates y itself (and maps depth to GL's), from the
+             * player's own Frame uniform. */
+            pbr_frame(h, &pbr_state, f);
+        } else {
+            glUniformMatrix4fv(glGetUniformLocation(prog, "u_proj"), 1, GL_FALSE, proj);
+            check(trisort_frame_node_matrices(h, f, true, node_texels, nn, &nn),
+                  "trisort_frame_node_matrices");
+            glBindTexture(GL_TEXTURE_2D, nodes_tex);
+            glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 4, (GLsizei)(nn / 16), GL_RGBA, GL_FLOAT,
+                            node_texels);
+        }
         glBindFramebuffer(GL_FRAMEBUFFER, fbo[0]);
         if (mode == TRISORT_MODE_SATURATE) glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
         else glClearColor(BACKGROUND[0], BACKGROUND[1], BACKGROUND[2], 1.0f);
@@ -553,9 +804,10 @@ int main(int argc, char **argv) {
             die("output folder path too long");
         write_png(path, rgba, w, hgt);
     }
-    printf("host: drew %u frames (%s) at %ux%u, %ux MSAA into %s\n", (unsigned)info.frame_count,
+    printf("host: drew %u frames (%s, %s shading) at %ux%u, %ux MSAA into %s\n",
+           (unsigned)info.frame_count,
            mode == TRISORT_MODE_BLEND ? "blend" : mode == TRISORT_MODE_DEPTH ? "depth" : "saturate",
-           (unsigned)w, (unsigned)hgt, (unsigned)samples, argv[2]);
+           pbr ? "pbr" : "basic", (unsigned)w, (unsigned)hgt, (unsigned)samples, argv[2]);
     free(ranges);
     free(pixels);
     free(rgba);
