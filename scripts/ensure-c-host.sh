@@ -2,10 +2,15 @@
 # Makes sure the C host example (examples/c-gles, tests/c_host.rs) can be built and run, and
 # that FORMAT.md's independent reader (docs/format_reader.py, tests/format_reader.rs) can run:
 # gcc, the EGL and GLES 3 headers and libraries with Mesa's EGL vendor, and Python's
-# zstandard module (Debian's python3-zstandard, for /usr/bin/python3). Installs what is missing.
+# zstandard module (Debian's python3-zstandard, for /usr/bin/python3); for the installed
+# library's builds (scripts/test-capi-package.sh) g++, CMake and pkg-config. Installs what is
+# missing.
 set -euo pipefail
 missing=()
 command -v gcc >/dev/null || missing+=(gcc)
+command -v g++ >/dev/null || missing+=(g++)
+command -v cmake >/dev/null || missing+=(cmake)
+command -v pkg-config >/dev/null || missing+=(pkgconf)
 [ -f /usr/include/EGL/egl.h ] || missing+=(libegl-dev)
 [ -f /usr/include/GLES3/gl3.h ] || missing+=(libgles-dev)
 case "$(ldconfig -p)" in

@@ -15,6 +15,10 @@ export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp/xdg-runtime-$(id -u)}"
 mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 export TRISORT_SCENES="${TRISORT_SCENES:-$(pwd)/../shared/scenes}"
 cargo test --workspace --all-targets "$@"
+# The C library installed as a C/C++ build takes it: SONAME, pkg-config, CMake, the C++
+# example, and the aarch64 cross-build run under qemu-aarch64 (README § Installing the C
+# library).
+bash scripts/test-capi-package.sh
 # The web player in headless Chromium (installs Chromium, Node's playwright-core and the
 # wasm-bindgen CLI when missing). TRISORT_SKIP_BROWSER=1 skips it on a developer machine;
 # CI refuses to skip it.

@@ -95,7 +95,7 @@ pub unsafe fn c_path(s: *const c_char, what: &str) -> Result<PathBuf, Failure> {
     Ok(PathBuf::from(s))
 }
 
-/// The length half of the copy copy convention (top of the header): writes `n` to `*len`
+/// The length half of the copy convention (top of the header): writes `n` to `*len`
 /// when `len` is given, and says whether to copy (`out` is given). Both null is a failure.
 ///
 /// # Safety
