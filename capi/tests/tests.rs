@@ -3,5 +3,6 @@
 mod api;
 mod baked;
 mod cpp_wrapper;
+mod gpu_data;
 mod header;
 mod light_variants;
