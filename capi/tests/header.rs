@@ -122,7 +122,10 @@ fn header_declares_the_abi_version_and_every_entry_point() {
     assert!(h.contains("#define TRISORT_ABI_VERSION 5"), "{h}");
     assert!(h.contains("#define TRISORT_FORMAT_VERSION 5"), "{h}");
     // Taken as uint32_t, so no function names the enum: its values must still be there.
-    assert!(h.contains("TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE = 1"), "{h}");
+    assert!(
+        h.contains("TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE = 1"),
+        "{h}"
+    );
     for f in [
         "trisort_abi_version",
         "trisort_format_version",
