@@ -10,7 +10,8 @@
 #
 # The library is the player only: no glTF importer and no C++ runtime. --with-export-order
 # also installs libtrisort_export (the player library plus trisort_export_order, which needs
-# the importer and libstdc++), trisort_export.h, trisort-export.pc and trisort::trisort_export.
+# the importer, whose meshoptimizer is C++: its static archive links libstdc++),
+# trisort_export.h, trisort-export.pc and trisort::trisort_export.
 #
 # Usage: scripts/install-capi.sh --prefix DIR [--target TRIPLE] [--profile release|dev]
 #                                [--libdir lib] [--with-export-order]
@@ -61,11 +62,14 @@ fi
 
 # One build gives the shared and the static library and the system libraries a static link
 # needs (rustc's native-static-libs note, replayed by cargo when the build is fresh).
-build() { # package → prints the native-static-libs
+# The SONAME goes to this crate's link alone (a build script's cdylib-link-arg would reach
+# every dependent cdylib too: libtrisort_export would be named libtrisort.so.0).
+build() { # package, installed name → prints the native-static-libs
   local log
   log="$(mktemp)"
   if ! cargo rustc --profile "$profile" "${target_args[@]}" -p "$1" --lib \
-      --crate-type cdylib,staticlib -- --print native-static-libs >"$log" 2>&1; then
+      --crate-type cdylib,staticlib -- --print native-static-libs \
+      -C "link-arg=-Wl,-soname,lib$2.so.$major" >"$log" 2>&1; then
     cat "$log" >&2
     rm -f "$log"
     echo "install-capi: building $1 failed" >&2
@@ -76,10 +80,10 @@ build() { # package → prints the native-static-libs
 }
 
 echo "install-capi: building trisort-capi ($profile${target:+, $target})" >&2
-static_libs="$(build trisort-capi)"
+static_libs="$(build trisort-capi trisort)"
 if [ "$export_order" = 1 ]; then
   echo "install-capi: building trisort-capi-export ($profile${target:+, $target})" >&2
-  export_static_libs="$(build trisort-capi-export)"
+  export_static_libs="$(build trisort-capi-export trisort_export)"
 fi
 
 # Into a staging directory beside the prefix, then moved in: an interrupted install leaves
