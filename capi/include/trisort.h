@@ -79,7 +79,11 @@
  * (`trisort_variant_count()`, `trisort_variant_name()`, `trisort_variant_materials()`) and
  * the frame rate (`trisort_fps()`). 4 added the raster profile (`trisort_raster_profile()`,
  * `trisort_check_device()`, `TRISORT_STATUS_PROFILE_MISMATCH`). 5 added
- * `trisort_format_version()` and `trisort_version_string()`, and takes the projection's depth
+ * `trisort_format_version()`, `trisort_version_string()` and the bytes the player's shaders
+ * read (`trisort_gpu_frame_uniform()`, `trisort_gpu_lighting_uniform()`,
+ * `trisort_gpu_material_texels()`, `trisort_gpu_node_texels()`, `trisort_gpu_texture_array()`,
+ * `trisort_gpu_texture_array_level()`, `trisort_gpu_environment()`,
+ * `trisort_gpu_environment_level()`: `trisort export-shaders`), and takes the projection's depth
  * range as a `uint32_t` (the same values and calling convention as the enum it was; an
  * out-of-range value is now `TRISORT_STATUS_OUT_OF_RANGE` instead of undefined behaviour);
  * `trisort_export_order()` moved to `libtrisort_export` (`trisort_export.h`).
