@@ -7,11 +7,8 @@ use std::ptr::null_mut;
 use glam::{DMat4, DVec3, DVec4};
 use trisort_capi::ffi::*;
 use trisort_format::container::encode;
-use trisort_format::{
-    Baked, DeviceInfo, DrawIndexedIndirectArgs, FileKind, FrameWindow, MergeInfo, MergeStats,
-    RecordSettings, TextureSlot, TextureTransform,
-};
-use trisort_testkit::fixtures::{frame_at, material, quad, scene};
+use trisort_format::{Baked, FileKind, FrameWindow, TextureSlot, TextureTransform};
+use trisort_testkit::fixtures::{baked, draw, material, quad, scene};
 
 use crate::api::last_error;
 
@@ -49,41 +46,20 @@ fn sample() -> Baked {
         trisort_scene::mips::texture_with_mips("n".into(), 4, 2, vec![128; 32], false, 1024);
     g.textures.push(normals);
     let copies = vec![0, 1, 2, 3, 4, 5, 6, 7, 2, 3];
-    let draw = |first: u32, count: u32| DrawIndexedIndirectArgs {
-        index_count: 3 * count,
-        instance_count: 1,
-        first_index: 3 * first,
-        base_vertex: 0,
-        first_instance: 0,
-    };
-    Baked {
-        tool_version: "test".into(),
-        scene_hash: [1; 32],
-        path_hash: [2; 32],
-        recording_hashes: vec![],
-        settings: RecordSettings::new((64, 32), 4),
-        device: DeviceInfo::default(),
-        merge: MergeInfo::default(),
-        stats: MergeStats::default(),
-        scene_ids: (0..g.triangles.len() as u32).collect(),
-        geometry: g,
+    baked(
+        g,
         copies,
-        draws: vec![draw(0, 4), draw(6, 4), draw(2, 6)],
-        frames: vec![
+        vec![draw(0, 4), draw(6, 4), draw(2, 6)],
+        vec![
             FrameWindow { first: 0, count: 2 },
             FrameWindow { first: 2, count: 1 },
         ],
-        frame_states: vec![
-            frame_at(DVec3::new(0.0, 0.0, 1.0)),
-            frame_at(DVec3::new(0.5, 0.0, 2.0)),
-        ],
-        removed_edges: vec![vec![], vec![]],
-        fps: None,
-        environment: trisort_format::Environment::uniform(1.0),
-    }
+        &[DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.5, 0.0, 2.0)],
+    )
 }
 
-fn open(baked: &Baked) -> *mut TrisortBaked {
+/// Opens `baked` from its encoded bytes.
+pub fn open(baked: &Baked) -> *mut TrisortBaked {
     baked.check_structure().unwrap();
     let bytes = encode(FileKind::Baked, baked);
     let mut h = null_mut();
@@ -95,7 +71,7 @@ fn open(baked: &Baked) -> *mut TrisortBaked {
 }
 
 /// Copies out with the length query first, as a C host does.
-fn get<T: Default + Clone>(
+pub fn get<T: Default + Clone>(
     mut f: impl FnMut(*mut T, usize, *mut usize) -> TrisortStatus,
 ) -> Vec<T> {
     let mut len = 0;

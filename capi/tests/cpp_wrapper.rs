@@ -18,11 +18,8 @@ use std::ptr::null_mut;
 use glam::DVec3;
 use trisort_capi::ffi::*;
 use trisort_format::container::encode;
-use trisort_format::{
-    Baked, DeviceInfo, DrawIndexedIndirectArgs, FileKind, FrameWindow, MergeInfo, MergeStats,
-    RecordSettings,
-};
-use trisort_testkit::fixtures::{frame_at, material, quad, scene};
+use trisort_format::{Baked, FileKind, FrameWindow};
+use trisort_testkit::fixtures::{baked, draw, material, quad, scene};
 
 /// The repository root (the example and the header are found from it).
 fn root() -> &'static Path {
@@ -118,38 +115,18 @@ fn sample() -> Baked {
         let z = -1.0 - k as f32;
         quad(&mut g, [-1.0, 1.0], [-1.0, 1.0], [z, z], (k % 2) as u32);
     }
-    let draw = |first: u32, count: u32| DrawIndexedIndirectArgs {
-        index_count: 3 * count,
-        instance_count: 1,
-        first_index: 3 * first,
-        base_vertex: 0,
-        first_instance: 0,
-    };
-    Baked {
-        tool_version: "test".into(),
-        scene_hash: [1; 32],
-        path_hash: [2; 32],
-        recording_hashes: vec![],
-        settings: RecordSettings::new((64, 32), 4),
-        device: DeviceInfo::default(),
-        merge: MergeInfo::default(),
-        stats: MergeStats::default(),
-        scene_ids: (0..g.triangles.len() as u32).collect(),
-        geometry: g,
-        copies: vec![0, 1, 2, 3, 4, 5, 6, 7, 2, 3],
-        draws: vec![draw(0, 4), draw(6, 4), draw(2, 6)],
-        frames: vec![
+    let mut b = baked(
+        g,
+        vec![0, 1, 2, 3, 4, 5, 6, 7, 2, 3],
+        vec![draw(0, 4), draw(6, 4), draw(2, 6)],
+        vec![
             FrameWindow { first: 0, count: 2 },
             FrameWindow { first: 2, count: 1 },
         ],
-        frame_states: vec![
-            frame_at(DVec3::new(0.0, 0.0, 1.0)),
-            frame_at(DVec3::new(0.5, 0.25, 2.0)),
-        ],
-        removed_edges: vec![vec![], vec![]],
-        fps: Some(24.0),
-        environment: trisort_format::Environment::uniform(1.0),
-    }
+        &[DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.5, 0.25, 2.0)],
+    );
+    b.fps = Some(24.0);
+    b
 }
 
 /// `trisort_frame_projection`'s depth argument from its value: the enum `TrisortDepthRange`

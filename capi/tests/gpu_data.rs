@@ -7,13 +7,11 @@ use std::ptr::null_mut;
 
 use glam::DVec3;
 use trisort_capi::ffi::*;
-use trisort_format::container::encode;
+
+use crate::baked::{get, open};
 use trisort_format::gpu_layout::{self, View};
-use trisort_format::{
-    Baked, DeviceInfo, DrawIndexedIndirectArgs, FileKind, FrameWindow, MergeInfo, MergeStats,
-    RecordSettings, TextureSlot,
-};
-use trisort_testkit::fixtures::{frame_at, material, quad, scene};
+use trisort_format::{Baked, FrameWindow, TextureSlot};
+use trisort_testkit::fixtures::{baked, draw, material, quad, scene};
 
 /// Two quads, one with an sRGB base-colour texture (2×1) and one with a linear normal
 /// texture (4×2); two frames.
@@ -36,60 +34,16 @@ fn sample() -> Baked {
     let (normals, _) =
         trisort_scene::mips::texture_with_mips("n".into(), 4, 2, vec![128; 32], false, 1024);
     g.textures.push(normals);
-    let draw = DrawIndexedIndirectArgs {
-        index_count: 12,
-        instance_count: 1,
-        first_index: 0,
-        base_vertex: 0,
-        first_instance: 0,
-    };
-    Baked {
-        tool_version: "test".into(),
-        scene_hash: [1; 32],
-        path_hash: [2; 32],
-        recording_hashes: vec![],
-        settings: RecordSettings::new((64, 32), 4),
-        device: DeviceInfo::default(),
-        merge: MergeInfo::default(),
-        stats: MergeStats::default(),
-        scene_ids: (0..g.triangles.len() as u32).collect(),
-        geometry: g,
-        copies: vec![0, 1, 2, 3],
-        draws: vec![draw],
-        frames: vec![
+    baked(
+        g,
+        vec![0, 1, 2, 3],
+        vec![draw(0, 4)],
+        vec![
             FrameWindow { first: 0, count: 1 },
             FrameWindow { first: 0, count: 1 },
         ],
-        frame_states: vec![
-            frame_at(DVec3::new(0.0, 0.0, 1.0)),
-            frame_at(DVec3::new(0.5, 0.0, 2.0)),
-        ],
-        removed_edges: vec![vec![], vec![]],
-        fps: None,
-        environment: trisort_format::Environment::uniform(1.0),
-    }
-}
-
-fn open(baked: &Baked) -> *mut TrisortBaked {
-    baked.check_structure().unwrap();
-    let bytes = encode(FileKind::Baked, baked);
-    let mut h = null_mut();
-    assert_eq!(
-        unsafe { trisort_open_bytes(bytes.as_ptr(), bytes.len(), &mut h) },
-        TrisortStatus::Ok
-    );
-    h
-}
-
-/// Copies out with the length query first, as a C host does.
-fn get<T: Default + Clone>(
-    mut f: impl FnMut(*mut T, usize, *mut usize) -> TrisortStatus,
-) -> Vec<T> {
-    let mut len = 0;
-    assert_eq!(f(null_mut(), 0, &mut len), TrisortStatus::Ok);
-    let mut out = vec![T::default(); len];
-    assert_eq!(f(out.as_mut_ptr(), len, &mut len), TrisortStatus::Ok);
-    out
+        &[DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.5, 0.0, 2.0)],
+    )
 }
 
 #[test]

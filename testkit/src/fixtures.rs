@@ -26,7 +26,8 @@
 use glam::{DMat4, DVec3};
 
 use trisort_format::{
-    AlphaMode, Camera, FrameState, Geometry, Material, Node, RecordSettings, Vertex,
+    AlphaMode, Baked, Camera, DeviceInfo, DrawIndexedIndirectArgs, FrameState, FrameWindow,
+    Geometry, Material, MergeInfo, MergeStats, Node, RecordSettings, Vertex,
 };
 
 /// Adds a quad spanning `x = [x0, x1]` and `y = [y0, y1]`, at depth z0 along x = x0 and z1
@@ -151,6 +152,50 @@ pub fn settings(size: u32, samples: u32) -> RecordSettings {
         samples,
         robust: trisort_format::Robust::OFF,
         ..Default::default()
+    }
+}
+
+/// The indirect draw of `count` index-buffer triangles from triangle `first` on.
+pub fn draw(first: u32, count: u32) -> DrawIndexedIndirectArgs {
+    DrawIndexedIndirectArgs {
+        index_count: 3 * count,
+        instance_count: 1,
+        first_index: 3 * first,
+        base_vertex: 0,
+        first_instance: 0,
+    }
+}
+
+/// A baked file written by hand, for the readers' tests (the C API's, the C++ wrapper's):
+/// geometry `g` (its scene ids are its triangle ids), the index buffer's triangles `copies`,
+/// the `draws`, each frame's window over them and each frame's eye ([`frame_at`]); recorded at
+/// 64×32 with 4 samples, lit by a uniform white environment, no frame rate, nothing removed.
+/// It is not a bake of anything: only its structure holds (`Baked::check_structure`).
+pub fn baked(
+    g: Geometry,
+    copies: Vec<u32>,
+    draws: Vec<DrawIndexedIndirectArgs>,
+    frames: Vec<FrameWindow>,
+    eyes: &[DVec3],
+) -> Baked {
+    Baked {
+        tool_version: "test".into(),
+        scene_hash: [1; 32],
+        path_hash: [2; 32],
+        recording_hashes: vec![],
+        settings: RecordSettings::new((64, 32), 4),
+        device: DeviceInfo::default(),
+        merge: MergeInfo::default(),
+        stats: MergeStats::default(),
+        scene_ids: (0..g.triangles.len() as u32).collect(),
+        geometry: g,
+        copies,
+        draws,
+        frames,
+        frame_states: eyes.iter().map(|&e| frame_at(e)).collect(),
+        removed_edges: vec![vec![]; eyes.len()],
+        fps: None,
+        environment: trisort_format::Environment::uniform(1.0),
     }
 }
 

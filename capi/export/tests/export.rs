@@ -8,11 +8,8 @@ use glam::DVec3;
 use trisort_export::ffi::{trisort_last_error, TrisortStatus};
 use trisort_export::trisort_export_order;
 use trisort_format::container::encode;
-use trisort_format::{
-    Baked, DeviceInfo, DrawIndexedIndirectArgs, FileKind, FrameWindow, MergeInfo, MergeStats,
-    RecordSettings,
-};
-use trisort_testkit::fixtures::{frame_at, material, quad, scene};
+use trisort_format::{Baked, FileKind, FrameWindow, RecordSettings};
+use trisort_testkit::fixtures::{baked, draw, material, quad, scene};
 
 fn last_error() -> String {
     let mut buf = vec![0u8; 1024];
@@ -21,34 +18,19 @@ fn last_error() -> String {
 }
 
 /// One quad, one frame drawing both its triangles; `index_count` is the draw's (6 is right).
-fn baked(index_count: u32) -> Baked {
+fn one_quad(index_count: u32) -> Baked {
     let mut g = scene(vec![material([1.0, 0.0, 0.0], 1.0)]);
     quad(&mut g, [-1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0], 0);
-    Baked {
-        tool_version: "test".into(),
-        scene_hash: [1; 32],
-        path_hash: [2; 32],
-        recording_hashes: vec![],
-        settings: RecordSettings::new((16, 16), 1),
-        device: DeviceInfo::default(),
-        merge: MergeInfo::default(),
-        stats: MergeStats::default(),
-        scene_ids: (0..g.triangles.len() as u32).collect(),
-        geometry: g,
-        copies: vec![0, 1],
-        draws: vec![DrawIndexedIndirectArgs {
-            index_count,
-            instance_count: 1,
-            first_index: 0,
-            base_vertex: 0,
-            first_instance: 0,
-        }],
-        frames: vec![FrameWindow { first: 0, count: 1 }],
-        frame_states: vec![frame_at(DVec3::new(0.0, 0.0, 1.0))],
-        removed_edges: vec![vec![]],
-        fps: None,
-        environment: trisort_format::Environment::uniform(1.0),
-    }
+    let mut b = baked(
+        g,
+        vec![0, 1],
+        vec![draw(0, 2)],
+        vec![FrameWindow { first: 0, count: 1 }],
+        &[DVec3::new(0.0, 0.0, 1.0)],
+    );
+    b.settings = RecordSettings::new((16, 16), 1);
+    b.draws[0].index_count = index_count;
+    b
 }
 
 fn c(p: &Path) -> CString {
@@ -57,11 +39,14 @@ fn c(p: &Path) -> CString {
 
 #[test]
 fn export_order_refuses_a_structurally_broken_baked_file_before_reading_the_scene() {
-    assert!(baked(6).check_structure().is_ok(), "the fixture is sound");
+    assert!(
+        one_quad(6).check_structure().is_ok(),
+        "the fixture is sound"
+    );
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("broken.baked");
     let out = dir.path().join("broken.order");
-    std::fs::write(&path, encode(FileKind::Baked, &baked(999))).unwrap();
+    std::fs::write(&path, encode(FileKind::Baked, &one_quad(999))).unwrap();
     let (baked_c, scene_c, out_c) = (c(&path), c(&dir.path().join("none.glb")), c(&out));
     let s = unsafe { trisort_export_order(baked_c.as_ptr(), scene_c.as_ptr(), out_c.as_ptr()) };
     assert_eq!(s, TrisortStatus::Format);
@@ -77,7 +62,7 @@ fn export_order_refuses_a_structurally_broken_baked_file_before_reading_the_scen
 fn export_order_names_a_missing_scene_and_a_null_path() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sound.baked");
-    std::fs::write(&path, encode(FileKind::Baked, &baked(6))).unwrap();
+    std::fs::write(&path, encode(FileKind::Baked, &one_quad(6))).unwrap();
     let out = dir.path().join("sound.order");
     let (baked_c, scene_c, out_c) = (c(&path), c(&dir.path().join("none.glb")), c(&out));
     let s = unsafe { trisort_export_order(baked_c.as_ptr(), scene_c.as_ptr(), out_c.as_ptr()) };
