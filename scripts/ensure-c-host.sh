@@ -11,6 +11,8 @@ command -v gcc >/dev/null || missing+=(gcc)
 command -v g++ >/dev/null || missing+=(g++)
 command -v cmake >/dev/null || missing+=(cmake)
 command -v pkg-config >/dev/null || missing+=(pkgconf)
+# spirv-val checks `trisort export-shaders --lang spirv` (tests/c_host.rs).
+command -v spirv-val >/dev/null || missing+=(spirv-tools)
 [ -f /usr/include/EGL/egl.h ] || missing+=(libegl-dev)
 [ -f /usr/include/GLES3/gl3.h ] || missing+=(libgles-dev)
 case "$(ldconfig -p)" in
