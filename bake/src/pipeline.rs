@@ -91,6 +91,13 @@ pub fn bake(
 ) -> Result<Baking, BakeError> {
     if let Some(r) = &settings.frames {
         crate::spec::FrameRange::from(r.clone()).resolve(working.timeline.frames.len() as u32)?;
+        // Refused before recording: the merge would refuse it after the whole recording.
+        if r.start != 0 {
+            return Err(BakeError::RangeNotFromStart {
+                start: r.start,
+                end: r.end,
+            });
+        }
     }
     let t0 = Instant::now();
     let rec_path = recording_path(output);

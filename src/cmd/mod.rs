@@ -74,7 +74,8 @@ pub struct RecordOpts {
     /// Safety bound on peel layers per frame (a frame hitting it is marked truncated).
     #[arg(long, default_value_t = RecordSettings::DEFAULT_MAX_LAYERS)]
     pub max_layers: u32,
-    /// Frames to record, half-open `a..b` (default: all).
+    /// Frames to record, half-open `a..b` (default: all). `bake` takes a range from frame 0
+    /// (`0..b`); `record` any, as a part of a sharded bake.
     #[arg(long, value_parser = parse_range)]
     pub frames: Option<FrameRange>,
     /// Sampling rate for `--path gltf` and generated paths.
