@@ -11,6 +11,8 @@ bash scripts/ensure-c-host.sh
 # gltfpack and gltf-pipeline (npm) make meshopt-, Draco-compressed and quantized copies of
 # CarConcept at test time (scene's import_compressed, tests/compressed_gltf.rs).
 bash scripts/ensure-gltf-tools.sh
+# Python's junitparser reads `verify --junit` reports (tests/verify_forged.rs).
+bash scripts/ensure-junitparser.sh
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp/xdg-runtime-$(id -u)}"
 mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 export TRISORT_SCENES="${TRISORT_SCENES:-$(pwd)/../shared/scenes}"

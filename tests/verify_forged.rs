@@ -9,6 +9,51 @@ use crate::support::*;
 
 const SCENE: &str = "demo:10000";
 
+/// A test case of a JUnit file as a JUnit parser reads it.
+#[derive(Debug)]
+struct JunitCase {
+    name: String,
+    passed: bool,
+    message: String,
+}
+
+/// The test cases of the JUnit XML at `path`, read by Python's junitparser (PyPI; CI installs
+/// it: scripts/ensure-junitparser.sh), which checks the file is JUnit. `None` (a skip) when
+/// junitparser is missing outside CI.
+fn junit_cases(path: &std::path::Path) -> Option<Vec<JunitCase>> {
+    let script = "import json, sys\n\
+        from junitparser import JUnitXml\n\
+        cases = []\n\
+        for suite in JUnitXml.fromfile(sys.argv[1]):\n\
+        \x20   for c in suite:\n\
+        \x20       cases.append([c.name, c.is_passed, ' '.join(r.message or '' for r in c.result)])\n\
+        print(json.dumps(cases))\n";
+    let out = std::process::Command::new("python3")
+        .args(["-c", script])
+        .arg(path)
+        .output()
+        .expect("python3");
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        if err.contains("No module named 'junitparser'") && std::env::var_os("CI").is_none() {
+            eprintln!("skipping the JUnit check: junitparser is missing (pip install junitparser)");
+            return None;
+        }
+        panic!("junitparser could not read {}: {err}", path.display());
+    }
+    let cases: Vec<(String, bool, String)> = serde_json::from_slice(&out.stdout).unwrap();
+    Some(
+        cases
+            .into_iter()
+            .map(|(name, passed, message)| JunitCase {
+                name,
+                passed,
+                message,
+            })
+            .collect(),
+    )
+}
+
 /// An honest bake (the demo car, 3 frames, 64², 4×) in a temporary directory, as `car.baked`
 /// with `car.baked.rec` beside it, decoded.
 struct Honest {
@@ -25,9 +70,18 @@ fn honest() -> Option<Honest> {
     run(dir.path(), &args(&bake), true);
     run(
         dir.path(),
-        &args("verify car.baked --recording car.baked.rec"),
+        &args("verify car.baked --recording car.baked.rec --junit honest.xml"),
         true,
     );
+    // The JUnit report of the honest file: a passing case per frame and the whole file.
+    if let Some(cases) = junit_cases(&dir.path().join("honest.xml")) {
+        let names: Vec<&str> = cases.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(
+            names,
+            ["frame 0", "frame 1", "frame 2", "graph rules (whole file)"]
+        );
+        assert!(cases.iter().all(|c| c.passed), "{cases:?}");
+    }
     let baked = trisort_format::read_file(FileKind::Baked, &dir.path().join("car.baked")).unwrap();
     let rec =
         trisort_format::read_file(FileKind::Recording, &dir.path().join("car.baked.rec")).unwrap();
@@ -174,8 +228,32 @@ fn every_edge_removed_and_the_cells_reversed_is_rejected() {
     );
     assert!(out.contains("graph rules: FAILED"), "{out}");
     // Images with the recording: frame 0 is wrong where nothing excuses it.
-    let images = ["--scene", SCENE, "--frames", "0..1", "--json"];
+    let images = [
+        "--scene",
+        SCENE,
+        "--frames",
+        "0..1",
+        "--json",
+        "--junit",
+        "forged.xml",
+    ];
     let out = h.rejected("every-edge", &forged, &images, &[]);
+    if let Some(cases) = junit_cases(&h.dir.path().join("forged.xml")) {
+        let frame0 = cases.iter().find(|c| c.name == "frame 0").expect("frame 0");
+        assert!(!frame0.passed, "{cases:?}");
+        assert!(
+            frame0.message.contains("graph rules") && frame0.message.contains("images"),
+            "{frame0:?}"
+        );
+        // Every frame lost its edges: each fails its graph rules (images: frame 0 only).
+        assert!(
+            cases
+                .iter()
+                .filter(|c| c.name.starts_with("frame "))
+                .all(|c| !c.passed && c.message.contains("order violations")),
+            "{cases:?}"
+        );
+    }
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let f = &v["frames"][0];
     assert_eq!(f["ok"], false, "{f}");

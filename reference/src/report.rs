@@ -192,3 +192,143 @@ pub fn text_report(
     }
     out
 }
+
+/// `verify --junit FILE`: JUnit XML for CI systems. One test suite named after the baked file;
+/// a test case per checked frame (`frame N`: failed when its graph rules or its image check
+/// failed, the failure saying which figures; skipped when the images were only measured, with
+/// no graph rule to judge), and a test case `graph rules (whole file)` for the file-wide
+/// findings (copies, structure, hashes). Each case's `system-out` holds its figures as JSON.
+pub fn junit_report(
+    baked: &Path,
+    graph: Option<&GraphReport>,
+    images: Option<&(ImageReport, ImageCheck)>,
+    measure_only: bool,
+) -> String {
+    let name = baked.display().to_string();
+    let class = format!(
+        "trisort.verify.{}",
+        baked
+            .file_stem()
+            .map_or_else(|| "baked".into(), |s| s.to_string_lossy())
+    );
+    let mut cases: Vec<JunitCase> = Vec::new();
+    let mut frames: Vec<u32> = graph.map_or_else(Vec::new, |g| {
+        g.frames.iter().map(|f| f.frame).collect::<Vec<_>>()
+    });
+    if let Some((report, _)) = images {
+        frames.extend(report.frames.iter().map(|f| f.frame));
+    }
+    frames.sort_unstable();
+    frames.dedup();
+    for frame in frames {
+        let g = graph.and_then(|g| g.frames.iter().find(|f| f.frame == frame));
+        let i = images.and_then(|(r, _)| r.frames.iter().find(|f| f.frame == frame));
+        let mut failures = Vec::new();
+        if let Some(g) = g.filter(|g| !g.ok()) {
+            failures.push(format!(
+                "graph rules: {} order violations, {} visible triangles not drawn, {} drawn \
+                 twice, {} bridge violations{}",
+                g.graph_violations,
+                g.visible_missing,
+                g.drawn_twice,
+                g.bridge_violations,
+                if g.truncated { ", peel truncated" } else { "" }
+            ));
+        }
+        if let Some(i) = i.filter(|i| !i.ok && !measure_only) {
+            failures.push(format!(
+                "images: {} ordered pixels more than 1/255 off (largest {}/255), {} with a hole \
+                 sample, {} in the wrong order; {} unordered samples",
+                i.comparison.pixels_over_tolerance_ordered,
+                i.comparison.max_channel_diff_ordered,
+                i.hole_pixels,
+                i.order_error_pixels,
+                i.unordered_samples
+            ));
+        }
+        let figures = json!({ "graph": g, "images": i });
+        cases.push(JunitCase {
+            name: format!("frame {frame}"),
+            failure: (!failures.is_empty()).then(|| failures.join("; ")),
+            skipped: failures.is_empty() && measure_only && i.is_some() && g.is_none(),
+            out: figures.to_string(),
+        });
+    }
+    if let Some(g) = graph {
+        let frame_failed = g.frames.iter().any(|f| !f.ok());
+        let whole_file = (!g.ok && !frame_failed) || g.bad_copies > 0;
+        cases.push(JunitCase {
+            name: "graph rules (whole file)".into(),
+            failure: whole_file.then(|| {
+                format!(
+                    "{} copies drawn in no frame, in frames apart or where hidden; {}",
+                    g.bad_copies,
+                    g.problems.join("; ")
+                )
+            }),
+            skipped: false,
+            out: json!({ "problems": g.problems, "bad_copies": g.bad_copies }).to_string(),
+        });
+    }
+    let failures = cases.iter().filter(|c| c.failure.is_some()).count();
+    let skipped = cases.iter().filter(|c| c.skipped).count();
+    let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let counts = format!(
+        "tests=\"{}\" failures=\"{failures}\" errors=\"0\" skipped=\"{skipped}\"",
+        cases.len()
+    );
+    let _ = writeln!(out, "<testsuites name=\"trisort verify\" {counts}>");
+    let _ = writeln!(out, "  <testsuite name=\"{}\" {counts}>", xml(&name));
+    for c in &cases {
+        let _ = writeln!(
+            out,
+            "    <testcase classname=\"{}\" name=\"{}\">",
+            xml(&class),
+            xml(&c.name)
+        );
+        if let Some(f) = &c.failure {
+            let _ = writeln!(
+                out,
+                "      <failure message=\"{}\" type=\"verify\">{}</failure>",
+                xml(f),
+                xml(f)
+            );
+        }
+        if c.skipped {
+            let _ = writeln!(
+                out,
+                "      <skipped message=\"images measured only (--measure-only)\"/>"
+            );
+        }
+        let _ = writeln!(out, "      <system-out>{}</system-out>", xml(&c.out));
+        let _ = writeln!(out, "    </testcase>");
+    }
+    out.push_str("  </testsuite>\n</testsuites>\n");
+    out
+}
+
+/// One test case of [`junit_report`].
+struct JunitCase {
+    name: String,
+    failure: Option<String>,
+    skipped: bool,
+    out: String,
+}
+
+/// `s` escaped for XML text and attribute values.
+fn xml(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            // Control characters are not allowed in XML 1.0.
+            c if (c as u32) < 0x20 && !matches!(c, '\n' | '\t' | '\r') => out.push(' '),
+            c => out.push(c),
+        }
+    }
+    out
+}

@@ -25,7 +25,7 @@ use trisort_gpu::{Gpu, GpuOptions};
 use trisort_player::headless::HeadlessRenderer;
 use trisort_player::Mode;
 use trisort_reference::frames::{verify_images, write_diff, Frames, FramesToVerify, ImageReport};
-use trisort_reference::report::{json_report, text_report};
+use trisort_reference::report::{json_report, junit_report, text_report};
 use trisort_reference::ImageCheck;
 
 use crate::common::{load_scene, parse_range, parse_size, print_json, FrameRange};
@@ -105,6 +105,10 @@ pub struct VerifyArgs {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// Also write the verdict as JUnit XML to FILE, a test case per checked frame (for CI
+    /// systems); written by rename, beside whatever the report prints.
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
     /// `--shading` and `--tonemap`: the player and the exact reference light alike, with the
     /// baked file's environment.
     #[command(flatten)]
@@ -193,6 +197,10 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         0
     };
     let ok = code == 0;
+    if let Some(file) = &a.junit {
+        let xml = junit_report(&a.baked, graph.as_ref(), images.as_ref(), a.measure_only);
+        trisort_format::container::write_bytes_atomic(file, xml.as_bytes())?;
+    }
     let check = images.as_ref().map(|(report, _)| {
         if a.measure_only {
             "measured_only"
