@@ -17,21 +17,9 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::OnceLock;
 
 use crate::support::{args, gpu_tempdir, run};
-
-/// The C API's static library, built next to this test binary (the CLI depends on the crate,
-/// which builds its cdylib and staticlib too).
-fn static_library() -> PathBuf {
-    let deps = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .to_path_buf();
-    let lib = deps.join("libtrisort_capi.a");
-    assert!(lib.exists(), "{} is missing", lib.display());
-    lib
-}
 
 /// Whether the C toolchain and Mesa's EGL/GLES headers are here; CI (which installs them with
 /// scripts/ensure-c-host.sh) requires them.
@@ -57,17 +45,10 @@ pub fn build_host(dir: &Path) -> PathBuf {
         .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-O1", "-I"])
         .arg(root.join("capi/include"))
         .arg(root.join("examples/c-gles/host.c"))
-        .arg(static_library())
-        // -lstdc++: the scene importer links meshoptimizer (C++) through the meshopt crate.
-        .args([
-            "-lEGL",
-            "-lGLESv2",
-            "-lstdc++",
-            "-lpthread",
-            "-ldl",
-            "-lm",
-            "-o",
-        ])
+        .arg(trisort_testkit::capi_static_library())
+        // The player library needs no C++ runtime (scripts/test-capi-package.sh checks the
+        // shared one with ldd).
+        .args(["-lEGL", "-lGLESv2", "-lpthread", "-ldl", "-lm", "-o"])
         .arg(&exe)
         .output()
         .expect("run gcc");
@@ -95,6 +76,22 @@ fn differing(a: &Path, b: &Path, by: u8) -> (usize, u8, usize) {
     (count, max, (a.width() * a.height()) as usize)
 }
 
+/// The demo bake both host tests draw (6 frames, 96², 4×), baked once and written into each
+/// test's directory as `car.baked`.
+fn demo_bake(d: &Path) {
+    static BYTES: OnceLock<Vec<u8>> = OnceLock::new();
+    let bytes = BYTES.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        run(
+            dir.path(),
+            &args("bake demo:10000 --path orbit:frames=6,degrees=120 --size 96x96 --samples 4 -o car.baked"),
+            true,
+        );
+        std::fs::read(dir.path().join("car.baked")).unwrap()
+    });
+    std::fs::write(d.join("car.baked"), bytes).unwrap();
+}
+
 #[test]
 fn c_host_draws_the_demo_bake_like_the_player() {
     if !c_toolchain() {
@@ -103,25 +100,10 @@ fn c_host_draws_the_demo_bake_like_the_player() {
     let Some(dir) = gpu_tempdir() else { return };
     let d = dir.path();
     let host = build_host(d);
-    run(
-        d,
-        &args("bake demo:10000 --path orbit:frames=6,degrees=120 --size 96x96 --samples 4 -o car.baked"),
-        true,
-    );
+    demo_bake(d);
     for mode in ["blend", "depth", "saturate"] {
         let (c_dir, rust_dir) = (d.join(format!("c-{mode}")), format!("rust-{mode}"));
-        std::fs::create_dir_all(&c_dir).unwrap();
-        let out = Command::new(&host)
-            .arg(d.join("car.baked"))
-            .arg(&c_dir)
-            .arg(mode)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "host failed in {mode} mode:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        run_host(&host, &d.join("car.baked"), &c_dir, mode, &[]);
         run(
             d,
             &[
@@ -240,11 +222,7 @@ fn c_host_draws_pbr_with_the_exported_shaders_like_the_player() {
     ] {
         assert!(shaders.join(f).exists(), "export-shaders wrote no {f}");
     }
-    run(
-        d,
-        &args("bake demo:10000 --path orbit:frames=6,degrees=120 --size 96x96 --samples 4 -o car.baked"),
-        true,
-    );
+    demo_bake(d);
     compare_pbr(d, &host, &shaders, "car.baked", 6);
     // A textured scene: the sRGB and linear texture arrays with their mips.
     if let Some(truck) = crate::support::scene("CesiumMilkTruck") {

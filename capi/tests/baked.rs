@@ -14,7 +14,7 @@ use crate::api::last_error;
 
 /// Four quads (8 triangles) in front of each other; the index buffer holds 10 copies, front
 /// to back; frame 0 draws copies 0..4 and 6..10, frame 1 copies 2..8.
-fn sample() -> Baked {
+pub fn sample() -> Baked {
     let mut g = scene(vec![
         material([1.0, 0.0, 0.0], 1.0),
         material([0.0, 0.0, 1.0], 0.5),

@@ -15,27 +15,13 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::ptr::null_mut;
 
-use glam::DVec3;
 use trisort_capi::ffi::*;
 use trisort_format::container::encode;
-use trisort_format::{Baked, FileKind, FrameWindow};
-use trisort_testkit::fixtures::{baked, draw, material, quad, scene};
+use trisort_format::{Baked, FileKind};
 
 /// The repository root (the example and the header are found from it).
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap()
-}
-
-/// The C API's static library, built next to this test binary (the deps directory).
-fn static_library() -> PathBuf {
-    let deps = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .to_path_buf();
-    let lib = deps.join("libtrisort_capi.a");
-    assert!(lib.exists(), "{} is missing", lib.display());
-    lib
 }
 
 /// Whether g++ is here; CI requires it.
@@ -79,7 +65,7 @@ fn build(dir: &Path, expected: bool) -> PathBuf {
     if expected {
         flags.push("-DTRISORT_HPP_NO_EXCEPTIONS");
     }
-    let lib = static_library();
+    let lib = trisort_testkit::capi_static_library();
     let out = gxx_example(
         &flags,
         &[
@@ -104,50 +90,11 @@ fn knows_cxx23() -> bool {
         .is_ok_and(|o| o.status.success())
 }
 
-/// A small baked file: four quads in front of each other (8 triangles), 10 copies in the
-/// index buffer, two frames (0: two draws, 1: one), recorded at 24 fps.
+/// The C API tests' hand-built file (`baked::sample`), recorded at 24 fps.
 fn sample() -> Baked {
-    let mut g = scene(vec![
-        material([1.0, 0.0, 0.0], 1.0),
-        material([0.0, 0.0, 1.0], 0.5),
-    ]);
-    for k in 0..4 {
-        let z = -1.0 - k as f32;
-        quad(&mut g, [-1.0, 1.0], [-1.0, 1.0], [z, z], (k % 2) as u32);
-    }
-    let mut b = baked(
-        g,
-        vec![0, 1, 2, 3, 4, 5, 6, 7, 2, 3],
-        vec![draw(0, 4), draw(6, 4), draw(2, 6)],
-        vec![
-            FrameWindow { first: 0, count: 2 },
-            FrameWindow { first: 2, count: 1 },
-        ],
-        &[DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.5, 0.25, 2.0)],
-    );
+    let mut b = crate::baked::sample();
     b.fps = Some(24.0);
     b
-}
-
-/// `trisort_frame_projection`'s depth argument from its value: the enum `TrisortDepthRange`
-/// up to ABI 4, a `u32` from ABI 5 on (the test compiles against either).
-trait DepthArg {
-    fn of(value: u32) -> Self;
-}
-
-impl DepthArg for u32 {
-    fn of(value: u32) -> Self {
-        value
-    }
-}
-
-impl DepthArg for TrisortDepthRange {
-    fn of(value: u32) -> Self {
-        match value {
-            0 => TrisortDepthRange::ZeroToOne,
-            _ => TrisortDepthRange::MinusOneToOne,
-        }
-    }
 }
 
 /// What the example must print for `frame` of the file at `path`, read through the C API.
@@ -194,9 +141,7 @@ fn expected_report(path: &Path, frame: u32) -> Vec<(&'static str, String)> {
     let aspect = f64::from(info.width) / f64::from(info.height);
     let projection = |depth: u32| {
         let mut p = [0f32; 16];
-        let s = unsafe {
-            trisort_frame_projection(h, frame, aspect, DepthArg::of(depth), p.as_mut_ptr())
-        };
+        let s = unsafe { trisort_frame_projection(h, frame, aspect, depth, p.as_mut_ptr()) };
         assert_eq!(s, TrisortStatus::Ok);
         matrix(p)
     };

@@ -8,6 +8,8 @@
 //! - [`gltfpack`], [`gltf_pipeline`]: glTF tools that make compressed, quantized test scenes
 //!   at test time, or a skip where they are missing, unless `TRISORT_REQUIRE_GLTF_TOOLS=1`
 //!   (CI, after `scripts/ensure-gltf-tools.sh`) makes that a failure;
+//! - [`capi_static_library`]: the C API's archive cargo built beside the test binary, for
+//!   the tests that compile C and C++ against it;
 //! - [`fixtures`]: small hand-built scenes with known answers.
 //!
 //! A crate's own unit tests (`#[cfg(test)]` in its `src/`) cannot use this crate where this
@@ -130,4 +132,14 @@ fn npm_tool(name: &str, env: &str, probe: &[&str], expect: &str) -> Option<PathB
         "skipping: {name} not found ({candidates:?}); run scripts/ensure-gltf-tools.sh or set {env}"
     );
     None
+}
+
+/// The C API's static library (`libtrisort_capi.a`) cargo built in the running test binary's
+/// directory (the deps folder: every crate that depends on trisort-capi builds its staticlib
+/// too), for the tests that compile C and C++ hosts against it. Panics when it is missing.
+pub fn capi_static_library() -> PathBuf {
+    let exe = std::env::current_exe().expect("the test binary's path");
+    let lib = exe.parent().expect("its folder").join("libtrisort_capi.a");
+    assert!(lib.exists(), "{} is missing", lib.display());
+    lib
 }
