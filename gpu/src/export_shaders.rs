@@ -227,7 +227,9 @@ fn glsl_stage(
             .binding
             .as_ref()
             .map(|b| (b.group, b.binding))
-            .unwrap_or((u32::MAX, u32::MAX))
+            // naga reflects bound resources only: an unbound one here is a bug, not a line
+            // of bindings.txt.
+            .expect("a reflected resource has a binding")
     };
     let mut names = StageNames::default();
     for (h, name) in &reflection.uniforms {
