@@ -12,11 +12,12 @@ import json
 import struct
 import sys
 
-# Versions this reader understands (FORMAT.md § Compatibility): 5; 4 (no raster profile in
+# Versions this reader understands (FORMAT.md § Compatibility): 6; 5 (no clips); 4 (no raster
+# profile in
 # `Robust`); 3 (no vertex tangent and
 # uv1, no material texture slots and PBR factors, no texture colour space and mips, no
 # environment); 2 (no `robust`, no `Geometry.variants`, no `fps` either).
-FORMAT_VERSIONS = (2, 3, 4, 5)
+FORMAT_VERSIONS = (2, 3, 4, 5, 6)
 ORDER_VERSION = 1
 
 
@@ -202,6 +203,20 @@ def read_baked(p, version):
             "exposure": p.f32()}
     else:
         b["environment"] = None
+    if version >= 6:
+        b["clips"] = p.seq(lambda: {
+            "name": p.string(), "first": p.u32(), "count": p.u32(), "fps": p.option(p.f64),
+            "path_hash": p.take(32).hex(), "path_first": p.u32()})
+    else:
+        b["clips"] = [{"name": "main", "first": 0, "count": len(b["frames"]), "fps": b["fps"],
+                       "path_hash": b["path_hash"], "path_first": 0}]
+    next_frame = 0
+    for c in b["clips"]:
+        if c["first"] != next_frame or c["count"] == 0:
+            raise Bad("clip %r does not start where the one before ends" % c["name"])
+        next_frame += c["count"]
+    if next_frame != len(b["frames"]):
+        raise Bad("the clips cover %d frames, the file has %d" % (next_frame, len(b["frames"])))
     return b
 
 
@@ -302,6 +317,8 @@ def baked_summary(data):
         "nodes": len(g["nodes"]),
         "variants": [v["name"] for v in g.get("variants", [])],
         "fps": b["fps"],
+        "clips": [{"name": c["name"], "first": c["first"], "count": c["count"], "fps": c["fps"]}
+                  for c in b["clips"]],
         "draws": len(b["draws"]),
         "draws_per_frame_max": max((w[1] for w in b["frames"]), default=0),
         "stats_index_triangles": b["stats"]["index_triangles"],

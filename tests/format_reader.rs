@@ -71,7 +71,7 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
     }
     assert_eq!(ours["stats_index_triangles"], inspect["index_triangles"]);
     assert_eq!(ours["triangles"], ours["unique_visible"]);
-    assert_eq!(ours["format_version"], 5);
+    assert_eq!(ours["format_version"], 6);
     // Version 5: the raster profile, as inspect reports it.
     let profile = &inspect["raster_profile"];
     assert_eq!(ours["raster_profile"]["name"], profile["name"]);

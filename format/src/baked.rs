@@ -144,6 +144,12 @@ pub struct Baked {
     pub fps: Option<f64>,
     /// The light the file is shaded with (the built-in studio unless the bake chose another).
     pub environment: crate::Environment,
+    /// The camera paths the frames belong to, in frame order (a bundle has several; a file
+    /// of one path has one, [`Clip::DEFAULT_NAME`] unless named). Each clip's frames are
+    /// windows over the one index buffer shared by all. `fps` above is the first clip's.
+    ///
+    /// [`Clip::DEFAULT_NAME`]: crate::Clip::DEFAULT_NAME
+    pub clips: Vec<crate::Clip>,
 }
 
 /// Checks a stored frame rate: absent, or finite and positive (a player divides by it).
@@ -252,6 +258,26 @@ impl Baked {
             crate::camera::check_frame_state(f, s, Some(g.nodes.len()))?;
         }
         self.environment.check_structure()?;
+        crate::clip::check_clips(&self.clips, self.frames.len())?;
         check_fps(self.fps)
+    }
+
+    /// The clip named `name`, or an error listing the file's clips.
+    pub fn clip(&self, name: &str) -> Result<&crate::Clip, String> {
+        self.clips.iter().find(|c| c.name == name).ok_or_else(|| {
+            let names: Vec<&str> = self.clips.iter().map(|c| c.name.as_str()).collect();
+            format!(
+                "no clip named {name:?}; the file's clips: {}",
+                names.join(", ")
+            )
+        })
+    }
+
+    /// The clip frame `f` belongs to, with its index.
+    pub fn clip_of_frame(&self, f: u32) -> Option<(usize, &crate::Clip)> {
+        self.clips
+            .iter()
+            .enumerate()
+            .find(|(_, c)| c.frames().contains(&f))
     }
 }

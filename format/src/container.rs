@@ -39,7 +39,7 @@ use serde::Serialize;
 /// second texture coordinate, texture colour spaces and mip chains, and the baked file's
 /// [`crate::Environment`]; 5, [`crate::Robust`] ends with the bake's
 /// [`crate::RasterProfile`].
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 
 /// Decompressed payloads larger than this are refused (16 GiB).
 pub const MAX_PAYLOAD: u64 = 16 << 30;
@@ -101,16 +101,19 @@ pub enum FormatError {
     },
     /// The file is of another version.
     #[error(
-        "{path}: format version {found} is not supported (this trisort reads version \
-         {supported}); record or merge it again with this trisort"
+        "{path}: format version {found} is not supported (this trisort reads {}); record or \
+         merge it again with this trisort", versions_text(*.oldest, *.supported)
     )]
     Version {
         /// The file.
         path: PathBuf,
         /// The version in the file.
         found: u32,
-        /// The version this build reads.
+        /// The version this build writes, the newest it reads.
         supported: u32,
+        /// The oldest version this build reads for this kind of file (baked files of
+        /// earlier versions are migrated in memory; recordings are read only at `supported`).
+        oldest: u32,
     },
     /// The file is shorter or longer than its header says.
     #[error("{path}: truncated or padded: header says {expected} payload bytes, file has {found}")]
@@ -138,6 +141,48 @@ pub enum FormatError {
     },
 }
 
+/// `version 6` or `versions 4 to 6`.
+fn versions_text(oldest: u32, newest: u32) -> String {
+    if oldest == newest {
+        format!("version {newest}")
+    } else {
+        format!("versions {oldest} to {newest}")
+    }
+}
+
+/// A type stored in the container: decoded at [`FORMAT_VERSION`], and at older versions where
+/// it migrates them ([`Baked`](crate::Baked) does, from
+/// [`legacy::OLDEST_READABLE`](crate::legacy::OLDEST_READABLE); a recording does not).
+pub trait Stored: DeserializeOwned {
+    /// The oldest format version read.
+    const OLDEST: u32 = FORMAT_VERSION;
+
+    /// Decodes the postcard payload of an older format `version` (`OLDEST ≤ version <
+    /// FORMAT_VERSION`) and migrates it, or says why it cannot.
+    fn decode_older(version: u32, raw: &[u8]) -> Result<Self, String> {
+        let _ = raw;
+        Err(format!("format version {version} is not migrated"))
+    }
+}
+
+impl Stored for crate::Recording {}
+
+impl Stored for crate::Baked {
+    const OLDEST: u32 = crate::legacy::OLDEST_READABLE;
+
+    fn decode_older(version: u32, raw: &[u8]) -> Result<Self, String> {
+        crate::legacy::decode_baked(version, raw)
+            .unwrap_or_else(|| Err(format!("format version {version} is not migrated")))
+    }
+}
+
+/// The format version of container bytes that start with `kind`'s magic, without checking
+/// more (`None`: too short or another kind).
+pub fn version_of(kind: FileKind, bytes: &[u8]) -> Option<u32> {
+    (bytes.len() >= 12 && &bytes[..8] == kind.magic())
+        .then(|| u32::from_le_bytes(bytes[8..12].try_into().unwrap()))
+}
+
 /// Encodes `value` into the container bytes (not on wasm32: it needs zstd's C library).
 #[cfg(not(target_arch = "wasm32"))]
 pub fn encode<T: Serialize>(kind: FileKind, value: &T) -> Vec<u8> {
@@ -163,26 +208,19 @@ pub fn encode_payload(kind: FileKind, raw: &[u8]) -> Vec<u8> {
     out
 }
 
-/// Decodes container bytes read from `path` (used only in messages).
-pub fn decode<T: DeserializeOwned>(
-    kind: FileKind,
-    bytes: &[u8],
-    path: &Path,
-) -> Result<T, FormatError> {
+/// Decodes container bytes read from `path` (used only in messages), migrating a baked file
+/// of an older version ([`Stored`]).
+pub fn decode<T: Stored>(kind: FileKind, bytes: &[u8], path: &Path) -> Result<T, FormatError> {
     decode_with(kind, bytes, path, cfg!(target_arch = "wasm32"))
 }
 
 /// [`decode`] with the pure-Rust `ruzstd` decompressor on every target (the path wasm32 builds
 /// always take); same checks, same result.
-pub fn decode_pure<T: DeserializeOwned>(
-    kind: FileKind,
-    bytes: &[u8],
-    path: &Path,
-) -> Result<T, FormatError> {
+pub fn decode_pure<T: Stored>(kind: FileKind, bytes: &[u8], path: &Path) -> Result<T, FormatError> {
     decode_with(kind, bytes, path, true)
 }
 
-fn decode_with<T: DeserializeOwned>(
+fn decode_with<T: Stored>(
     kind: FileKind,
     bytes: &[u8],
     path: &Path,
@@ -203,11 +241,12 @@ fn decode_with<T: DeserializeOwned>(
         });
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
-    if version != FORMAT_VERSION {
+    if !(T::OLDEST..=FORMAT_VERSION).contains(&version) {
         return Err(FormatError::Version {
             path: p(),
             found: version,
             supported: FORMAT_VERSION,
+            oldest: T::OLDEST,
         });
     }
     let packed_len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
@@ -241,9 +280,15 @@ fn decode_with<T: DeserializeOwned>(
     // another build whose types differ at the same version (postcard is not self-describing:
     // a field added before a release shifts everything after it).
     let rewrite = format!(
-        "the checksum matches, so another trisort build of format version {FORMAT_VERSION} with a \
+        "the checksum matches, so another trisort build of format version {version} with a \
          different layout probably wrote it: record or merge it again with this trisort"
     );
+    if version != FORMAT_VERSION {
+        return T::decode_older(version, &raw).map_err(|e| FormatError::Payload {
+            path: p(),
+            reason: format!("decoding version {version} failed: {e}; {rewrite}"),
+        });
+    }
     let (value, rest) = postcard::take_from_bytes::<T>(&raw).map_err(|e| FormatError::Payload {
         path: p(),
         reason: format!("decoding failed: {e}; {rewrite}"),
@@ -281,7 +326,7 @@ fn decompress(payload: &[u8], raw_len: u64, pure: bool) -> Result<Vec<u8>, Strin
 }
 
 /// Reads and decodes a file of the given kind.
-pub fn read_file<T: DeserializeOwned>(kind: FileKind, path: &Path) -> Result<T, FormatError> {
+pub fn read_file<T: Stored>(kind: FileKind, path: &Path) -> Result<T, FormatError> {
     let bytes = std::fs::read(path).map_err(|source| FormatError::Io {
         path: path.to_path_buf(),
         source,
@@ -341,6 +386,8 @@ pub fn write_file_atomic<T: Serialize>(
 mod tests {
     use super::*;
 
+    impl Stored for Vec<(u32, String)> {}
+
     fn sample() -> Vec<(u32, String)> {
         (0..1000).map(|i| (i, format!("item {i}"))).collect()
     }
@@ -393,7 +440,7 @@ mod tests {
     }
 
     #[test]
-    fn a_file_of_the_previous_version_is_refused_with_what_to_do() {
+    fn a_file_of_a_version_not_read_is_refused_with_what_to_do() {
         let mut bytes = encode(FileKind::Baked, &sample());
         bytes[8..12].copy_from_slice(&(FORMAT_VERSION - 1).to_le_bytes());
         let err = decode::<Vec<(u32, String)>>(FileKind::Baked, &bytes, Path::new("old.baked"))
@@ -401,15 +448,25 @@ mod tests {
         assert!(matches!(
             err,
             FormatError::Version {
-                found: 4,
-                supported: 5,
+                found: 5,
+                supported: 6,
+                oldest: 6,
                 ..
             }
         ));
         assert_eq!(
             err.to_string(),
-            "old.baked: format version 4 is not supported (this trisort reads version 5); \
+            "old.baked: format version 5 is not supported (this trisort reads version 6); \
              record or merge it again with this trisort"
+        );
+        // A baked file reads back to version 4 (migrated), not version 3.
+        bytes[8..12].copy_from_slice(&3u32.to_le_bytes());
+        let err =
+            decode::<crate::Baked>(FileKind::Baked, &bytes, Path::new("old.baked")).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("format version 3 is not supported (this trisort reads versions 4 to 6)"),
+            "{err}"
         );
     }
 
@@ -447,6 +504,7 @@ mod tests {
             b: Vec<u8>,
             fps: Option<f64>,
         }
+        impl Stored for After {}
         let bytes = encode(
             FileKind::Baked,
             &Before {

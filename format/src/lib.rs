@@ -14,10 +14,12 @@
 
 pub mod baked;
 pub mod camera;
+pub mod clip;
 pub mod container;
 pub mod environment;
 pub mod geometry;
 pub mod gpu_layout;
+pub mod legacy;
 pub mod options;
 pub mod order;
 pub mod recording;
@@ -25,9 +27,10 @@ pub mod structure;
 
 pub use baked::{Baked, DrawIndexedIndirectArgs, FrameWindow, MatrixCell, MergeInfo, MergeStats};
 pub use camera::{world_transforms, Camera, FrameState, NodePose};
+pub use clip::Clip;
 #[cfg(not(target_arch = "wasm32"))]
 pub use container::write_file_atomic;
-pub use container::{read_file, FileKind, FormatError, FORMAT_VERSION};
+pub use container::{read_file, FileKind, FormatError, Stored, FORMAT_VERSION};
 pub use environment::{Environment, Sun};
 pub use geometry::{
     AlphaMode, Geometry, Material, MaterialVariant, Node, Texture, TextureSlot, TextureTransform,

@@ -101,6 +101,9 @@ pub struct Recording {
     /// Frames per second of the path (TOML `fps`, a generator's `--fps`, the glTF sampling
     /// rate), carried into the baked file; `None` where the writer did not know it.
     pub fps: Option<f64>,
+    /// The camera paths `frame_states` is made of, in order (one for a single path; a
+    /// bundle's several), carried into the baked file ([`crate::Baked::clips`]).
+    pub clips: Vec<crate::Clip>,
 }
 
 impl Recording {
@@ -271,6 +274,7 @@ impl Recording {
         for (f, st) in self.frame_states.iter().enumerate() {
             crate::camera::check_frame_state(f, st, nodes)?;
         }
+        crate::clip::check_clips(&self.clips, self.frame_states.len())?;
         crate::baked::check_fps(self.fps)
     }
 
@@ -317,6 +321,7 @@ mod tests {
             unique_visible: vec![2, 5, 9],
             geometry: Geometry::default(),
             fps: Some(30.0),
+            clips: vec![crate::Clip::whole(4, Some(30.0), [0; 32])],
         }
     }
 

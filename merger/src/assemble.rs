@@ -104,6 +104,7 @@ impl Assembled {
             removed_edges,
             fps: first.fps,
             environment: trisort_format::Environment::uniform(0.0),
+            clips: first.clips.clone(),
         }
     }
 }

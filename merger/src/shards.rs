@@ -107,6 +107,7 @@ pub fn differences(a: &Recording, b: &Recording) -> Vec<Difference> {
         frames: _,   // the ranges: what is joined, not compared
         geometry: _, // G's triangles: follows from the scene and G
         fps: _,      // part of the path hash
+        clips: _,    // compared below
     } = a;
     let short = |h: &trisort_format::Hash| hash_hex(h)[..16].to_string();
     let phase = |r: &Recording| format!("{:?}", r.phase).to_lowercase();
@@ -147,6 +148,20 @@ pub fn differences(a: &Recording, b: &Recording) -> Vec<Difference> {
         out.push(Difference {
             device: false,
             what: "frame states (cameras or poses) under one path hash".into(),
+        });
+    }
+    if a.clips != b.clips {
+        let names = |r: &Recording| {
+            let v: Vec<String> = r
+                .clips
+                .iter()
+                .map(|c| format!("{} {}..{}", c.name, c.first, c.first + c.count))
+                .collect();
+            v.join(", ")
+        };
+        out.push(Difference {
+            device: false,
+            what: format!("clips ({} vs {})", names(a), names(b)),
         });
     }
     if a.phase == Phase::Graphs && b.phase == Phase::Graphs && a.unique_visible != b.unique_visible

@@ -135,6 +135,11 @@ pub fn recording_from_frames(scene_triangles: u32, frames: &[FrameSpec]) -> Reco
         unique_visible: g,
         geometry,
         fps: None,
+        clips: vec![trisort_format::Clip::whole(
+            frames.len() as u32,
+            None,
+            trisort_format::hash_bytes(b"synthetic path"),
+        )],
     }
 }
 

@@ -129,6 +129,7 @@ fn auto_chooses_on_the_first_segment() {
     let mut first = rec.clone();
     first.frames.truncate(16);
     first.frame_states.truncate(16);
+    first.clips[0].count = 16;
     let head = std::slice::from_ref(&first);
     let best = merge(head, &only(s, l, Some(16))).unwrap();
     for s2 in Strategy::ALL {

@@ -180,6 +180,7 @@ mod tests {
             removed_edges: vec![],
             fps: None,
             environment: trisort_format::Environment::uniform(1.0),
+            clips: vec![],
         }
     }
 

@@ -234,6 +234,12 @@ pub fn record(
         geometry,
         // The job knows frames, not the path's rate: the CLI sets it from the timeline.
         fps: None,
+        // One clip of the whole path; a bundle's caller replaces it with the bundle's clips.
+        clips: vec![trisort_format::Clip::whole(
+            job.frames.len() as u32,
+            None,
+            job.path_hash,
+        )],
     })
 }
 

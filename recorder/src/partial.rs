@@ -18,6 +18,14 @@ pub struct PartialDir {
     dir: PathBuf,
 }
 
+/// A finished frame's result as stored (its encoding is the value's): read only at the
+/// current format version, like a recording.
+#[derive(serde::Deserialize)]
+#[serde(transparent)]
+struct Finished<T>(T);
+
+impl<T: DeserializeOwned> trisort_format::Stored for Finished<T> {}
+
 /// Phase-1 result of a frame: visible set, layers, truncated.
 pub(crate) type Visibility = (Vec<u32>, u32, bool);
 /// Phase-2 result of a frame: covered, edges, ties, layers, truncated, and the triangles the
@@ -79,7 +87,9 @@ impl PartialDir {
     fn load<T: DeserializeOwned>(&self, name: String) -> Option<T> {
         let path = self.dir.join(name);
         let bytes = std::fs::read(&path).ok()?;
-        decode(FileKind::Recording, &bytes, &path).ok()
+        decode::<Finished<T>>(FileKind::Recording, &bytes, &path)
+            .ok()
+            .map(|f| f.0)
     }
 
     fn store<T: Serialize>(&self, name: String, value: &T) -> Result<(), FormatError> {

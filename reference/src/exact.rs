@@ -350,6 +350,7 @@ pub fn whole_scene_baked(
         removed_edges: vec![vec![]; frames.len()],
         fps: None,
         environment: environment.clone(),
+        clips: vec![trisort_format::Clip::whole(frame_count, None, [0; 32])],
     }
 }
 

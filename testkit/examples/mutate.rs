@@ -165,7 +165,7 @@ fn mutate_bytes(mut bytes: Vec<u8>, rng: &mut Rng) -> Vec<u8> {
     bytes
 }
 
-fn mutant<T: Serialize + DeserializeOwned>(
+fn mutant<T: Serialize + trisort_format::Stored>(
     kind: FileKind,
     input: &Path,
     seed: u64,

@@ -196,6 +196,11 @@ pub fn baked(
         removed_edges: vec![vec![]; eyes.len()],
         fps: None,
         environment: trisort_format::Environment::uniform(1.0),
+        clips: vec![trisort_format::Clip::whole(
+            eyes.len() as u32,
+            None,
+            [2; 32],
+        )],
     }
 }
 

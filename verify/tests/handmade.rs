@@ -94,6 +94,7 @@ fn recording() -> Recording {
         unique_visible: vec![A, H, B],
         geometry: geometry(3),
         fps: None,
+        clips: vec![trisort_format::Clip::whole(2, None, [2; 32])],
     }
 }
 
@@ -146,6 +147,7 @@ fn baked(
         removed_edges: vec![vec![], vec![]],
         fps: rec.fps,
         environment: trisort_format::Environment::uniform(1.0),
+        clips: rec.clips.clone(),
     };
     restat(&mut b, rec);
     b
@@ -469,12 +471,14 @@ fn a_cycle_through_forty_thousand_triangles() {
         unique_visible: all.clone(),
         scene_triangles: n,
         geometry: geometry(n),
+        clips: vec![trisort_format::Clip::whole(1, None, [2; 32])],
         ..recording()
     };
     let mut b = baked(&rec, Bridge::Visible, all, &[(0, n)], &[]);
     b.frames.truncate(1);
     b.frame_states.truncate(1);
     b.removed_edges.truncate(1);
+    b.clips[0].count = 1;
     b.removed_edges[0] = vec![local(n - 1, 0, 1)];
     restat(&mut b, &rec);
     let r = check_graph(std::slice::from_ref(&rec), &b);

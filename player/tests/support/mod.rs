@@ -104,6 +104,7 @@ pub fn quads() -> Baked {
         removed_edges: vec![vec![]; frames],
         fps: None,
         environment: trisort_format::Environment::uniform(1.0),
+        clips: vec![trisort_format::Clip::whole(frames as u32, None, [2; 32])],
     }
 }
 
@@ -280,5 +281,6 @@ pub fn faces() -> Baked {
     ];
     b.frame_states = vec![frame_state(); 2];
     b.removed_edges = vec![vec![]; 2];
+    b.clips[0].count = 2;
     b
 }
