@@ -41,6 +41,14 @@ pub enum PlayerError {
     /// ([`Player::set_variant`](crate::Player::set_variant)).
     #[error(transparent)]
     Variant(#[from] trisort_format::VariantError),
+    /// A clip name the file does not have ([`Player::set_clip`](crate::Player::set_clip)).
+    #[error("no clip named {name:?}; the file's clips: {}", clips.join(", "))]
+    UnknownClip {
+        /// The name asked for.
+        name: String,
+        /// The file's clips, in frame order.
+        clips: Vec<String>,
+    },
     /// The device was lost or a readback failed.
     #[error("GPU readback failed: {0}")]
     Readback(String),

@@ -40,7 +40,9 @@ pub use error::PlayerError;
 #[cfg(not(target_arch = "wasm32"))]
 pub use headless::{render_frames, HeadlessConfig, HeadlessRenderer, RenderedFrame};
 pub use on_screen::{OnScreen, OnScreenSettings};
-pub use player::{baked_from_bytes, blend_state, fragment_entry_point, open_baked, Player};
+pub use player::{
+    baked_from_bytes, blend_state, clip_index, fragment_entry_point, open_baked, Player,
+};
 #[cfg(not(target_arch = "wasm32"))]
 pub use self_check::{SelfCheck, SelfCheckFrame};
 pub use trisort_format::{Mode, ParseOptionError};

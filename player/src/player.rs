@@ -1,8 +1,9 @@
 //! [`Player`]: uploads a baked file once and draws a frame with one multi-draw-indirect call.
 
+use std::ops::Range;
 use std::path::Path;
 
-use trisort_format::{Baked, DrawIndexedIndirectArgs, FileKind, FrameWindow, Material};
+use trisort_format::{Baked, Clip, DrawIndexedIndirectArgs, FileKind, FrameWindow, Material};
 use trisort_gpu::scene_gpu::{Bindings, SceneGpu, ScenePipeline, View};
 use wgpu::util::DeviceExt;
 
@@ -59,6 +60,10 @@ pub struct Player {
     /// worked out once from the file's geometry.
     materials: Vec<Material>,
     variants: Vec<(String, Result<Vec<Material>, trisort_format::VariantError>)>,
+    /// The file's clips (at least one, covering the frames in order) and the index of the
+    /// one selected ([`Player::set_clip`]).
+    clips: Vec<Clip>,
+    clip: usize,
 }
 
 impl Player {
@@ -188,6 +193,8 @@ impl Player {
                     (v.name.clone(), table)
                 })
                 .collect(),
+            clips: baked.clips.clone(),
+            clip: 0,
         })
     }
 
@@ -224,6 +231,39 @@ impl Player {
     /// The names of the file's material variants, in file order.
     pub fn variant_names(&self) -> Vec<String> {
         self.variants.iter().map(|(n, _)| n.clone()).collect()
+    }
+
+    /// The file's clips (its camera paths), in frame order: at least one, together covering
+    /// every frame ([`Baked::clips`]).
+    pub fn clips(&self) -> &[Clip] {
+        &self.clips
+    }
+
+    /// The selected clip: the first until [`Player::set_clip`] selects another.
+    pub fn clip(&self) -> &Clip {
+        &self.clips[self.clip]
+    }
+
+    /// The index of the selected clip in [`Player::clips`].
+    pub fn clip_index(&self) -> usize {
+        self.clip
+    }
+
+    /// The file's frames the selected clip spans: what a host plays, in order, to play the
+    /// clip. Frame indices stay the file's: pass them to [`Player::draw`] as they are (frame
+    /// `clip_frames().start` is the clip's frame 0).
+    pub fn clip_frames(&self) -> Range<u32> {
+        self.clip().frames()
+    }
+
+    /// Selects the clip named `name` (see [`Player::clip_frames`]). Every frame of the file
+    /// stays drawable; the selection only says which frames the clip's playback iterates.
+    ///
+    /// Errors, leaving the selection as it was, with [`PlayerError::UnknownClip`] (listing
+    /// the file's clips) when the file has no clip of that name.
+    pub fn set_clip(&mut self, name: &str) -> Result<(), PlayerError> {
+        self.clip = clip_index(&self.clips, name)?;
+        Ok(())
     }
 
     /// Draws frame `frame` into `pass`: binds the pipeline, the frame's uniforms and node
@@ -345,6 +385,18 @@ impl Player {
     pub fn warnings(&self) -> &[String] {
         &self.warnings
     }
+}
+
+/// The index of the clip named `name` among `clips`, or [`PlayerError::UnknownClip`] listing
+/// their names (for hosts that pick a clip before building a [`Player`]).
+pub fn clip_index(clips: &[Clip], name: &str) -> Result<usize, PlayerError> {
+    clips
+        .iter()
+        .position(|c| c.name == name)
+        .ok_or_else(|| PlayerError::UnknownClip {
+            name: name.to_string(),
+            clips: clips.iter().map(|c| c.name.clone()).collect(),
+        })
 }
 
 /// The fragment entry point of [`trisort_gpu::PLAYER`] a mode uses: straight alpha for

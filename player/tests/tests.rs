@@ -5,6 +5,7 @@
 mod support;
 
 mod baked_file;
+mod clips;
 mod play;
 mod self_check;
 mod shading;
