@@ -86,9 +86,12 @@
  * `trisort_gpu_environment_level()`: `trisort export-shaders`), and takes the projection's depth
  * range as a `uint32_t` (the same values and calling convention as the enum it was; an
  * out-of-range value is now `TRISORT_STATUS_OUT_OF_RANGE` instead of undefined behaviour);
- * `trisort_export_order()` moved to `libtrisort_export` (`trisort_export.h`).
+ * `trisort_export_order()` moved to `libtrisort_export` (`trisort_export.h`). 6 added the
+ * clips of a file of format 6, the camera paths it bundles (`trisort_clip_count()`,
+ * `trisort_clip_name()`, `trisort_clip_frames()`, `trisort_clip_fps()`,
+ * `trisort_clip_find()`).
  */
-#define TRISORT_ABI_VERSION 5
+#define TRISORT_ABI_VERSION 6
 
 /**
  * The baked-file format version this header's library reads (`trisort_format_version()`
@@ -217,8 +220,9 @@ typedef enum TrisortStatus {
    */
   TRISORT_STATUS_PANIC = 7,
   /**
-   * The file holds no such thing: no frame rate (`trisort_fps()`), no material variant of
-   * that name (`trisort_variant_materials()`). The message says what is missing.
+   * The file holds no such thing: no frame rate (`trisort_fps()`, `trisort_clip_fps()`),
+   * no material variant of that name (`trisort_variant_materials()`), no clip of that name
+   * (`trisort_clip_find()`). The message says what is missing.
    */
   TRISORT_STATUS_ABSENT = 8,
   /**
@@ -1021,6 +1025,71 @@ enum TrisortStatus trisort_raster_profile(const struct TrisortBaked *h,
  */
 enum TrisortStatus trisort_check_device(const struct TrisortBaked *h,
                                         const struct TrisortDeviceRaster *device);
+
+/**
+ * Stores the number of clips in `*out`: the camera paths the file bundles (a car's start-up
+ * tour and its "door open" path sharing one index buffer), at least 1. Clip k (below this
+ * count) is a run of consecutive frames (`trisort_clip_frames()`); the clips cover the
+ * file's frames in order from frame 0. Frame numbers everywhere else in this API are the
+ * file's: a host plays clip k by drawing frames `first .. first + count - 1`. Added in ABI 6.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
+enum TrisortStatus trisort_clip_count(const struct TrisortBaked *h, uint32_t *out);
+
+/**
+ * Copies the name of clip `clip` (below `trisort_clip_count()`) as a NUL-terminated string;
+ * `cap` and `len` count bytes (the string convention, top of this header). A name is 1 to 64
+ * ASCII letters, digits, `_`, `-` and `.`, unique within the file; "main" is the name of the
+ * only clip of a file baked from one unnamed path. An index past the clips is
+ * `TRISORT_STATUS_OUT_OF_RANGE`. Added in ABI 6.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is null or valid for `cap` byte writes; `len` is null or
+ * valid for one write.
+ */
+enum TrisortStatus trisort_clip_name(const struct TrisortBaked *h,
+                                     uint32_t clip,
+                                     char *out,
+                                     size_t cap,
+                                     size_t *len);
+
+/**
+ * Stores the frames of clip `clip` (below `trisort_clip_count()`): its first frame among the
+ * file's frames in `*first` and its number of frames (at least 1) in `*count`, so it spans
+ * frames `*first .. *first + *count - 1`. Both pointers are required (nothing is written
+ * when either is null). An index past the clips is `TRISORT_STATUS_OUT_OF_RANGE`. Added in
+ * ABI 6.
+ *
+ * # Safety
+ * `h` is an open handle; `first` and `count` are valid for one write each.
+ */
+enum TrisortStatus trisort_clip_frames(const struct TrisortBaked *h,
+                                       uint32_t clip,
+                                       uint32_t *first,
+                                       uint32_t *count);
+
+/**
+ * Stores the frame rate clip `clip` (below `trisort_clip_count()`) plays at by default in
+ * `*out`. As `trisort_fps()`: when the file stores none for the clip, writes 0 to `*out` and
+ * returns `TRISORT_STATUS_ABSENT`; a stored rate is always finite and positive. An index
+ * past the clips is `TRISORT_STATUS_OUT_OF_RANGE`. Added in ABI 6.
+ *
+ * # Safety
+ * `h` is an open handle; `out` is valid for one write.
+ */
+enum TrisortStatus trisort_clip_fps(const struct TrisortBaked *h, uint32_t clip, double *out);
+
+/**
+ * Stores the index of the clip named `name` (NUL-terminated UTF-8, compared byte for byte)
+ * in `*out`. When no clip has this name, returns `TRISORT_STATUS_ABSENT` with a message
+ * naming the file and listing its clips, and leaves `*out` as it was. Added in ABI 6.
+ *
+ * # Safety
+ * `h` is an open handle; `name` is a NUL-terminated string; `out` is valid for one write.
+ */
+enum TrisortStatus trisort_clip_find(const struct TrisortBaked *h, const char *name, uint32_t *out);
 
 /**
  * Stores the figures of the light the file is shaded with in `*out` (its name:

@@ -28,7 +28,8 @@
  * Conventions, thread safety and lifetimes are the C API's (the top of trisort.h): a handle
  * may be read from several threads at once; an Error reads the calling thread's last error
  * right after the call that failed. Wrapped: the functions of ABI 4, and format_version()
- * and version_string() when the included trisort.h is of ABI 5 or later. Not wrapped: the
+ * and version_string() when the included trisort.h is of ABI 5 or later, Baked::clips() and
+ * Baked::find_clip() when it is of ABI 6 or later. Not wrapped: the
  * `trisort_gpu_*` functions of ABI 5 (call them with Baked::get()) and writing ORDER files
  * (trisort_export_order(), libtrisort_export).
  *
@@ -301,6 +302,24 @@ struct DeviceCheck {
     /** Every difference (the C API's message), empty when `matches`. */
     std::string differences;
 };
+
+#if TRISORT_ABI_VERSION >= 6
+/**
+ * A clip: one camera path of the file (Baked::clips()). It spans the file's frames
+ * `first .. first + count - 1`; frame numbers elsewhere are the file's, so a host plays the
+ * clip by drawing those frames.
+ */
+struct Clip {
+    /** The clip's name ("main" for the only clip of a file baked from one unnamed path). */
+    std::string name;
+    /** Its first frame among the file's frames. */
+    std::uint32_t first = 0;
+    /** Its number of frames (at least 1). */
+    std::uint32_t count = 0;
+    /** The rate it plays at by default, or std::nullopt when the file stores none. */
+    std::optional<double> fps;
+};
+#endif
 
 /** The ABI version of the library actually linked (trisort_abi_version()). */
 inline std::uint32_t abi_version() noexcept { return trisort_abi_version(); }
@@ -725,6 +744,54 @@ public:
                 return trisort_variant_materials(h_.get(), name.c_str(), o, c, l);
             });
     }
+
+#if TRISORT_ABI_VERSION >= 6
+    /** The file's clips (at least one), in file order: together they cover its frames. */
+    result<std::vector<Clip>> clips() const {
+        std::uint32_t n = 0;
+        TrisortStatus s = trisort_clip_count(h_.get(), &n);
+        if (s != TRISORT_STATUS_OK) {
+            return detail::fail<std::vector<Clip>>(s);
+        }
+        std::vector<Clip> clips(n);
+        for (std::uint32_t k = 0; k < n; ++k) {
+            Clip &c = clips[k];
+            auto name = detail::copy_string([&](char *o, std::size_t cap, std::size_t *l) {
+                return trisort_clip_name(h_.get(), k, o, cap, l);
+            });
+#if defined(TRISORT_HPP_NO_EXCEPTIONS)
+            if (!name) {
+                return result<std::vector<Clip>>(unexpect, name.error());
+            }
+            c.name = std::move(*name);
+#else
+            c.name = std::move(name);
+#endif
+            s = trisort_clip_frames(h_.get(), k, &c.first, &c.count);
+            if (s != TRISORT_STATUS_OK) {
+                return detail::fail<std::vector<Clip>>(s);
+            }
+            double fps = 0.0;
+            s = trisort_clip_fps(h_.get(), k, &fps);
+            if (s == TRISORT_STATUS_OK) {
+                c.fps = fps;
+            } else if (s != TRISORT_STATUS_ABSENT) {
+                return detail::fail<std::vector<Clip>>(s);
+            }
+        }
+        return clips;
+    }
+
+    /**
+     * The index of the clip named `name` (for clips()). Fails with TRISORT_STATUS_ABSENT when
+     * no clip has the name; the message lists the file's clips.
+     */
+    result<std::uint32_t> find_clip(const std::string &name) const {
+        return detail::store<std::uint32_t>([&](std::uint32_t *out) {
+            return trisort_clip_find(h_.get(), name.c_str(), out);
+        });
+    }
+#endif
 
 private:
     std::unique_ptr<TrisortBaked, detail::CloseBaked> h_;

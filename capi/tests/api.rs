@@ -194,3 +194,160 @@ fn order_handles_copy_out_by_the_buffer_convention() {
     assert_eq!(s, TrisortStatus::Format);
     assert!(last_error().contains("junk.order"));
 }
+
+/// The C API tests' hand-built file (`baked::sample`, 2 frames) as a bundle of two clips:
+/// "intro" (frame 0, 24 fps) and "door-open" (frame 1, no rate stored).
+pub fn two_clips() -> trisort_format::Baked {
+    let mut b = crate::baked::sample();
+    let clip = |name: &str, first, fps| trisort_format::Clip {
+        name: name.into(),
+        first,
+        count: 1,
+        fps,
+        path_hash: [first as u8 + 3; 32],
+        path_first: 0,
+    };
+    b.clips = vec![clip("intro", 0, Some(24.0)), clip("door-open", 1, None)];
+    b.check_structure().unwrap();
+    b
+}
+
+/// A clip's name copied out as a host does (length query, then the copy).
+fn clip_name(h: *const TrisortBaked, clip: u32) -> Result<String, TrisortStatus> {
+    let mut len = 0;
+    let s = unsafe { trisort_clip_name(h, clip, null_mut(), 0, &mut len) };
+    if s != TrisortStatus::Ok {
+        return Err(s);
+    }
+    let mut buf = vec![0x55u8; len + 1];
+    let s = unsafe { trisort_clip_name(h, clip, buf.as_mut_ptr().cast(), buf.len(), &mut len) };
+    assert_eq!(s, TrisortStatus::Ok);
+    assert_eq!(buf[len], 0, "NUL-terminated");
+    buf.truncate(len);
+    Ok(String::from_utf8(buf).unwrap())
+}
+
+#[test]
+fn clips_give_names_frame_ranges_and_rates_and_refuse_bad_indices() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("bundle.baked");
+    trisort_format::write_file_atomic(trisort_format::FileKind::Baked, &file, &two_clips())
+        .unwrap();
+    let c = CString::new(file.to_str().unwrap()).unwrap();
+    let mut h: *mut TrisortBaked = null_mut();
+    assert_eq!(
+        unsafe { trisort_open_path(c.as_ptr(), &mut h) },
+        TrisortStatus::Ok
+    );
+    let mut n = 0;
+    assert_eq!(unsafe { trisort_clip_count(h, &mut n) }, TrisortStatus::Ok);
+    assert_eq!(n, 2);
+
+    let names: Vec<String> = (0..n).map(|k| clip_name(h, k).unwrap()).collect();
+    assert_eq!(names, ["intro", "door-open"]);
+    let frames: Vec<(u32, u32)> = (0..n)
+        .map(|k| {
+            let (mut first, mut count) = (99, 99);
+            let s = unsafe { trisort_clip_frames(h, k, &mut first, &mut count) };
+            assert_eq!(s, TrisortStatus::Ok);
+            (first, count)
+        })
+        .collect();
+    assert_eq!(frames, [(0, 1), (1, 1)]);
+    let mut fps = -1.0;
+    assert_eq!(
+        unsafe { trisort_clip_fps(h, 0, &mut fps) },
+        TrisortStatus::Ok
+    );
+    assert_eq!(fps, 24.0);
+    // No rate stored: ABSENT, 0 written, as trisort_fps().
+    assert_eq!(
+        unsafe { trisort_clip_fps(h, 1, &mut fps) },
+        TrisortStatus::Absent
+    );
+    assert_eq!(fps, 0.0);
+    let e = last_error();
+    assert!(e.contains("bundle.baked") && e.contains("door-open"), "{e}");
+
+    // Found by name; an unknown name is ABSENT, listing the clips, *out untouched.
+    let mut k = 7;
+    let door = CString::new("door-open").unwrap();
+    let s = unsafe { trisort_clip_find(h, door.as_ptr(), &mut k) };
+    assert_eq!((s, k), (TrisortStatus::Ok, 1));
+    assert_eq!(last_error(), "");
+    let mut k = 7;
+    let trunk = CString::new("trunk").unwrap();
+    let s = unsafe { trisort_clip_find(h, trunk.as_ptr(), &mut k) };
+    assert_eq!((s, k), (TrisortStatus::Absent, 7));
+    let e = last_error();
+    assert!(
+        e.contains("bundle.baked") && e.contains("\"trunk\"") && e.contains("intro, door-open"),
+        "{e}"
+    );
+
+    // Out of range: every per-clip function, with a message naming the file and the index.
+    let (mut first, mut count) = (5, 5);
+    assert_eq!(clip_name(h, 2), Err(TrisortStatus::OutOfRange));
+    assert!(last_error().contains("clip 2 is out of range (2 clips)"));
+    let s = unsafe { trisort_clip_frames(h, 2, &mut first, &mut count) };
+    assert_eq!((s, first, count), (TrisortStatus::OutOfRange, 5, 5));
+    assert_eq!(
+        unsafe { trisort_clip_fps(h, u32::MAX, &mut fps) },
+        TrisortStatus::OutOfRange
+    );
+    assert!(last_error().contains("bundle.baked"), "{}", last_error());
+
+    // Null pointers.
+    let null_h: *const TrisortBaked = null();
+    assert_eq!(
+        unsafe { trisort_clip_count(null_h, &mut n) },
+        TrisortStatus::NullArgument
+    );
+    assert_eq!(
+        unsafe { trisort_clip_count(h, null_mut()) },
+        TrisortStatus::NullArgument
+    );
+    assert_eq!(
+        unsafe { trisort_clip_name(h, 0, null_mut(), 0, null_mut()) },
+        TrisortStatus::NullArgument
+    );
+    let mut small = [0x55u8; 5];
+    let s = unsafe { trisort_clip_name(h, 0, small.as_mut_ptr().cast(), 5, null_mut()) };
+    assert_eq!((s, small[0]), (TrisortStatus::BufferTooSmall, 0x55));
+    let s = unsafe { trisort_clip_frames(h, 0, null_mut(), &mut count) };
+    assert_eq!((s, count), (TrisortStatus::NullArgument, 5));
+    let s = unsafe { trisort_clip_frames(h, 0, &mut first, null_mut()) };
+    assert_eq!((s, first), (TrisortStatus::NullArgument, 5));
+    assert_eq!(
+        unsafe { trisort_clip_fps(h, 0, null_mut()) },
+        TrisortStatus::NullArgument
+    );
+    assert_eq!(
+        unsafe { trisort_clip_find(h, null(), &mut k) },
+        TrisortStatus::NullArgument
+    );
+    assert!(last_error().contains("name"), "{}", last_error());
+    assert_eq!(
+        unsafe { trisort_clip_find(h, door.as_ptr(), null_mut()) },
+        TrisortStatus::NullArgument
+    );
+    assert_eq!(
+        unsafe { trisort_clip_find(null_h, door.as_ptr(), &mut k) },
+        TrisortStatus::NullArgument
+    );
+    unsafe { trisort_close(h) };
+
+    // A file of one unnamed path has one clip, "main", over all its frames.
+    let h = crate::baked::open(&crate::baked::sample());
+    assert_eq!(unsafe { trisort_clip_count(h, &mut n) }, TrisortStatus::Ok);
+    assert_eq!((n, clip_name(h, 0).unwrap()), (1, "main".to_string()));
+    let s = unsafe { trisort_clip_frames(h, 0, &mut first, &mut count) };
+    assert_eq!((s, first, count), (TrisortStatus::Ok, 0, 2));
+    let main = CString::new("main").unwrap();
+    assert_eq!(
+        unsafe { trisort_clip_find(h, main.as_ptr(), &mut k) },
+        TrisortStatus::Ok
+    );
+    assert_eq!(k, 0);
+    unsafe { trisort_close(h) };
+}

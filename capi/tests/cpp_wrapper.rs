@@ -90,9 +90,10 @@ fn knows_cxx23() -> bool {
         .is_ok_and(|o| o.status.success())
 }
 
-/// The C API tests' hand-built file (`baked::sample`), recorded at 24 fps.
+/// The C API tests' hand-built file (`baked::sample`), recorded at 24 fps, as a bundle of
+/// two clips (`api::two_clips`: "intro" at 24 fps and "door-open" with no rate).
 fn sample() -> Baked {
-    let mut b = crate::baked::sample();
+    let mut b = crate::api::two_clips();
     b.fps = Some(24.0);
     b
 }
@@ -180,9 +181,36 @@ fn expected_report(path: &Path, frame: u32) -> Vec<(&'static str, String)> {
         ("projection zero to one", projection(0)),
         ("projection minus one to one", projection(1)),
         ("node matrices", info.node_count.to_string()),
+        ("clips", clips_line(h)),
+        ("last clip found", "1".into()),
     ];
     unsafe { trisort_close(h) };
     report
+}
+
+/// The example's `clips` line for the file open as `h`, read through the C API: the count,
+/// then per clip `'NAME' FIRST+COUNT @FPS` (`@none` without a rate).
+fn clips_line(h: *const TrisortBaked) -> String {
+    let mut n = 0;
+    assert_eq!(unsafe { trisort_clip_count(h, &mut n) }, TrisortStatus::Ok);
+    let mut line = n.to_string();
+    for k in 0..n {
+        let mut buf = [0u8; 80];
+        let mut len = 0;
+        let s = unsafe { trisort_clip_name(h, k, buf.as_mut_ptr().cast(), 80, &mut len) };
+        assert_eq!(s, TrisortStatus::Ok);
+        let (mut first, mut count, mut fps) = (0, 0, 0.0);
+        let s = unsafe { trisort_clip_frames(h, k, &mut first, &mut count) };
+        assert_eq!(s, TrisortStatus::Ok);
+        let fps = match unsafe { trisort_clip_fps(h, k, &mut fps) } {
+            TrisortStatus::Ok => fps.to_string(),
+            TrisortStatus::Absent => "none".into(),
+            s => panic!("trisort_clip_fps: {s:?}"),
+        };
+        let name = std::str::from_utf8(&buf[..len]).unwrap();
+        line += &format!(" '{name}' {first}+{count} @{fps}");
+    }
+    line
 }
 
 /// The `key: value` lines of the example's output.

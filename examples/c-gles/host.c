@@ -3,11 +3,14 @@
  * own small shaders, one glDrawElements per range, and writes each frame as a PNG.
  *
  *   host BAKED OUT_DIR [blend|depth|saturate] [--shading basic|pbr] [--shaders DIR]
+ *        [--clip NAME]
  *
  * `--shading basic` (the default) draws with this file's own small shaders (one light plus
  * ambient); `--shading pbr` draws with the player's own shaders as `trisort export-shaders
  * --lang glsl-es-300 -o DIR` writes them (physically based, lit by the file's environment,
  * tone mapped), loaded from DIR, fed the bytes the player uploads (trisort_gpu_*()).
+ * `--clip NAME` draws only the frames of the clip (camera path) of that name; frame numbers
+ * (and the PNG names) stay the file's. Without it every frame of every clip is drawn.
  *
  * Frames are drawn at the size and MSAA sample count the file was recorded at, into a linear
  * RGBA16F target, and quantized once to 8-bit sRGB as trisort's own player does; so on the same
@@ -506,10 +509,10 @@ int main(int argc, char **argv) {
     float *node_texels, *material_texels, *pixels, proj[16];
     unsigned char *rgba;
     size_t nv, nidx, nm, nn = 0, nr, k;
-    uint32_t f, tw = 1, th = 1, t, w, hgt, samples, x, y;
+    uint32_t f, tw = 1, th = 1, t, w, hgt, samples, x, y, clip, first = 0, count;
     GLuint prog = 0, vao, vbo, ibo, nodes_tex = 0, materials_tex, array_tex, fbo[2], rb[3];
     int bytes_per_index, back_to_front, pbr = 0, a;
-    const char *mode_name = NULL, *shaders = NULL;
+    const char *mode_name = NULL, *shaders = NULL, *clip_name = NULL;
     char path[4096];
     Pbr pbr_state = {0, 0, 1};
 
@@ -520,6 +523,8 @@ int main(int argc, char **argv) {
             else if (strcmp(argv[a], "basic") != 0) die("--shading must be basic or pbr");
         } else if (!strcmp(argv[a], "--shaders") && a + 1 < argc) {
             shaders = argv[++a];
+        } else if (!strcmp(argv[a], "--clip") && a + 1 < argc) {
+            clip_name = argv[++a];
         } else if (!mode_name && argv[a][0] != '-') {
             mode_name = argv[a];
         } else {
@@ -528,13 +533,19 @@ int main(int argc, char **argv) {
     }
     if (argc < 3) {
         fprintf(stderr, "usage: host BAKED OUT_DIR [blend|depth|saturate] [--shading basic|pbr] "
-                        "[--shaders DIR]\n");
+                        "[--shaders DIR] [--clip NAME]\n");
         return 2;
     }
     if (pbr && !shaders) die("--shading pbr needs --shaders DIR (trisort export-shaders --lang glsl-es-300 -o DIR)");
     if (trisort_abi_version() != TRISORT_ABI_VERSION) die("libtrisort_capi's ABI differs from trisort.h");
     check(trisort_open_path(argv[1], &h), "trisort_open_path");
     check(trisort_info(h, &info), "trisort_info");
+    count = info.frame_count;
+    if (clip_name) {
+        /* A clip is a run of the file's frames; an unknown name fails listing the clips. */
+        check(trisort_clip_find(h, clip_name, &clip), "trisort_clip_find");
+        check(trisort_clip_frames(h, clip, &first, &count), "trisort_clip_frames");
+    }
     mode = info.recommended_mode;
     if (mode_name) {
         if (!strcmp(mode_name, "blend")) mode = TRISORT_MODE_BLEND;
@@ -744,7 +755,7 @@ int main(int argc, char **argv) {
     pixels = xmalloc((size_t)w * hgt * 4 * sizeof(float));
     rgba = xmalloc((size_t)w * hgt * 4);
     ranges = NULL;
-    for (f = 0; f < info.frame_count; f++) {
+    for (f = first; f < first + count; f++) {
         check(trisort_frame_projection(h, f, (double)w / (double)hgt,
                                        TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE, proj),
               "trisort_frame_projection");
@@ -805,7 +816,7 @@ int main(int argc, char **argv) {
         write_png(path, rgba, w, hgt);
     }
     printf("host: drew %u frames (%s, %s shading) at %ux%u, %ux MSAA into %s\n",
-           (unsigned)info.frame_count,
+           (unsigned)count,
            mode == TRISORT_MODE_BLEND ? "blend" : mode == TRISORT_MODE_DEPTH ? "depth" : "saturate",
            pbr ? "pbr" : "basic", (unsigned)w, (unsigned)hgt, (unsigned)samples, argv[2]);
     free(ranges);

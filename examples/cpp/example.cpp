@@ -39,6 +39,10 @@ struct Report {
     trisort::Matrix projection_zero_to_one{};
     trisort::Matrix projection_minus_one_to_one{};
     std::size_t node_matrix_count = 0;
+#if TRISORT_ABI_VERSION >= 6
+    std::vector<trisort::Clip> clips;
+    std::uint32_t last_clip_found = 0;  // find_clip() of the last clip's name
+#endif
 };
 
 // A device as a host's graphics API might describe it: 8 sub-pixel bits, the standard
@@ -94,6 +98,10 @@ Report collect(const std::string &path, std::uint32_t frame) {
     r.projection_minus_one_to_one =
         baked.frame_projection(frame, aspect, trisort::DepthRange::MinusOneToOne);
     r.node_matrix_count = baked.frame_node_matrices(frame, true).size();
+#if TRISORT_ABI_VERSION >= 6
+    r.clips = baked.clips();
+    r.last_clip_found = baked.find_clip(r.clips.back().name);
+#endif
     return r;
 }
 
@@ -165,6 +173,12 @@ trisort::expected<Report> collect(const std::string &path, std::uint32_t frame) 
     r.projection_minus_one_to_one = *minus_one_to_one;
     EXAMPLE_TRY(nodes, baked.frame_node_matrices(frame, true));
     r.node_matrix_count = nodes->size();
+#if TRISORT_ABI_VERSION >= 6
+    EXAMPLE_TRY(clips, baked.clips());
+    r.clips = std::move(*clips);
+    EXAMPLE_TRY(found, baked.find_clip(r.clips.back().name));
+    r.last_clip_found = *found;
+#endif
     return r;
 }
 
@@ -259,6 +273,20 @@ bool print(const std::string &path, const Report &r) {
     print_matrix("projection zero to one", r.projection_zero_to_one);
     print_matrix("projection minus one to one", r.projection_minus_one_to_one);
     std::cout << "node matrices: " << r.node_matrix_count << '\n';
+#if TRISORT_ABI_VERSION >= 6
+    // A clip plays the file's frames first .. first + count - 1.
+    std::cout << "clips: " << r.clips.size();
+    for (const trisort::Clip &c : r.clips) {
+        std::cout << " '" << c.name << "' " << c.first << '+' << c.count << " @";
+        if (c.fps) {
+            std::cout << std::setprecision(17) << *c.fps;
+        } else {
+            std::cout << "none";
+        }
+    }
+    std::cout << '\n';
+    std::cout << "last clip found: " << r.last_clip_found << '\n';
+#endif
     return ok;
 }
 

@@ -25,8 +25,11 @@ use crate::order::Order;
 /// `trisort_gpu_environment_level()`: `trisort export-shaders`), and takes the projection's depth
 /// range as a `uint32_t` (the same values and calling convention as the enum it was; an
 /// out-of-range value is now `TRISORT_STATUS_OUT_OF_RANGE` instead of undefined behaviour);
-/// `trisort_export_order()` moved to `libtrisort_export` (`trisort_export.h`).
-pub const TRISORT_ABI_VERSION: u32 = 5;
+/// `trisort_export_order()` moved to `libtrisort_export` (`trisort_export.h`). 6 added the
+/// clips of a file of format 6, the camera paths it bundles (`trisort_clip_count()`,
+/// `trisort_clip_name()`, `trisort_clip_frames()`, `trisort_clip_fps()`,
+/// `trisort_clip_find()`).
+pub const TRISORT_ABI_VERSION: u32 = 6;
 
 /// The baked-file format version this header's library reads (`trisort_format_version()`
 /// says what the loaded library reads): a file of another version is refused with
@@ -65,8 +68,9 @@ pub enum TrisortStatus {
     Unsupported = 6,
     /// An internal error (a panic, caught): please report it.
     Panic = 7,
-    /// The file holds no such thing: no frame rate (`trisort_fps()`), no material variant of
-    /// that name (`trisort_variant_materials()`). The message says what is missing.
+    /// The file holds no such thing: no frame rate (`trisort_fps()`, `trisort_clip_fps()`),
+    /// no material variant of that name (`trisort_variant_materials()`), no clip of that name
+    /// (`trisort_clip_find()`). The message says what is missing.
     Absent = 8,
     /// The device is outside the bake's raster profile (`trisort_check_device()`); the
     /// message names each difference.
