@@ -115,6 +115,34 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("cut.baked"));
 }
 
+/// The reader reads the older versions trisort reads (tests/data/, written by the trisort of
+/// their version) with the same counts as `inspect`, which migrates them; the clip it reports
+/// for a file without clips is the one trisort reads it with.
+#[test]
+fn the_independent_reader_reads_the_older_versions_in_tests_data() {
+    let Some(python) = python() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    for (file, version) in [("format4.baked", 4), ("format5.baked", 5)] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(file);
+        let ours = read(python, &path);
+        assert_eq!(ours["format_version"], version);
+        let inspect = run_json(dir.path(), &["inspect", path.to_str().unwrap()]);
+        for key in ["frames", "index_triangles", "unique_visible", "fps"] {
+            assert_eq!(ours[key], inspect[key], "{file}: {key}");
+        }
+        assert_eq!(
+            ours["clips"][0]["name"], inspect["clips"][0]["name"],
+            "{file}"
+        );
+        assert_eq!(
+            ours["clips"][0]["count"], inspect["clips"][0]["frames"],
+            "{file}"
+        );
+    }
+}
+
 /// The reader checks the lengths FORMAT.md states: a mip level one byte short, or a texture
 /// without its full mip chain, is refused (trisort's own check refuses them too), naming the
 /// texture (and level).

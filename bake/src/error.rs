@@ -45,19 +45,10 @@ pub enum BakeError {
         /// Frames of the path.
         frames: u32,
     },
-    /// A bake of a frame range that does not start at the path's first frame: a baked file
-    /// plays its path from frame 0, and `merge` takes recordings that cover it from there.
-    #[error(
-        "frames {start}..{end}: a bake plays its path from frame 0, so its range starts there \
-         (0..{end}); frames {start}..{end} alone are a part of a sharded bake: record them with \
-         `trisort record --frames {start}..{end}` and merge them after the parts before them"
-    )]
-    RangeNotFromStart {
-        /// First frame asked for.
-        start: u32,
-        /// One past the last frame asked for.
-        end: u32,
-    },
+    /// The paths of a bundle cannot be made clips as given (names missing, repeated or
+    /// malformed; a frame range over several paths).
+    #[error("{0}")]
+    Clips(String),
     /// Recordings that cannot be used as given (malformed, of another scene, path, settings
     /// or device, not covering the path).
     #[error("{0}")]

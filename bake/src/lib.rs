@@ -23,9 +23,7 @@ pub mod spec;
 pub use error::BakeError;
 pub use pipeline::{bake, finished_recording, merge_to_file, recording_path, Baking};
 pub use record::{record_in_memory, record_to_file, RecordTarget};
-pub use source::{load_path, load_scene, working_scene, Light, Working};
-
-use std::ops::Range;
+pub use source::{load_path, load_scene, parse_path_arg, working_scene, Light, PathArg, Working};
 
 use trisort_format::RecordSettings;
 use trisort_merger::MergeOptions;
@@ -35,16 +33,19 @@ use trisort_merger::MergeOptions;
 pub struct Settings {
     /// The scene: a `.glb`/`.gltf` file, or `demo` / `demo:TRIANGLES` for the built-in car.
     pub scene: String,
-    /// The path: a TOML file, `gltf[:…]`, `orbit:…`, `dolly:…`, or `demo` for the demo car's
-    /// default path.
-    pub path: String,
+    /// The paths, one per clip, each `[NAME=]SPEC` ([`source::parse_path_arg`]): SPEC a TOML
+    /// file, `gltf[:…]`, `orbit:…`, `dolly:…`, or `demo` for the demo car's default path.
+    /// Several make a bundle: their frames follow each other in one recording and one baked
+    /// file, each path a named clip of its own rate.
+    pub paths: Vec<String>,
     /// Sampling rate of `gltf` and generated paths, in frames per second.
     pub fps: f64,
     /// Recording settings, the raster profile among them (their `split_intersections` says
     /// whether crossing triangles are split first).
     pub record: RecordSettings,
-    /// The frames to record (`None`: the whole path).
-    pub frames: Option<Range<u32>>,
+    /// A frame range of the path to bake as a clip of those frames alone (`None`: the whole
+    /// path; one path only), resolved against the path once it is loaded.
+    pub frames: Option<spec::FrameRange>,
     /// Merge options.
     pub merge: MergeOptions,
     /// The light stored in the baked file.
@@ -57,7 +58,7 @@ impl Settings {
     pub fn new(scene: impl Into<String>, path: impl Into<String>) -> Settings {
         Settings {
             scene: scene.into(),
-            path: path.into(),
+            paths: vec![path.into()],
             fps: 30.0,
             record: RecordSettings::default(),
             frames: None,

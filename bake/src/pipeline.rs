@@ -33,7 +33,6 @@ pub fn finished_recording(
     }
     let rec: Recording = trisort_format::read_file(FileKind::Recording, path).ok()?;
     let n = working.timeline.frames.len() as u32;
-    let range = settings.frames.clone().unwrap_or(0..n);
     let same = rec.tool_version == trisort_format::TOOL_VERSION
         && rec.phase == Phase::Graphs
         && rec.scene_hash == working.scene.hash()
@@ -41,7 +40,8 @@ pub fn finished_recording(
         && rec.settings == settings.record
         && rec.fps == Some(working.timeline.fps)
         && rec.device == gpu.device_info()
-        && rec.frames.iter().map(|f| f.frame).eq(range);
+        && rec.clips == working.clips
+        && rec.frames.iter().map(|f| f.frame).eq(0..n);
     same.then_some(rec)
 }
 
@@ -89,16 +89,6 @@ pub fn bake(
     output: &Path,
     events: &mut dyn Events,
 ) -> Result<Baking, BakeError> {
-    if let Some(r) = &settings.frames {
-        crate::spec::FrameRange::from(r.clone()).resolve(working.timeline.frames.len() as u32)?;
-        // Refused before recording: the merge would refuse it after the whole recording.
-        if r.start != 0 {
-            return Err(BakeError::RangeNotFromStart {
-                start: r.start,
-                end: r.end,
-            });
-        }
-    }
     let t0 = Instant::now();
     let rec_path = recording_path(output);
     let finished = finished_recording(gpu, working, settings, &rec_path);
@@ -115,7 +105,9 @@ pub fn bake(
         None => {
             let target = RecordTarget {
                 settings: &settings.record,
-                frames: settings.frames.clone(),
+                // The whole timeline: a range of the path (`settings.frames`) is already all
+                // of it, a clip of its own (`Working::load`).
+                frames: None,
                 phase: Phase::Graphs,
                 known_visible: None,
             };

@@ -57,6 +57,7 @@ pub fn record_in_memory(
     events.recorded();
     let mut rec = recorded?;
     rec.fps = Some(timeline.fps);
+    rec.clips[0].fps = rec.fps;
     Ok(rec)
 }
 
@@ -86,6 +87,7 @@ pub fn record_to_file(
         source,
     })?;
     rec.fps = Some(working.timeline.fps);
+    rec.clips = working.clips.clone();
     trisort_format::write_file_atomic(FileKind::Recording, output, &rec)?;
     partial.remove()?;
     Ok(rec)

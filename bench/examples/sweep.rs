@@ -37,7 +37,8 @@ fn main() -> ExitCode {
     // The scene as the default settings record it (crossing triangles split), as `trisort
     // bench --sweep` sees it.
     let settings = trisort_format::RecordSettings::default();
-    let working = match trisort_bake::Working::load(&args[0], &args[1], 30.0, &settings) {
+    let paths = [args[1].clone()];
+    let working = match trisort_bake::Working::load(&args[0], &paths, 30.0, None, &settings) {
         Ok(w) => w,
         Err(e) => {
             eprintln!("{e}");

@@ -225,10 +225,5 @@ fn working(
     scene: &trisort_scene::Scene,
     timeline: &trisort_paths::Timeline,
 ) -> trisort_bake::Working {
-    trisort_bake::Working {
-        scene: scene.clone(),
-        timeline: timeline.clone(),
-        split: None,
-        split_seconds: 0.0,
-    }
+    trisort_bake::Working::whole(scene.clone(), timeline.clone(), None, 0.0)
 }

@@ -18,9 +18,11 @@ pub struct BakeArgs {
     /// Scene (.glb/.gltf, or `demo[:TRIANGLES]`).
     scene: String,
     /// Path: TOML file, `gltf` (or `gltf:animation=NAME,camera=NAME`), `orbit:…`, `dolly:…`
-    /// or `demo`.
-    #[arg(long)]
-    path: String,
+    /// or `demo`. Repeat it as `--path NAME=SPEC` for a bundle: every path recorded and
+    /// merged into one sorted index buffer, each a clip of its own (`play --clip NAME`).
+    /// With `--frames A..B` (one path) the bake is a clip of those frames alone.
+    #[arg(long, required = true)]
+    path: Vec<String>,
     /// Output baked file. The recording is kept beside it as `BAKED.rec` (verify uses it).
     #[arg(short, long)]
     output: PathBuf,
@@ -33,27 +35,44 @@ pub struct BakeArgs {
     json: bool,
 }
 
-/// The pipeline's settings for `scene` and `path` from the command line's options; the
+/// The pipeline's settings for `scene` and `paths` from the command line's options; the
 /// frame range is resolved against the path once it is loaded.
-fn settings(scene: &str, path: &str, record: &RecordOpts, merge: &MergeOpts) -> Result<Settings> {
+fn settings(
+    scene: &str,
+    paths: &[String],
+    record: &RecordOpts,
+    merge: &MergeOpts,
+) -> Result<Settings> {
     Ok(Settings {
         scene: scene.to_string(),
-        path: path.to_string(),
+        paths: paths.to_vec(),
         fps: record.fps,
         record: record.settings()?,
-        frames: None,
+        frames: record.frames,
         merge: merge.options(),
         light: merge.light(),
     })
 }
 
+/// The clips of a baked file as the `--json` key `clips` lists them.
+fn clips_json(baked: &trisort_format::Baked) -> serde_json::Value {
+    baked
+        .clips
+        .iter()
+        .map(|c| {
+            serde_json::json!({
+                "name": c.name, "first": c.first, "frames": c.count, "fps": c.fps,
+                "path_first": c.path_first,
+            })
+        })
+        .collect()
+}
+
 pub fn run(a: BakeArgs) -> Result<ExitCode> {
-    let mut settings = settings(&a.scene, &a.path, &a.record, &a.merge)?;
+    let settings = settings(&a.scene, &a.path, &a.record, &a.merge)?;
     // First: a bad light fails before the scene is loaded and split.
     let environment = settings.light.load()?;
     let working = load_working(&settings)?;
-    let n = working.timeline.frames.len() as u32;
-    settings.frames = a.record.frames.map(|r| r.resolve(n)).transpose()?;
     let gpu = crate::common::open_gpu()?;
     let done = trisort_bake::bake(
         &gpu,
@@ -75,6 +94,7 @@ pub fn run(a: BakeArgs) -> Result<ExitCode> {
         v["record_seconds"] = record_s.into();
         v["recording_reused"] = done.recording_reused.into();
         v["merge_seconds"] = merge_s.into();
+        v["clips"] = clips_json(baked);
         v["seconds"] = (record_s + merge_s).into();
         print_json(&v);
     } else {
@@ -91,6 +111,20 @@ pub fn run(a: BakeArgs) -> Result<ExitCode> {
             rec.scene_triangles
         );
         println!("{}", merge_summary(baked, merge_s));
+        if baked.clips.len() > 1 || baked.clips[0].path_first > 0 {
+            for c in &baked.clips {
+                let rate = c.fps.map(|f| format!(" at {f} fps")).unwrap_or_default();
+                println!(
+                    "clip {}: frames {}..{} ({} frames{rate}; path frames {}..{})",
+                    c.name,
+                    c.first,
+                    c.first + c.count,
+                    c.count,
+                    c.path_first,
+                    c.path_first + c.count
+                );
+            }
+        }
         println!(
             "wrote {} (recording: {})",
             a.output.display(),

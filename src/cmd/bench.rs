@@ -115,7 +115,7 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
     // Every bake and rival below sees the scene as the default settings record it.
     let working = load_working(&trisort_bake::Settings {
         fps: a.fps,
-        ..trisort_bake::Settings::new(&a.scene, &a.path)
+        ..trisort_bake::Settings::new(&a.scene, a.path.as_str())
     })?;
     let (scene, timeline) = (&working.scene, &working.timeline);
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
@@ -230,7 +230,7 @@ fn bake_samples(a: &BenchArgs, gpu: &Gpu, working: &trisort_bake::Working) -> Re
                 bridge: a.bridge,
                 ..MergeOptions::default()
             },
-            ..trisort_bake::Settings::new(&a.scene, &a.path)
+            ..trisort_bake::Settings::new(&a.scene, a.path.as_str())
         };
         let mut console = crate::common::Console::new();
         bakes.push(bake_for(

@@ -132,12 +132,7 @@ fn demo_working(a: &DemoArgs, settings: &RecordSettings) -> Result<trisort_bake:
     let t_split = Instant::now();
     let split =
         trisort_bake::working_scene(&mut scene, "demo", &path.frames, "the demo path", settings)?;
-    let working = trisort_bake::Working {
-        scene,
-        timeline: path,
-        split,
-        split_seconds: t_split.elapsed().as_secs_f64(),
-    };
+    let working = trisort_bake::Working::whole(scene, path, split, t_split.elapsed().as_secs_f64());
     if let Some(line) = working.split_summary() {
         eprintln!("trisort: {line}");
     }

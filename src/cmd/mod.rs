@@ -9,6 +9,7 @@ mod inspect;
 pub mod merge;
 mod play;
 pub mod record;
+mod upgrade;
 pub mod verify;
 mod window;
 
@@ -54,6 +55,9 @@ enum Command {
     /// Write the player's vertex and fragment shaders for hosts (GLSL ES 3.00, SPIR-V or
     /// WGSL) with their binding layout.
     ExportShaders(export_shaders::ExportShadersArgs),
+    /// Rewrite a baked file of an earlier format version in the current one (frames, draws
+    /// and figures unchanged).
+    Upgrade(upgrade::UpgradeArgs),
 }
 
 /// Recording options shared by `record` and `bake`.
@@ -74,8 +78,9 @@ pub struct RecordOpts {
     /// Safety bound on peel layers per frame (a frame hitting it is marked truncated).
     #[arg(long, default_value_t = RecordSettings::DEFAULT_MAX_LAYERS)]
     pub max_layers: u32,
-    /// Frames to record, half-open `a..b` (default: all). `bake` takes a range from frame 0
-    /// (`0..b`); `record` any, as a part of a sharded bake.
+    /// Frames, half-open `a..b` (default: all). `bake` bakes the range as a clip of those
+    /// frames alone (one path; `play` numbers them from 0, `inspect` shows where they start
+    /// on the path); `record` records the range as a part of a sharded bake.
     #[arg(long, value_parser = parse_range)]
     pub frames: Option<FrameRange>,
     /// Sampling rate for `--path gltf` and generated paths.
@@ -169,5 +174,6 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Demo(a) => demo::run(a),
         Command::ExportOrder(a) => export_order::run(a),
         Command::ExportShaders(a) => export_shaders::run(a),
+        Command::Upgrade(a) => upgrade::run(a),
     }
 }

@@ -36,9 +36,10 @@ pub struct RecordArgs {
     /// Scene (.glb/.gltf, or `demo[:TRIANGLES]`).
     scene: String,
     /// Path: TOML file, `gltf` (or `gltf:animation=NAME,camera=NAME`), `orbit:…`, `dolly:…`
-    /// or `demo`.
-    #[arg(long)]
-    path: String,
+    /// or `demo`. Repeat it as `--path NAME=SPEC` for a bundle: the paths' frames one after
+    /// the other, each a named clip (`--frames`/`--shard` then cut the bundle's frames).
+    #[arg(long, required = true)]
+    path: Vec<String>,
     /// Output recording.
     #[arg(short, long)]
     output: PathBuf,
@@ -69,7 +70,8 @@ pub fn run(mut a: RecordArgs) -> Result<ExitCode> {
     let working = load_working(&trisort_bake::Settings {
         fps: a.opts.fps,
         record: settings,
-        ..trisort_bake::Settings::new(&a.scene, &a.path)
+        paths: a.path.clone(),
+        ..trisort_bake::Settings::new(&a.scene, "")
     })?;
     let timeline = &working.timeline;
     if let Some(shard) = a.shard {
@@ -171,7 +173,8 @@ fn write_union(
     if a.shard.is_some() || a.opts.frames.is_some() {
         bail!("--phase union joins whole-path results; it takes no --shard or --frames");
     }
-    let (rec, joined) = join_visibility(&a.visibility, working, settings, (&a.scene, &a.path))?;
+    let paths = a.path.join(" ");
+    let (rec, joined) = join_visibility(&a.visibility, working, settings, (&a.scene, &paths))?;
     trisort_format::write_file_atomic(FileKind::Recording, &a.output, &rec)?;
     let secs = t0.elapsed().as_secs_f64();
     if a.json {

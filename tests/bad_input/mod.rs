@@ -317,23 +317,3 @@ fn mismatched_recordings_are_not_merged() {
         fails(d, &args, &[1], file, problem);
     }
 }
-
-/// A bake of frames that do not start at the path's first one is refused before anything is
-/// recorded (it used to record them all, then fail in the merge), and leaves no file behind.
-#[test]
-fn a_bake_of_a_range_after_frame_0_is_refused_before_recording() {
-    let Some(dir) = gpu_tempdir() else { return };
-    let d = dir.path();
-    let args = args("bake demo:2000 --path orbit:frames=6 --size 32x32 --frames 2..5 -o r.baked");
-    let started = std::time::Instant::now();
-    fails(
-        d,
-        &args,
-        &[1],
-        "frames 2..5",
-        "trisort record --frames 2..5",
-    );
-    // Refused up front: no recording of three frames first.
-    assert!(!d.join("r.baked.rec").exists() && !d.join("r.baked.rec.partial").exists());
-    eprintln!("refused in {:.1} s", started.elapsed().as_secs_f64());
-}
