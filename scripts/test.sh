@@ -13,6 +13,11 @@ bash scripts/ensure-c-host.sh
 bash scripts/ensure-gltf-tools.sh
 # Python's junitparser reads `verify --junit` reports (tests/verify_forged.rs).
 bash scripts/ensure-junitparser.sh
+# Chromium and playwright-core read `verify --report` pages back (tests/verify_report.rs; the
+# browser test below installs the rest of what it needs).
+if [ "${TRISORT_SKIP_BROWSER:-}" != 1 ]; then
+  bash scripts/ensure-web.sh --browser-only
+fi
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp/xdg-runtime-$(id -u)}"
 mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 export TRISORT_SCENES="${TRISORT_SCENES:-$(pwd)/../shared/scenes}"

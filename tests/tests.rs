@@ -27,5 +27,6 @@ mod variants_cli;
 mod verify_cli;
 mod verify_forged;
 mod verify_images;
+mod verify_report;
 mod webgl2_cli;
 mod window_cli;

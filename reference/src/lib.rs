@@ -23,6 +23,7 @@ pub mod default_pipeline;
 pub mod deploy;
 pub mod exact;
 pub mod frames;
+pub mod html;
 pub mod oit;
 pub mod peeling;
 pub mod report;

@@ -198,8 +198,10 @@ pub fn text_report(
 /// failed, the failure saying which figures; skipped when the images were only measured, with
 /// no graph rule to judge), and a test case `graph rules (whole file)` for the file-wide
 /// findings (copies, structure, hashes). Each case's `system-out` holds its figures as JSON.
+/// A frame's case names its clip (of `clips`) in its class name, `trisort.verify.STEM.CLIP`.
 pub fn junit_report(
     baked: &Path,
+    clips: &[trisort_format::Clip],
     graph: Option<&GraphReport>,
     images: Option<&(ImageReport, ImageCheck)>,
     measure_only: bool,
@@ -247,7 +249,9 @@ pub fn junit_report(
             ));
         }
         let figures = json!({ "graph": g, "images": i });
+        let clip = clips.iter().find(|c| c.frames().contains(&frame));
         cases.push(JunitCase {
+            class: clip.map_or_else(|| class.clone(), |c| format!("{class}.{}", c.name)),
             name: format!("frame {frame}"),
             failure: (!failures.is_empty()).then(|| failures.join("; ")),
             skipped: failures.is_empty() && measure_only && i.is_some() && g.is_none(),
@@ -258,6 +262,7 @@ pub fn junit_report(
         let frame_failed = g.frames.iter().any(|f| !f.ok());
         let whole_file = (!g.ok && !frame_failed) || g.bad_copies > 0;
         cases.push(JunitCase {
+            class: class.clone(),
             name: "graph rules (whole file)".into(),
             failure: whole_file.then(|| {
                 format!(
@@ -283,7 +288,7 @@ pub fn junit_report(
         let _ = writeln!(
             out,
             "    <testcase classname=\"{}\" name=\"{}\">",
-            xml(&class),
+            xml(&c.class),
             xml(&c.name)
         );
         if let Some(f) = &c.failure {
@@ -309,6 +314,7 @@ pub fn junit_report(
 
 /// One test case of [`junit_report`].
 struct JunitCase {
+    class: String,
     name: String,
     failure: Option<String>,
     skipped: bool,

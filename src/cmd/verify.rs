@@ -14,7 +14,8 @@
 //! was verified and exits 4 unless `--allow-unverified` is given. The error of an 8-bit sRGB
 //! deployment target is reported separately (`srgb8`) and never gated on.
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
@@ -25,6 +26,7 @@ use trisort_gpu::{Gpu, GpuOptions};
 use trisort_player::headless::HeadlessRenderer;
 use trisort_player::Mode;
 use trisort_reference::frames::{verify_images, write_diff, Frames, FramesToVerify, ImageReport};
+use trisort_reference::html::{html_report, thumbnails, HtmlReport, ReportFile, Thumbnails};
 use trisort_reference::report::{json_report, junit_report, text_report};
 use trisort_reference::ImageCheck;
 
@@ -59,9 +61,14 @@ pub struct VerifyArgs {
     /// MSAA samples (default: the recorded count).
     #[arg(long)]
     samples: Option<u32>,
-    /// Frames to check, half-open `a..b` (default: all).
+    /// Frames to check, half-open `a..b` (default: all; with `--clip`, relative to the clip).
     #[arg(long, value_parser = parse_range)]
     frames: Option<FrameRange>,
+    /// Check only the frames of clip NAME (one camera path of a bundle; `inspect` lists the
+    /// clips). The graph rules stay file-wide (copies and windows span the clips); the
+    /// reports list the clip's frames.
+    #[arg(long, value_name = "NAME")]
+    clip: Option<String>,
     /// Off the recorded pattern: fail a frame whose largest colour-channel difference on
     /// ordered pixels exceeds N/255. Off the pattern, a check needs this (or `--measure-only`).
     #[arg(long, value_name = "N", conflicts_with = "measure_only")]
@@ -109,6 +116,12 @@ pub struct VerifyArgs {
     /// systems); written by rename, beside whatever the report prints.
     #[arg(long, value_name = "FILE")]
     junit: Option<PathBuf>,
+    /// Also write a self-contained HTML sign-off report as DIR/index.html (created; written by
+    /// rename): the files' BLAKE3 hashes, the bake's settings and raster profile, a verdict
+    /// per clip and per frame (worst first) with thumbnails of the player's frame, the
+    /// reference and a difference heat map embedded.
+    #[arg(long, value_name = "DIR")]
+    report: Option<PathBuf>,
     /// `--shading` and `--tonemap`: the player and the exact reference light alike, with the
     /// baked file's environment.
     #[command(flatten)]
@@ -166,15 +179,30 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             Some(baked.environment.difference(&expected))
         }
     };
+    let clip = match &a.clip {
+        None => None,
+        Some(name) => Some(
+            baked
+                .clip(name)
+                .map_err(|e| anyhow::anyhow!("--clip {name}: {e}"))?
+                .clone(),
+        ),
+    };
     let recs = read_recordings(&a.recording)?;
     let played = match a.mode {
         Mode::Depth => trisort_verify::PlayedIn::Depth,
         Mode::Blend | Mode::Saturate => trisort_verify::PlayedIn::Blend,
     };
-    let graph = (!recs.is_empty()).then(|| trisort_verify::check_graph_for(&recs, &baked, played));
+    let mut graph =
+        (!recs.is_empty()).then(|| trisort_verify::check_graph_for(&recs, &baked, played));
+    if let (Some(g), Some(c)) = (&mut graph, &clip) {
+        // The verdict stays file-wide; the frames listed are the clip's.
+        g.frames.retain(|f| c.frames().contains(&f.frame));
+    }
+    let mut thumbs = BTreeMap::new();
     let images = match &a.scene {
         None => None,
-        Some(spec) => match image_check(&a, spec, &baked, &recs) {
+        Some(spec) => match image_check(&a, spec, &baked, &recs, clip.as_ref(), &mut thumbs) {
             Ok(r) => Some(r),
             // The graph rules failed already (the files disagree): that is the verdict.
             Err(e) if graph.as_ref().is_some_and(|g| !g.ok) => {
@@ -198,7 +226,13 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
     };
     let ok = code == 0;
     if let Some(file) = &a.junit {
-        let xml = junit_report(&a.baked, graph.as_ref(), images.as_ref(), a.measure_only);
+        let xml = junit_report(
+            &a.baked,
+            &baked.clips,
+            graph.as_ref(),
+            images.as_ref(),
+            a.measure_only,
+        );
         trisort_format::container::write_bytes_atomic(file, xml.as_bytes())?;
     }
     let check = images.as_ref().map(|(report, _)| {
@@ -210,8 +244,53 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             "max_error"
         }
     });
+    let verdict = format!(
+        "{}: {}",
+        a.baked.display(),
+        match code {
+            0 if unverified => "images NOT VERIFIED (--measure-only --allow-unverified)",
+            0 => "OK",
+            UNVERIFIED => "images NOT VERIFIED (--measure-only; exit 4 unless --allow-unverified)",
+            _ => "FAILED",
+        }
+    );
+    if let Some(dir) = &a.report {
+        let html = html_report(&HtmlReport {
+            baked: hashed_file(&a.baked)?,
+            scene: a.scene.as_deref().map(scene_file).transpose()?,
+            recordings: a
+                .recording
+                .iter()
+                .map(|p| hashed_file(p))
+                .collect::<Result<_>>()?,
+            tool_version: env!("CARGO_PKG_VERSION"),
+            baked_tool_version: &baked.tool_version,
+            settings: settings_rows(&baked),
+            raster_profile: trisort_bake::figures::profile_summary(&baked.settings),
+            clips: &baked.clips,
+            clip: a.clip.as_deref(),
+            ok,
+            verdict: verdict.clone(),
+            graph: graph.as_ref(),
+            images: images.as_ref(),
+            measure_only: a.measure_only,
+            thumbnails: &thumbs,
+        });
+        trisort_reference::html::write_report(dir, &html)?;
+    }
     if a.json {
         let mut v = json_report(ok, graph.as_ref(), images.as_ref());
+        for f in v["frames"].as_array_mut().into_iter().flatten() {
+            let clip = f["frame"]
+                .as_u64()
+                .and_then(|n| baked.clip_of_frame(n as u32))
+                .map(|(_, c)| c.name.clone());
+            f["clip"] = json!(clip);
+        }
+        v["clip"] = json!(a.clip);
+        if let Some(dir) = &a.report {
+            v["report"] = json!(dir.join("index.html").display().to_string());
+        }
         if let Some(dir) = &a.frames_dir {
             v["frames_dir"] = json!(dir.display().to_string());
         }
@@ -253,19 +332,105 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
                 "environment: {name:?}, not checked (give --environment FILE.hdr, the light it was baked with)"
             ),
         }
-        println!(
-            "{}: {}",
-            a.baked.display(),
-            match code {
-                0 if unverified => "images NOT VERIFIED (--measure-only --allow-unverified)",
-                0 => "OK",
-                UNVERIFIED =>
-                    "images NOT VERIFIED (--measure-only; exit 4 unless --allow-unverified)",
-                _ => "FAILED",
-            }
-        );
+        if let Some(dir) = &a.report {
+            println!("report: {}", dir.join("index.html").display());
+        }
+        println!("{verdict}");
     }
     Ok(ExitCode::from(code))
+}
+
+/// BLAKE3 of a file's bytes, hex.
+fn blake3_hex(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    Ok(hex(&trisort_format::hash_bytes(&bytes)))
+}
+
+/// Bytes as lower-case hex.
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// A file of the report with its hash.
+fn hashed_file(path: &Path) -> Result<ReportFile> {
+    Ok(ReportFile {
+        path: path.display().to_string(),
+        blake3: Some(blake3_hex(path)?),
+        note: String::new(),
+    })
+}
+
+/// The scene of `--scene SPEC` for the report: a file's hash (a .gltf's buffers and images
+/// are files of their own, not hashed here: the baked file's scene hash covers the geometry),
+/// or a built-in scene.
+fn scene_file(spec: &str) -> Result<ReportFile> {
+    let path = Path::new(spec);
+    if path.is_file() {
+        let gltf = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
+        Ok(ReportFile {
+            note: if gltf {
+                "(the .gltf file itself; its buffers and images are not hashed here)".into()
+            } else {
+                String::new()
+            },
+            ..hashed_file(path)?
+        })
+    } else {
+        Ok(ReportFile {
+            path: spec.to_string(),
+            blake3: None,
+            note: "built-in scene, no file to hash".into(),
+        })
+    }
+}
+
+/// The bake's settings as rows for the report: the recording settings (flattened), how it
+/// was merged, its frames, clips, light and stored hashes.
+fn settings_rows(baked: &Baked) -> Vec<(String, String)> {
+    fn flatten(prefix: &str, v: &Value, out: &mut Vec<(String, String)>) {
+        match v {
+            Value::Object(map) => {
+                for (k, v) in map {
+                    let key = if prefix.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{prefix}.{k}")
+                    };
+                    flatten(&key, v, out);
+                }
+            }
+            Value::String(s) => out.push((prefix.to_string(), s.clone())),
+            other => out.push((prefix.to_string(), other.to_string())),
+        }
+    }
+    let mut rows = Vec::new();
+    let settings = serde_json::to_value(baked.settings).unwrap_or(Value::Null);
+    flatten("settings", &settings, &mut rows);
+    let m = &baked.merge;
+    let merge = json!({
+        "strategy": m.strategy,
+        "layout": m.layout,
+        "bridge": m.bridge,
+        "depth_only": m.depth_only,
+        "segment": m.segment,
+        "seeding": m.seeding,
+    });
+    flatten("merge", &merge, &mut rows);
+    rows.push(("frames".into(), baked.frames.len().to_string()));
+    rows.push((
+        "fps".into(),
+        baked.fps.map_or_else(|| "-".into(), |f| f.to_string()),
+    ));
+    rows.push(("copies".into(), baked.copies.len().to_string()));
+    rows.push(("triangles".into(), baked.scene_ids.len().to_string()));
+    rows.push(("environment".into(), baked.environment.name.clone()));
+    let device = serde_json::to_value(&baked.device).unwrap_or(Value::Null);
+    flatten("recording device", &device, &mut rows);
+    rows.push(("scene hash (stored)".into(), hex(&baked.scene_hash)));
+    rows.push(("path hash (stored)".into(), hex(&baked.path_hash)));
+    rows
 }
 
 /// The image check of `verify --scene SPEC`: the scene as recorded (split where the
@@ -276,6 +441,8 @@ fn image_check(
     spec: &str,
     baked: &Baked,
     recs: &[Recording],
+    clip: Option<&trisort_format::Clip>,
+    thumbs: &mut BTreeMap<u32, Thumbnails>,
 ) -> Result<(ImageReport, ImageCheck)> {
     let settings = recs.first().map_or(baked.settings, |r| r.settings);
     let mut scene = load_scene(spec)?;
@@ -302,11 +469,20 @@ fn image_check(
             &with_variant
         }
     };
-    let n = baked.frames.len() as u32;
+    let (first, n) = clip.map_or((0, baked.frames.len() as u32), |c| (c.first, c.count));
     let range = match a.frames {
-        Some(r) => r.resolve(n)?,
+        Some(r) => {
+            let r = r.resolve(n).with_context(|| match clip {
+                Some(c) => format!(
+                    "--frames counts within clip {:?} ({} frames)",
+                    c.name, c.count
+                ),
+                None => "--frames".into(),
+            })?;
+            first + r.start..first + r.end
+        }
         None if n == 0 => bail!("the baked file has no frames"),
-        None => 0..n,
+        None => first..first + n,
     };
     let check = ImageCheck {
         size: a.size.unwrap_or((settings.width, settings.height)),
@@ -368,9 +544,14 @@ fn image_check(
         frames: range,
         source: captured,
     };
-    let report = verify_images(&gpu, what, |v| match &a.diff_dir {
-        Some(dir) if a.diff_all || !v.report.ok => write_diff(dir, v, size),
-        _ => Ok(()),
+    let report = verify_images(&gpu, what, |v| {
+        if a.report.is_some() {
+            thumbs.insert(v.report.frame, thumbnails(v, size)?);
+        }
+        match &a.diff_dir {
+            Some(dir) if a.diff_all || !v.report.ok => write_diff(dir, v, size),
+            _ => Ok(()),
+        }
     })?;
     Ok((report, check))
 }
