@@ -101,6 +101,10 @@ fn a_bundle_plays_each_clip_as_its_separate_bake_and_is_smaller() {
     assert_eq!(baked.copies, merged.copies);
     assert_eq!(baked.draws, merged.draws);
     assert_eq!(baked.frames, merged.frames);
+
+    // verify rebuilds the scene as the bake split it, over all the bundle's frames.
+    let v = run_json(d, &["verify", "bundle.baked", "--scene", SCENE]);
+    assert_eq!(v["ok"], true, "{v}");
 }
 
 #[test]

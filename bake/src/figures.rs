@@ -298,3 +298,18 @@ pub fn profile_check_json(
         },
     })
 }
+
+/// The clips of a baked file as the `--json` key `clips` lists them (`bake`, `merge`):
+/// `[{name, first, frames, fps, path_first}]`, `frames` being the clip's frame count.
+pub fn clips_json(baked: &Baked) -> serde_json::Value {
+    baked
+        .clips
+        .iter()
+        .map(|c| {
+            json!({
+                "name": c.name, "first": c.first, "frames": c.count, "fps": c.fps,
+                "path_first": c.path_first,
+            })
+        })
+        .collect()
+}

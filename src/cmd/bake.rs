@@ -5,7 +5,9 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::Args;
-use trisort_bake::figures::{add_split_json, baked_json, merge_summary, recording_json};
+use trisort_bake::figures::{
+    add_split_json, baked_json, clips_json, merge_summary, recording_json,
+};
 use trisort_bake::{recording_path, Settings};
 
 use crate::cmd::merge::MergeOpts;
@@ -54,19 +56,6 @@ fn settings(
     })
 }
 
-/// The clips of a baked file as the `--json` key `clips` lists them.
-fn clips_json(baked: &trisort_format::Baked) -> serde_json::Value {
-    baked
-        .clips
-        .iter()
-        .map(|c| {
-            serde_json::json!({
-                "name": c.name, "first": c.first, "frames": c.count, "fps": c.fps,
-                "path_first": c.path_first,
-            })
-        })
-        .collect()
-}
 
 pub fn run(a: BakeArgs) -> Result<ExitCode> {
     let settings = settings(&a.scene, &a.path, &a.record, &a.merge)?;

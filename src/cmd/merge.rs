@@ -138,7 +138,9 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
     let baked = trisort_bake::merge_to_file(&recs, &names, &opts, environment, &a.output)?;
     let seconds = t0.elapsed().as_secs_f64();
     if a.json {
-        print_json(&trisort_bake::figures::baked_json(&baked, seconds));
+        let mut v = trisort_bake::figures::baked_json(&baked, seconds);
+        v["clips"] = trisort_bake::figures::clips_json(&baked);
+        print_json(&v);
     } else {
         println!("{}", trisort_bake::figures::merge_summary(&baked, seconds));
         println!("wrote {}", a.output.display());
