@@ -56,7 +56,6 @@ fn settings(
     })
 }
 
-
 pub fn run(a: BakeArgs) -> Result<ExitCode> {
     let settings = settings(&a.scene, &a.path, &a.record, &a.merge)?;
     // First: a bad light fails before the scene is loaded and split.
