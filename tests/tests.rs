@@ -11,6 +11,7 @@ mod bench_cli;
 mod bundle_cli;
 mod c_host;
 mod cli_basics;
+mod clips_cli;
 mod compressed_gltf;
 mod environment_cli;
 mod export_order;

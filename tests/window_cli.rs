@@ -102,7 +102,11 @@ fn on_path(name: &str) -> bool {
 
 /// Runs the binary under `xvfb-run` with `args`, killing it after `limit`; returns the exit
 /// code, stdout and stderr.
-fn under_xvfb(dir: &Path, args: &[&str], limit: Duration) -> (Option<i32>, String, String) {
+pub(crate) fn under_xvfb(
+    dir: &Path,
+    args: &[&str],
+    limit: Duration,
+) -> (Option<i32>, String, String) {
     let (out_path, err_path) = (dir.join("xvfb.stdout"), dir.join("xvfb.stderr"));
     let mut cmd = xvfb_run("640x480x24");
     cmd.current_dir(dir)
@@ -137,7 +141,7 @@ fn under_xvfb(dir: &Path, args: &[&str], limit: Duration) -> (Option<i32>, Strin
 
 /// CI sets `TRISORT_REQUIRE_DISPLAY=1` (and installs xvfb and x11-apps): there a missing tool
 /// fails the test instead of skipping it.
-fn tools_missing(tools: &[&str]) -> bool {
+pub(crate) fn tools_missing(tools: &[&str]) -> bool {
     let missing: Vec<&str> = tools.iter().copied().filter(|t| !on_path(t)).collect();
     if !missing.is_empty() && std::env::var("TRISORT_REQUIRE_DISPLAY").as_deref() == Ok("1") {
         panic!("{missing:?} not on PATH and TRISORT_REQUIRE_DISPLAY=1");

@@ -97,6 +97,18 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         .check_structure()
         .map_err(|e| anyhow::anyhow!("{}: malformed baked file: {e}", a.file))?;
     let mut v = trisort_bake::figures::baked_file_json(&baked);
+    // The camera paths of the file (a bundle has several): DESIGN's `clips[{name, frames,
+    // fps}]`, `frames` the clip's count, with where it starts in the file and in its path.
+    v["clips"] = baked
+        .clips
+        .iter()
+        .map(|c| {
+            json!({
+                "name": c.name, "first": c.first, "frames": c.count, "fps": c.fps,
+                "path_first": c.path_first,
+            })
+        })
+        .collect();
     if let Some(png) = &a.matrix {
         let m = trisort_bench::matrix::draw_matrix(&baked, png)?;
         let margin = trisort_bench::matrix::MARGIN;
@@ -111,9 +123,31 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
         print_json(&v);
     } else {
         println!("{}: baked file, {} frames", a.file, baked.frames.len());
+        print_clips(&baked.clips);
         println!("{}", serde_json::to_string_pretty(&v)?);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The clips of a baked file, one line each: name, the file's frames it spans, count, rate,
+/// and the frame of its path it starts at where that is not 0.
+fn print_clips(clips: &[trisort_format::Clip]) {
+    println!("  clips {} (play --clip NAME):", clips.len());
+    for c in clips {
+        let frames = c.frames();
+        let fps = c
+            .fps
+            .map_or("fps unknown".to_string(), |f| format!("{f} fps"));
+        let from = match c.path_first {
+            0 => String::new(),
+            p => format!(", from frame {p} of its path"),
+        };
+        let plural = if c.count == 1 { "" } else { "s" };
+        println!(
+            "    {}: frames {}..{} ({} frame{plural}), {fps}{from}",
+            c.name, frames.start, frames.end, c.count
+        );
+    }
 }
 
 /// `inspect` of a scene: counts, materials by alpha mode, animated nodes, bounds, material

@@ -8,10 +8,10 @@ use clap::Args;
 use serde_json::json;
 use trisort_format::{Baked, FileKind};
 use trisort_gpu::{DeviceBackend, DeviceLimits, Gpu, GpuOptions, Shading, ToneMap};
-use trisort_player::headless::{HeadlessConfig, RenderedFrame};
+use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
 use trisort_player::{Mode, SelfCheck, SelfCheckFrame};
 
-use trisort_reference::frames::{play_frames_to, PlayFrames, PlayedPath};
+use trisort_reference::frames::{play_frames_to, write_png, PlayFrames, PlayedPath};
 
 use crate::common::{
     parse_range, parse_size, parse_subpixel_offset, print_json, progress_bar, FrameRange,
@@ -22,10 +22,17 @@ use crate::common::{
 pub struct PlayArgs {
     /// Baked file.
     baked: PathBuf,
-    /// Frames to play, half-open `a..b` (default: all).
+    /// Frames to play, half-open `a..b` (default: all; with --clip, frames of the clip, 0 its
+    /// first).
     #[arg(long, value_parser = parse_range)]
     frames: Option<FrameRange>,
-    /// Where to write PNG frames (`frame-NNNNN.png`); none: render and time only.
+    /// Play only clip NAME of a bundle (one of its camera paths; `inspect` lists them):
+    /// --frames counts from the clip's first frame, the PNGs and `--json` frames are numbered
+    /// within the clip, and --window starts at it and plays at its rate.
+    #[arg(long, value_name = "NAME")]
+    clip: Option<String>,
+    /// Where to write PNG frames (`frame-NNNNN.png`; with --clip, numbered within the clip);
+    /// none: render and time only.
     #[arg(long)]
     out_dir: Option<PathBuf>,
     /// Playback size (default: the recorded size).
@@ -43,11 +50,12 @@ pub struct PlayArgs {
     /// Open a window (needs X11 or Wayland) to play, pause, step and scrub.
     ///
     /// Keys: Space play/pause, Right/Left step, Home/End first/last frame, drag with the left
-    /// button or 0-9 to scrub, Escape/Q quit.
+    /// button or 0-9 to scrub, Tab/C next clip (Shift: previous), F1-F9 clip 1-9, Escape/Q
+    /// quit.
     #[arg(long)]
     window: bool,
     /// With --window: playback rate in frames per second (default: the path's, stored in the
-    /// baked file; 30 for files that store none).
+    /// baked file, or the clip's; 30 for files that store none).
     #[arg(long, requires = "window")]
     fps: Option<f64>,
     /// Play the file's materials as material variant NAME (glTF KHR_materials_variants;
@@ -153,6 +161,60 @@ fn play_with_progress(gpu: &Gpu, what: PlayFrames<'_>) -> Result<(Vec<RenderedFr
     Ok(played)
 }
 
+/// [`play_with_progress`] with the frames numbered from `base` (the first frame of the clip
+/// played): frame `f` of the file is written as `frame-NNNNN.png` with NNNNN = `f - base`
+/// and comes back as frame `f - base`, so a clip of a bundle plays to the names a bake of its
+/// path alone plays to.
+fn play_numbered(
+    gpu: &Gpu,
+    what: PlayFrames<'_>,
+    base: u32,
+) -> Result<(Vec<RenderedFrame>, PlayedPath)> {
+    if base == 0 {
+        return play_with_progress(gpu, what);
+    }
+    // `play_frames_to` names the PNGs by the file's frames: play without writing, then write
+    // each frame under its clip-local name.
+    let renderer = HeadlessRenderer::new(gpu, what.baked, what.config)?;
+    renderer.set_subpixel_offset(what.offset);
+    renderer.set_variant(what.variant)?;
+    let player = renderer.player();
+    let path = PlayedPath {
+        bindings: player.bindings().name(),
+        draw_path: player.config().draw_path.name(),
+        texture_bytes: player.texture_bytes(),
+        warnings: player.warnings().to_vec(),
+    };
+    for w in &path.warnings {
+        eprintln!("trisort: warning: {w}");
+    }
+    if let Some(d) = what.out_dir {
+        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
+    }
+    // One untimed render first: the first draw compiles pipelines (as `play_frames_to`).
+    if !what.frames.is_empty() {
+        renderer.render(what.frames.start)?;
+    }
+    let bar = progress_bar(what.frames.len() as u64, "play");
+    let (w, h) = what.config.size;
+    let mut out = Vec::with_capacity(what.frames.len());
+    for f in what.frames {
+        let r = renderer.render(f)?;
+        let local = f - base;
+        if let Some(d) = what.out_dir {
+            write_png(&d.join(format!("frame-{local:05}.png")), w, h, &r.rgba8)?;
+        }
+        bar.inc(1);
+        out.push(RenderedFrame {
+            frame: local,
+            rgba8: Vec::new(),
+            ..r
+        });
+    }
+    bar.finish_and_clear();
+    Ok((out, path))
+}
+
 /// Checks the device against the bake's raster profile at `samples` with the projection moved
 /// by `offset` ([`trisort_gpu::raster_probe::check_profile`]): a warning naming what differs,
 /// or with `strict` an error.
@@ -190,11 +252,22 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
     baked
         .check_structure()
         .map_err(|e| anyhow::anyhow!("{}: malformed baked file: {e}", a.baked.display()))?;
-    let n = baked.frames.len() as u32;
+    let clip = match &a.clip {
+        Some(name) => Some(
+            baked
+                .clip(name)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", a.baked.display()))?,
+        ),
+        None => None,
+    };
+    // The frames played are the clip's (the whole file's without --clip); --frames and the
+    // numbers reported count from its first frame.
+    let (base, n) = clip.map_or((0, baked.frames.len() as u32), |c| (c.first, c.count));
     let range = match a.frames {
         Some(r) => r.resolve(n)?,
         None => 0..n,
     };
+    let range = range.start + base..range.end + base;
     let config = headless_config(&a, &baked);
     let gpu = crate::common::open_gpu_with(a.device.options())?;
     let offset = a.subpixel_offset.unwrap_or([0.0, 0.0]);
@@ -220,8 +293,8 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
         offset,
         variant: a.variant.as_deref(),
     };
-    let (frames, path) =
-        play_with_progress(&gpu, what).with_context(|| format!("playing {}", a.baked.display()))?;
+    let (frames, path) = play_numbered(&gpu, what, base)
+        .with_context(|| format!("playing {}", a.baked.display()))?;
     let checks = if a.self_check {
         Some(self_check_frames(&gpu, &baked, &config, offset, range)?)
     } else {
@@ -232,6 +305,7 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
         gpu: &gpu,
         config: &config,
         frames: &frames,
+        clip,
         path,
         checks: checks.as_deref(),
         holes,
@@ -266,6 +340,7 @@ fn run_window(a: &PlayArgs) -> Result<ExitCode> {
         glass_opacity: a.glass_opacity,
         fps: a.fps,
         variant: a.variant.clone(),
+        clip: a.clip.clone(),
         shading: a.shading,
         exit_after: a.window_frames,
         json: a.json,
@@ -313,7 +388,10 @@ fn self_check_frames(
 struct Played<'a> {
     gpu: &'a Gpu,
     config: &'a HeadlessConfig,
+    /// The frames, numbered within the clip played (the file's frames without `--clip`).
     frames: &'a [RenderedFrame],
+    /// The clip played (`--clip`).
+    clip: Option<&'a trisort_format::Clip>,
     path: PlayedPath,
     /// Per-frame self-check results (with `--self-check`).
     checks: Option<&'a [SelfCheckFrame]>,
@@ -352,6 +430,8 @@ fn print_play_json(
         "tonemap": p.config.tone_map.name(),
         "texture_bytes": p.path.texture_bytes,
         "variant": a.variant,
+        // The clip played (`--clip`; null: the file's frames, numbered as in the file).
+        "clip": p.clip.map(|c| &c.name),
         "subpixel_offset": offset,
         "profile_check": trisort_bake::figures::profile_check_json(baked, profile),
         "frames": list,
@@ -375,8 +455,10 @@ fn print_play_text(a: &PlayArgs, p: &Played<'_>) {
         )
     };
     println!(
-        "played {} frames ({} mode) on {} ({:?}; {} bindings, {} draws): {timing}",
+        "played {} frames{} ({} mode) on {} ({:?}; {} bindings, {} draws): {timing}",
         p.frames.len(),
+        p.clip
+            .map_or(String::new(), |c| format!(" of clip {}", c.name)),
         a.mode.name(),
         p.gpu.info.name,
         p.gpu.info.backend,
@@ -400,7 +482,9 @@ fn print_play_text(a: &PlayArgs, p: &Played<'_>) {
         for c in bad.iter().take(20) {
             println!(
                 "  frame {}: {} hole pixels (max {}/255)",
-                c.frame, c.holes, c.max_channel_diff
+                c.frame - p.clip.map_or(0, |c| c.first),
+                c.holes,
+                c.max_channel_diff
             );
         }
     }

@@ -22,7 +22,8 @@ pub const NO_DISPLAY: &str =
 pub struct WindowArgs<'a> {
     /// The baked file.
     pub baked: &'a Path,
-    /// Frames to play (default: all); playback loops over them.
+    /// Frames to play (default: all; with `clip`, counted from the clip's first frame);
+    /// playback loops over them.
     pub frames: Option<FrameRange>,
     /// Initial window size (default: the recorded size).
     pub size: Option<(u32, u32)>,
@@ -36,6 +37,8 @@ pub struct WindowArgs<'a> {
     pub fps: Option<f64>,
     /// Material variant to play (default: the file's default materials).
     pub variant: Option<String>,
+    /// Clip to start at (default: the file's frames in order).
+    pub clip: Option<String>,
     /// Surface model and tone map.
     pub shading: ShadingArgs,
     /// For tests and automation: quit after presenting this many frames.
@@ -92,10 +95,16 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
         tone_map: a.shading.tonemap,
         fps: a.fps,
         variant: a.variant,
+        clip: a.clip,
         exit_after: a.exit_after,
     };
     let session = Session::open(a.baked, options).map_err(cli_error)?;
-    let frames = a.frames.map(|r| r.resolve(session.frame_count()));
+    // --frames counts from the first frame of the clip started at (of the file without one).
+    let within = session.clip_frames();
+    let frames = a.frames.map(|r| {
+        r.resolve(within.len() as u32)
+            .map(|r| r.start + within.start..r.end + within.start)
+    });
     let mut host = Host {
         baked: a.baked,
         strict_profile: a.strict_profile,
@@ -109,16 +118,20 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
             "mode": played.mode.name(),
             "variant": played.variant,
             "fps": played.fps,
+            "clip": played.clip,
             "presented_frames": played.presented,
             "last_frame": played.last_frame,
         }));
     } else {
         println!(
-            "presented {} frames ({} mode) on {}; last frame {}",
+            "presented {} frames ({} mode) on {}; last frame {}{}",
             played.presented,
             played.mode.name(),
             played.device,
-            played.last_frame
+            played.last_frame,
+            played
+                .clip
+                .map_or(String::new(), |c| format!(" of clip {c}"))
         );
     }
     Ok(ExitCode::SUCCESS)

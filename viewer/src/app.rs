@@ -7,10 +7,10 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use trisort_format::Baked;
+use trisort_format::{Baked, Clip};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
-use winit::event::{ElementState, KeyEvent, MouseButton, WindowEvent};
+use winit::event::{ElementState, KeyEvent, Modifiers, MouseButton, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
@@ -26,7 +26,17 @@ const RESIZE_SETTLE: Duration = Duration::from_millis(150);
 
 /// The controls, told to the user once the event loop exists.
 const CONTROLS: &str = "window controls: Space play/pause, Right/Left step, Home/End \
-                        first/last, drag or 0-9 to scrub, Escape/Q quit";
+                        first/last, drag or 0-9 to scrub, Tab/C next clip (Shift: previous), \
+                        F1-F9 clip 1-9, Escape/Q quit";
+
+/// The rate a clip plays at: the one asked for, else the clip's, else the file's, else 30
+/// (`clip` `None`: the file's frames in order).
+pub(crate) fn rate(asked: Option<f64>, clip: Option<&Clip>, baked: &Baked) -> f64 {
+    asked
+        .or(clip.and_then(|c| c.fps))
+        .or(baked.fps)
+        .unwrap_or(30.0)
+}
 
 /// Runs the event loop of `session` over `range` until the window closes.
 pub(crate) fn run(
@@ -42,6 +52,7 @@ pub(crate) fn run(
         baked,
         options,
         fps,
+        clip,
     } = session;
     let name = path.file_name().map_or_else(
         || path.display().to_string(),
@@ -59,6 +70,10 @@ pub(crate) fn run(
             tone_map: options.tone_map,
         },
         period: Duration::from_secs_f64(1.0 / fps),
+        fps,
+        asked_fps: options.fps,
+        clip,
+        shift: false,
         variant: options.variant,
         exit_after: options.exit_after,
         path,
@@ -90,10 +105,11 @@ pub(crate) fn run(
             .as_ref()
             .map_or_else(String::new, |g| g.gpu.info.name.clone()),
         mode: viewer.play.mode,
+        clip: viewer.clip.map(|k| viewer.baked.clips[k].name.clone()),
+        last_frame: viewer.frame - viewer.clip.map_or(0, |k| viewer.baked.clips[k].first),
         variant: viewer.variant,
-        fps,
+        fps: viewer.fps,
         presented: viewer.presented,
-        last_frame: viewer.frame,
     })
 }
 
@@ -104,13 +120,22 @@ struct Viewer<'h> {
     /// Samples, mode, glass opacity and shading of every player built.
     play: PlaySettings,
     period: Duration,
+    /// The rate playback runs at (`1 / period`).
+    fps: f64,
+    /// The rate asked for (`None`: each clip's).
+    asked_fps: Option<f64>,
+    /// The clip selected (an index into the file's clips; `None`: the file's frames).
+    clip: Option<usize>,
+    /// Whether a Shift key is held (Shift+Tab selects the previous clip).
+    shift: bool,
     /// Material variant, applied to every player built.
     variant: Option<String>,
     exit_after: Option<u64>,
     path: PathBuf,
     name: String,
     baked: Baked,
-    /// The frame shown (an index into the file's frames, inside `range`).
+    /// The frame shown (an index into the file's frames, inside `range`, which is inside the
+    /// selected clip's frames).
     frame: u32,
     range: Range<u32>,
     playing: bool,
@@ -167,6 +192,7 @@ impl ApplicationHandler for Viewer<'_> {
                     },
                 ..
             } => self.key(event_loop, &logical_key),
+            WindowEvent::ModifiersChanged(m) => self.shift = modifiers_shift(&m),
             WindowEvent::CursorMoved { position, .. } => {
                 self.cursor_x = position.x;
                 if self.dragging {
@@ -294,10 +320,19 @@ impl Viewer<'_> {
                 self.playing = false;
                 self.show(self.frame.saturating_sub(1));
             }
+            Key::Named(NamedKey::Tab) => self.step_clip(!self.shift),
             Key::Named(NamedKey::Home) => self.show(self.range.start),
             Key::Named(NamedKey::End) => self.show(self.range.end - 1),
+            Key::Named(f) => {
+                let clips = self.baked.clips.len();
+                if let Some(k) = function_key(f).filter(|&k| k < clips) {
+                    self.select_clip(k);
+                }
+            }
             Key::Character(c) => match c.as_str() {
                 "q" | "Q" => event_loop.exit(),
+                "c" => self.step_clip(true),
+                "C" => self.step_clip(false),
                 d => {
                     if let Some(k) = d.parse::<u32>().ok().filter(|&k| k <= 9) {
                         self.show(self.frame_at(k as f64 / 10.0));
@@ -308,14 +343,55 @@ impl Viewer<'_> {
         }
     }
 
+    /// Selects the next clip (`forward`) or the previous one, wrapping around; from the
+    /// file's frames (no clip selected), the first or the last.
+    fn step_clip(&mut self, forward: bool) {
+        let n = self.baked.clips.len();
+        let k = match (self.clip, forward) {
+            (None, true) => 0,
+            (None, false) => n - 1,
+            (Some(k), true) => (k + 1) % n,
+            (Some(k), false) => (k + n - 1) % n,
+        };
+        self.select_clip(k);
+    }
+
+    /// Plays clip `k` from its first frame, looping over its frames at its rate (or the one
+    /// asked for).
+    fn select_clip(&mut self, k: usize) {
+        let clip = &self.baked.clips[k];
+        self.clip = Some(k);
+        self.range = clip.frames();
+        self.fps = rate(self.asked_fps, Some(clip), &self.baked);
+        self.period = Duration::from_secs_f64(1.0 / self.fps);
+        self.next_tick = Instant::now() + self.period;
+        self.frame = self.range.start;
+        self.request_redraw();
+        self.update_title();
+    }
+
     fn update_title(&mut self) {
         let Some(g) = &self.gfx else { return };
+        let clips = &self.baked.clips;
+        // Within a clip, its name and the frame counted from its first; otherwise the file's
+        // frame, and the clip it belongs to where the file has several.
+        let (clip, base) = match self.clip {
+            Some(k) => (
+                format!(" · clip {} ({} of {})", clips[k].name, k + 1, clips.len()),
+                clips[k].first,
+            ),
+            None if clips.len() > 1 => {
+                let name = (self.baked.clip_of_frame(self.frame)).map_or("?", |(_, c)| &c.name);
+                (format!(" · clip {name}"), 0)
+            }
+            None => (String::new(), 0),
+        };
         let title = format!(
-            "{} · frame {} of {}..{} · {} · {} · trisort",
+            "{}{clip} · frame {} of {}..{} · {} · {} · trisort",
             self.name,
-            self.frame,
-            self.range.start,
-            self.range.end - 1,
+            self.frame - base,
+            self.range.start - base,
+            self.range.end - 1 - base,
             if self.playing { "playing" } else { "paused" },
             self.play.mode.name(),
         );
@@ -391,4 +467,27 @@ impl Viewer<'_> {
         }
         Ok(())
     }
+}
+
+/// The function keys F1–F9, which select clips 1–9.
+const CLIP_KEYS: [NamedKey; 9] = [
+    NamedKey::F1,
+    NamedKey::F2,
+    NamedKey::F3,
+    NamedKey::F4,
+    NamedKey::F5,
+    NamedKey::F6,
+    NamedKey::F7,
+    NamedKey::F8,
+    NamedKey::F9,
+];
+
+/// The clip (counted from 0) a function key F1–F9 selects.
+fn function_key(key: &NamedKey) -> Option<usize> {
+    CLIP_KEYS.iter().position(|k| k == key)
+}
+
+/// Whether `m` holds a Shift key.
+fn modifiers_shift(m: &Modifiers) -> bool {
+    m.state().shift_key()
 }

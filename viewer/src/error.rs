@@ -29,6 +29,16 @@ pub enum ViewerError {
         #[source]
         source: trisort_format::VariantError,
     },
+    /// The clip asked for ([`ViewerOptions::clip`](crate::ViewerOptions::clip)) is not in
+    /// the file.
+    #[error("playing {}", file.display())]
+    Clip {
+        /// The baked file.
+        file: PathBuf,
+        /// The error naming the file's clips.
+        #[source]
+        source: trisort_player::PlayerError,
+    },
     /// A frame range that is empty or runs past the file's frames.
     #[error("frame range {start}..{end} is empty or outside the file's frames 0..{frames}")]
     FrameRange {

@@ -20,6 +20,13 @@
 //! variant ([`ViewerOptions::variant`]) is applied again whenever the player is rebuilt. The
 //! title shows the frame index.
 //!
+//! Clips (the camera paths of a bundle, [`trisort_format::Clip`]): Tab or C selects the next
+//! clip, Shift+Tab or Shift+C the previous one, F1–F9 clip 1–9. Playback then loops over the
+//! clip's frames at its rate ([`ViewerOptions::fps`] where given), and the title shows the
+//! clip's name and the frame within it. [`ViewerOptions::clip`] starts at a clip; without
+//! it the viewer plays the file's frames in order, the title naming the clip of the frame
+//! shown when the file has several.
+//!
 //! Use: [`Session::open`] checks the display and reads the file, [`Session::play`] runs the
 //! event loop until the window is closed and returns what was [`Played`]. The library prints
 //! nothing: what the user should read (the controls, the device, the player's warnings) goes
@@ -57,6 +64,9 @@ pub struct ViewerOptions {
     pub fps: Option<f64>,
     /// Material variant to play (`None`: the file's default materials).
     pub variant: Option<String>,
+    /// Clip to start at (`None`: the file's frames, in order); the frame range given to
+    /// [`Session::play`] must then lie inside it ([`Session::clip_frames`]).
+    pub clip: Option<String>,
     /// For tests and automation: quit after presenting this many frames.
     pub exit_after: Option<u64>,
 }
@@ -84,11 +94,15 @@ pub struct Played {
     pub mode: Mode,
     /// The material variant played.
     pub variant: Option<String>,
-    /// Playback rate in frames per second.
+    /// Playback rate in frames per second (the last one played at, which follows the clip
+    /// where [`ViewerOptions::fps`] was not given).
     pub fps: f64,
     /// Frames presented to the window.
     pub presented: u64,
-    /// The frame shown last.
+    /// The clip selected last (`None`: none was; the file's frames were played in order).
+    pub clip: Option<String>,
+    /// The frame shown last: counted from the first frame of [`Played::clip`], or the file's
+    /// frame where no clip was selected.
     pub last_frame: u32,
 }
 
@@ -98,6 +112,8 @@ pub struct Session {
     baked: Baked,
     options: ViewerOptions,
     fps: f64,
+    /// The clip to start at (its index in the file's clips).
+    clip: Option<usize>,
 }
 
 /// Whether the environment names a display server. Only Linux and the BSDs need one named;
@@ -122,7 +138,7 @@ pub fn display_named() -> bool {
 impl Session {
     /// Checks that a display is named ([`ViewerError::NoDisplay`], before reading the file, so
     /// a headless machine gets that error first) and that the rate is positive, then reads
-    /// `path` and checks that it has the material variant asked for.
+    /// `path` and checks that it has the material variant and the clip asked for.
     pub fn open(path: &Path, options: ViewerOptions) -> Result<Session, ViewerError> {
         if !display_named() {
             return Err(ViewerError::NoDisplay { detail: None });
@@ -131,8 +147,15 @@ impl Session {
             return Err(ViewerError::Fps(fps));
         }
         let baked = trisort_player::open_baked(path)?;
+        let clip = (options.clip.as_deref())
+            .map(|name| trisort_player::clip_index(&baked.clips, name))
+            .transpose()
+            .map_err(|source| ViewerError::Clip {
+                file: path.to_path_buf(),
+                source,
+            })?;
         // Checked once here (the file's structure check holds its fps finite and positive).
-        let fps = options.fps.or(baked.fps).unwrap_or(30.0);
+        let fps = app::rate(options.fps, clip.map(|k| &baked.clips[k]), &baked);
         baked
             .geometry
             .variant_materials(options.variant.as_deref())
@@ -145,6 +168,7 @@ impl Session {
             baked,
             options,
             fps,
+            clip,
         })
     }
 
@@ -153,7 +177,17 @@ impl Session {
         self.baked.frames.len() as u32
     }
 
-    /// Opens the window and plays `frames` (`None`: all; playback loops over them) until the
+    /// The file's frames playback starts in: those of [`ViewerOptions::clip`], or all of
+    /// them. A frame range for [`Session::play`] must lie inside.
+    pub fn clip_frames(&self) -> Range<u32> {
+        match self.clip {
+            Some(k) => self.baked.clips[k].frames(),
+            None => 0..self.frame_count(),
+        }
+    }
+
+    /// Opens the window and plays `frames` (the file's frame indices, inside
+    /// [`Session::clip_frames`]; `None`: all of those; playback loops over them) until the
     /// window is closed or [`ViewerOptions::exit_after`] frames were presented.
     pub fn play(
         self,
@@ -161,8 +195,9 @@ impl Session {
         host: &mut dyn ViewerHost,
     ) -> Result<Played, ViewerError> {
         let n = self.frame_count();
+        let within = self.clip_frames();
         let range = match frames {
-            Some(r) if r.start >= r.end || r.end > n => {
+            Some(r) if r.start >= r.end || r.start < within.start || r.end > within.end => {
                 return Err(ViewerError::FrameRange {
                     start: r.start,
                     end: r.end,
@@ -171,7 +206,7 @@ impl Session {
             }
             Some(r) => r,
             None if n == 0 => return Err(ViewerError::NoFrames { file: self.path }),
-            None => 0..n,
+            None => within,
         };
         app::run(self, range, host)
     }
