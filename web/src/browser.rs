@@ -8,7 +8,7 @@ use trisort_gpu::{Gpu, UncapturedError};
 use trisort_player::{OnScreen, OnScreenSettings};
 use wasm_bindgen::prelude::*;
 
-use crate::{BrowserBackend, FrameFigures};
+use crate::{clip_figures, BrowserBackend, FrameFigures};
 
 /// Reports a Rust panic on the browser console instead of an opaque "unreachable".
 #[wasm_bindgen(start)]
@@ -30,6 +30,8 @@ pub struct WebPlayer {
     on_screen: OnScreen,
     backend: &'static str,
     fps: Option<f64>,
+    /// The selected clip, an index into the player's clips ([`WebPlayer::set_clip`]).
+    clip: usize,
     robust: trisort_format::Robust,
     warnings: Vec<String>,
     uncaptured: UncapturedError,
@@ -117,6 +119,7 @@ impl WebPlayer {
             on_screen,
             backend: backend_name,
             fps,
+            clip: 0,
             robust,
             warnings,
             uncaptured,
@@ -189,19 +192,75 @@ impl WebPlayer {
         self.on_screen.player().frame_commands(frame).len() as u32
     }
 
-    /// The figures line the page shows for `frame`, drawn in `ms` milliseconds.
+    /// The figures line the page shows for `frame`, drawn in `ms` milliseconds (with the
+    /// clip and the frame's place in it when the file has several clips).
     pub fn figures(&self, frame: u32, ms: f64) -> String {
-        FrameFigures {
+        let mut line = FrameFigures {
             frame,
             frames: self.frame_count(),
             triangles: self.frame_triangles(frame) as u64,
             draws: self.frame_draws(frame),
             ms,
         }
-        .to_string()
+        .to_string();
+        if self.clips_of().len() > 1 {
+            let c = self.selected();
+            line += &clip_figures(&c.name, frame, c.first, c.count);
+        }
+        line
     }
 
-    /// The path's frame rate as baked (`undefined` for files that do not say).
+    /// The names of the file's clips (its camera paths), in frame order: at least one
+    /// (`main` for a file of one unnamed path).
+    pub fn clips(&self) -> Vec<String> {
+        self.clips_of().iter().map(|c| c.name.clone()).collect()
+    }
+
+    /// The file's frames clip `name` spans, `[first, count]`: frames `first .. first +
+    /// count` (frame numbers are the file's everywhere). An unknown name is an error listing
+    /// the clips.
+    pub fn clip_range(&self, name: &str) -> Result<Vec<u32>, JsError> {
+        let c = self.named(name)?;
+        Ok(vec![c.first, c.count])
+    }
+
+    /// The frame rate clip `name` was baked at (`undefined` where the file does not say).
+    pub fn clip_fps(&self, name: &str) -> Result<Option<f64>, JsError> {
+        Ok(self.named(name)?.fps)
+    }
+
+    /// Selects the clip named `name`: the page then plays, scrubs and steps within its
+    /// frames ([`WebPlayer::clip_first`], [`WebPlayer::clip_length`]) at its rate. An unknown
+    /// name is an error listing the clips, and the selection stays.
+    pub fn set_clip(&mut self, name: &str) -> Result<(), JsError> {
+        self.clip = trisort_player::clip_index(self.clips_of(), name).map_err(js_error)?;
+        Ok(())
+    }
+
+    /// The selected clip's name (the first clip until [`WebPlayer::set_clip`]).
+    pub fn clip(&self) -> String {
+        self.selected().name.clone()
+    }
+
+    /// The selected clip's first frame, among the file's frames.
+    pub fn clip_first(&self) -> u32 {
+        self.selected().first
+    }
+
+    /// The selected clip's number of frames.
+    pub fn clip_length(&self) -> u32 {
+        self.selected().count
+    }
+
+    /// The frame after (`step` 1) or before (`step` −1) `frame` in the selected clip, looping
+    /// within it ([`crate::step_in_clip`]).
+    pub fn step_frame(&self, frame: u32, step: i32) -> u32 {
+        let c = self.selected();
+        crate::step_in_clip(frame, c.first, c.count, step)
+    }
+
+    /// The path's frame rate as baked (`undefined` for files that do not say); a clip's own is
+    /// [`WebPlayer::clip_fps`].
     pub fn fps(&self) -> Option<f64> {
         self.fps
     }
@@ -274,6 +333,21 @@ impl WebPlayer {
     /// What makes this playback inexact (another device than the recording's, …).
     pub fn warnings(&self) -> Vec<String> {
         self.warnings.clone()
+    }
+}
+
+impl WebPlayer {
+    fn clips_of(&self) -> &[trisort_format::Clip] {
+        self.on_screen.player().clips()
+    }
+
+    fn selected(&self) -> &trisort_format::Clip {
+        &self.clips_of()[self.clip]
+    }
+
+    fn named(&self, name: &str) -> Result<&trisort_format::Clip, JsError> {
+        let k = trisort_player::clip_index(self.clips_of(), name).map_err(js_error)?;
+        Ok(&self.clips_of()[k])
     }
 }
 

@@ -94,6 +94,27 @@ impl fmt::Display for FrameFigures {
     }
 }
 
+/// The frame after (`step` 1) or before (`step` −1) `frame` when playing the clip that spans
+/// the file's frames `first .. first + count`: playback loops within the clip, and a frame
+/// outside it (another clip's, shown when the clip was chosen) goes to the clip's first frame.
+/// `count` 0 (no frames) stays at `first`.
+pub fn step_in_clip(frame: u32, first: u32, count: u32, step: i32) -> u32 {
+    if count == 0 || frame < first || frame - first >= count {
+        return first;
+    }
+    let k = i64::from(frame - first) + i64::from(step);
+    first + k.rem_euclid(i64::from(count)) as u32
+}
+
+/// What the figures line adds for a file of several clips: the clip's name and the frame's
+/// place in it (`frame` among the file's frames; the clip spans `first .. first + count`).
+pub fn clip_figures(name: &str, frame: u32, first: u32, count: u32) -> String {
+    if frame < first || frame - first >= count {
+        return format!(" · clip {name} (frame outside it)");
+    }
+    format!(" · clip {name} {}/{count}", frame - first + 1)
+}
+
 /// `37126` → `37,126`.
 fn group_thousands(n: u64) -> String {
     let digits = n.to_string();
@@ -124,6 +145,27 @@ mod tests {
         );
         let err = "vulkan".parse::<BrowserBackend>().unwrap_err();
         assert!(err.contains("'vulkan'") && err.contains("webgl2"), "{err}");
+    }
+
+    #[test]
+    fn playback_loops_within_the_clip() {
+        // A clip over frames 20..48.
+        assert_eq!(step_in_clip(20, 20, 28, 1), 21);
+        assert_eq!(step_in_clip(47, 20, 28, 1), 20);
+        assert_eq!(step_in_clip(20, 20, 28, -1), 47);
+        assert_eq!(step_in_clip(30, 20, 28, -1), 29);
+        // Another clip's frame goes to the clip's start.
+        assert_eq!(step_in_clip(5, 20, 28, 1), 20);
+        assert_eq!(step_in_clip(48, 20, 28, -1), 20);
+        // A one-frame clip stays; a clip at the file's end near u32::MAX does not overflow.
+        assert_eq!(step_in_clip(7, 7, 1, 1), 7);
+        assert_eq!(step_in_clip(u32::MAX - 1, u32::MAX - 2, 2, 1), u32::MAX - 2);
+        assert_eq!(step_in_clip(3, 3, 0, 1), 3);
+        assert_eq!(clip_figures("door", 21, 20, 28), " · clip door 2/28");
+        assert_eq!(
+            clip_figures("door", 2, 20, 28),
+            " · clip door (frame outside it)"
+        );
     }
 
     #[test]

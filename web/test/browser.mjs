@@ -4,7 +4,7 @@
 //
 //   node web/test/browser.mjs --dist web/dist --native DIR --frames 0,12,24 --out DIR
 //        [--backend webgl2] [--mode blend] [--shading pbr|basic] [--self-check no] [--file demo.baked] [--bad-file NAME]
-//        [--variant-file NAME --variant VARIANT]
+//        [--variant-file NAME --variant VARIANT] [--clip-file NAME --clip CLIP]
 //        [--chromium /usr/bin/chromium]
 //
 // Writes the browser's frames as DIR/frame-NNNNN.png (for `trisort verify --frames-dir`) and
@@ -178,7 +178,46 @@ try {
       };
     }, a.variant);
   }
-  console.log(JSON.stringify({ device, frames, self_check: selfCheck, bad_file: badFile, variant, console_errors: errors }, null, 1));
+  // Clips (the camera paths of a bundle) chosen on the page: the scrub bar, stepping and
+  // playback stay within the chosen clip's frames, at its rate.
+  let clip = null;
+  if (a["clip-file"]) {
+    const { page: cp } = await openPlayer(`file=${a["clip-file"]}`, "clips");
+    clip = await cp.evaluate((name) => {
+      const t = window.trisort;
+      const p = t.state.player;
+      const $ = (id) => document.getElementById(id);
+      const clips = p.clips();
+      const ranges = clips.map((c) => Array.from(p.clip_range(c)));
+      const options = Array.from($("clip").options).map((o) => o.value);
+      const shown = !$("clip-box").hidden;
+      const initial = { clip: p.clip(), frame: t.state.frame, min: Number($("scrub").min), max: Number($("scrub").max) };
+      $("clip").value = name;
+      $("clip").dispatchEvent(new Event("change"));
+      const first = p.clip_first(), length = p.clip_length(), last = first + length - 1;
+      const selected = {
+        clip: p.clip(), first, length, frame: t.state.frame,
+        min: Number($("scrub").min), max: Number($("scrub").max), fps: Number($("fps").value),
+        clip_fps: p.clip_fps(name) ?? null, figures: $("figures").textContent,
+      };
+      // Stepping and playback (which steps by one) loop within the clip.
+      const visited = new Set();
+      for (let k = 0; k < 2 * length; k++) { t.step(1); visited.add(t.state.frame); }
+      t.renderFrame(last);
+      t.step(1);
+      const after_last = t.state.frame;
+      t.step(-1);
+      const before_first = t.state.frame;
+      let unknown = "";
+      try { p.set_clip("no-such-clip"); } catch (e) { unknown = e.message; }
+      return {
+        name, clips, ranges, options, shown, initial, selected, after_last, before_first,
+        visited_min: Math.min(...visited), visited_max: Math.max(...visited), visited: visited.size,
+        still: p.clip(), unknown, error: $("error").textContent,
+      };
+    }, a.clip);
+  }
+  console.log(JSON.stringify({ device, frames, self_check: selfCheck, bad_file: badFile, variant, clip, console_errors: errors }, null, 1));
 } catch (e) {
   failed = e;
 } finally {

@@ -33,9 +33,13 @@ scenes="${TRISORT_SCENES:-$(pwd)/../shared/scenes}"
 "$trisort" bake "$scenes/CarConcept/CarConcept.glb" --path orbit:frames=1 --size 64x64 \
   --keep-intersections --raster-profile browser -o web/dist/variants.baked \
   >/dev/null 2>"$out/variants-bake.log"
+# A bundle of two clips (camera paths) over the demo's frames, made without baking two paths:
+# "intro", frames 0..20 at the file's rate, and "orbit", the rest at 12 fps.
+cargo run -q -p trisort-web --example split_clips -- "$baked" web/dist/clips.baked intro:20 orbit@12
 node web/test/browser.mjs --dist web/dist --native "$out/native" --frames "$list" \
   --out "$out/browser" --backend webgl2 --bad-file truncated.baked \
-  --variant-file variants.baked --variant "Torched Graphite" > "$out/browser.json"
+  --variant-file variants.baked --variant "Torched Graphite" \
+  --clip-file clips.baked --clip orbit > "$out/browser.json"
 # Exit 3 means "verified and some frame failed the recorded pattern's tolerance": expected on
 # another rasterizer; the gate below reads the figures instead.
 "$trisort" verify "$baked" --scene demo --frames-dir "$out/browser" --json \
@@ -138,6 +142,22 @@ if (!va || !va.shown || va.variants.length !== 3 || va.pixels_changed === 0 || v
   bad.push(`CarConcept's variants did not play as expected: ${JSON.stringify(va)}`);
 } else {
   console.log(`  variant "${va.name}" on CarConcept: ${va.pixels_changed} pixels change colour`);
+}
+const cl = b.clip;
+const clipOk = cl && cl.clips.join() === "intro,orbit" && cl.options.join() === "intro,orbit" &&
+  cl.shown && JSON.stringify(cl.ranges) === JSON.stringify([[0, 20], [20, n - 20]]) &&
+  cl.initial.clip === "intro" && cl.initial.frame === 0 && cl.initial.min === 0 && cl.initial.max === 19 &&
+  cl.selected.clip === "orbit" && cl.selected.first === 20 && cl.selected.length === n - 20 &&
+  cl.selected.frame === 20 && cl.selected.min === 20 && cl.selected.max === n - 1 &&
+  cl.selected.fps === 12 && cl.selected.clip_fps === 12 && cl.selected.figures.includes("clip orbit 1/") &&
+  cl.after_last === 20 && cl.before_first === n - 1 && cl.visited_min === 20 &&
+  cl.visited_max === n - 1 && cl.visited === n - 20 && cl.still === "orbit" &&
+  cl.unknown.includes("no-such-clip") && cl.unknown.includes("intro") && cl.unknown.includes("orbit") &&
+  !cl.error;
+if (!clipOk) {
+  bad.push(`the two-clip file did not play as expected: ${JSON.stringify(cl)}`);
+} else {
+  console.log(`  clips ${cl.clips.join(", ")}: "${cl.name}" plays frames ${cl.selected.min}..${cl.selected.max} at ${cl.selected.fps} fps, looping`);
 }
 if (bad.length) { console.error("browser test failed:\n  " + bad.join("\n  ")); process.exit(1); }
 JS

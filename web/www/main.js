@@ -4,6 +4,8 @@
 // ?mode=blend|depth|saturate, ?shading=pbr|basic and ?tonemap=neutral|aces choose how. ?selfcheck=1 plays in depth mode and also draws the
 // file's z-buffer twin on a hidden canvas: pixels where the two differ are holes on this
 // browser (a triangle the frame leaves out is nearest there); the figures show their count.
+// A file of several clips (camera paths) gets a clip choice: playback, the scrub bar and the
+// arrow keys then stay within the clip's frames (frame numbers are the file's), at its rate.
 // window.trisort exposes the player and the self-check to tests.
 import init, { WebPlayer } from "./pkg/trisort_web.js";
 
@@ -17,7 +19,7 @@ const $ = (id) => document.getElementById(id);
 const canvas = $("canvas");
 
 const state = { player: null, twin: null, frame: 0, playing: false, last: 0, ms: 0 };
-window.trisort = { state, ready: null, renderFrame, open, selfCheck, pixels, compare };
+window.trisort = { state, ready: null, renderFrame, open, selfCheck, pixels, compare, setClip, step };
 
 // The RGBA pixels of a canvas or image (a canvas copied in the same task as its draw, while
 // its drawing buffer holds the frame), and the 2D canvas holding the copy.
@@ -115,8 +117,38 @@ async function open(bytes, name) {
     return o;
   }));
   $("variant-box").hidden = variants.length === 0;
-  renderFrame(0);
+  const clips = p.clips();
+  $("clip").replaceChildren(...clips.map((name) => {
+    const o = document.createElement("option");
+    o.value = name;
+    const [first, count] = p.clip_range(name);
+    o.textContent = `${name} (frames ${first}–${first + count - 1})`;
+    return o;
+  }));
+  $("clip-box").hidden = clips.length < 2;
+  setClip(p.clip());
   return p;
+}
+
+// Selects clip `name` on the player (and the self-check's twin), restricts the scrub bar to
+// its frames, takes its frame rate where the file has one, and shows its first frame.
+function setClip(name) {
+  const p = state.player;
+  p.set_clip(name);
+  if (state.twin) state.twin.set_clip(name);
+  const first = p.clip_first();
+  const scrub = $("scrub");
+  scrub.min = String(first);
+  scrub.max = String(first + p.clip_length() - 1);
+  const fps = p.clip_fps(name) ?? p.fps();
+  if (fps) $("fps").value = String(Math.round(fps));
+  $("clip").value = name;
+  renderFrame(first);
+}
+
+// Shows the frame after (+1) or before (-1) the one shown, looping within the clip.
+function step(by) {
+  return renderFrame(state.player.step_frame(state.frame, by));
 }
 
 async function fetchBaked(url) {
@@ -130,8 +162,7 @@ function tick(now) {
   const fps = Math.max(1, Number($("fps").value) || 24);
   if (now - state.last >= 1000 / fps) {
     state.last = now;
-    const next = (state.frame + 1) % state.player.frame_count();
-    try { renderFrame(next); } catch (e) { state.playing = false; showError(e); }
+    try { step(1); } catch (e) { state.playing = false; showError(e); }
   }
   requestAnimationFrame(tick);
 }
@@ -153,6 +184,10 @@ $("variant").addEventListener("change", (e) => {
     renderFrame(state.frame);
   } catch (err) { showError(err); }
 });
+$("clip").addEventListener("change", (e) => {
+  $("error").textContent = "";
+  try { setClip(e.target.value); } catch (err) { showError(err); }
+});
 $("scrub").addEventListener("input", (e) => {
   setPlaying(false);
   try { renderFrame(Number(e.target.value)); } catch (err) { showError(err); }
@@ -172,10 +207,9 @@ stage.addEventListener("drop", (e) => {
 });
 document.addEventListener("keydown", (e) => {
   if (!state.player || e.target.tagName === "INPUT") return;
-  const n = state.player.frame_count();
   if (e.key === " ") { e.preventDefault(); setPlaying(!state.playing); }
-  else if (e.key === "ArrowRight") { setPlaying(false); renderFrame((state.frame + 1) % n); }
-  else if (e.key === "ArrowLeft") { setPlaying(false); renderFrame((state.frame + n - 1) % n); }
+  else if (e.key === "ArrowRight") { setPlaying(false); step(1); }
+  else if (e.key === "ArrowLeft") { setPlaying(false); step(-1); }
 });
 
 window.trisort.ready = (async () => {
