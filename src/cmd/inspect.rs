@@ -99,16 +99,7 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
     let mut v = trisort_bake::figures::baked_file_json(&baked);
     // The camera paths of the file (a bundle has several): DESIGN's `clips[{name, frames,
     // fps}]`, `frames` the clip's count, with where it starts in the file and in its path.
-    v["clips"] = baked
-        .clips
-        .iter()
-        .map(|c| {
-            json!({
-                "name": c.name, "first": c.first, "frames": c.count, "fps": c.fps,
-                "path_first": c.path_first,
-            })
-        })
-        .collect();
+    v["clips"] = trisort_bake::figures::clips_json(&baked);
     if let Some(png) = &a.matrix {
         let m = trisort_bench::matrix::draw_matrix(&baked, png)?;
         let margin = trisort_bench::matrix::MARGIN;
