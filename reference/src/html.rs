@@ -294,6 +294,18 @@ figure{margin:0;display:inline-block}figcaption{font-size:.75em;text-align:cente
 
 /// The report as one HTML document.
 pub fn html_report(r: &HtmlReport<'_>) -> String {
+    let rows = rows(r);
+    let mut o = String::new();
+    head_and_files(&mut o, r);
+    settings_and_check(&mut o, r);
+    clips_table(&mut o, r, &rows);
+    frames_table(&mut o, r, &rows);
+    o.push_str(LEGEND);
+    o
+}
+
+/// The rows of every frame either check reports, worst first.
+fn rows<'a>(r: &HtmlReport<'a>) -> Vec<Row<'a>> {
     let mut frames: Vec<u32> = r
         .graph
         .map_or_else(Vec::new, |g| g.frames.iter().map(|f| f.frame).collect());
@@ -330,8 +342,11 @@ pub fn html_report(r: &HtmlReport<'_>) -> String {
         })
         .collect();
     rows.sort_by_key(|row| std::cmp::Reverse(row.severity()));
+    rows
+}
 
-    let mut o = String::new();
+/// The document's head, the verdict banner, the files with their hashes and the versions.
+fn head_and_files(o: &mut String, r: &HtmlReport<'_>) {
     let title = format!("trisort verify: {}", r.baked.path);
     let _ = write!(
         o,
@@ -384,8 +399,10 @@ pub fn html_report(r: &HtmlReport<'_>) -> String {
         escape(r.baked_tool_version)
     );
     o.push_str("</table>\n");
+}
 
-    // The bake's settings and what was checked.
+/// The bake's settings and raster profile, and what was checked how.
+fn settings_and_check(o: &mut String, r: &HtmlReport<'_>) {
     o.push_str("<h2>Bake settings</h2>\n<table id=\"settings\">\n");
     let _ = writeln!(
         o,
@@ -469,8 +486,10 @@ pub fn html_report(r: &HtmlReport<'_>) -> String {
     }
     check_row("clip verified", r.clip.unwrap_or("all").to_string());
     o.push_str("</table>\n");
+}
 
-    // Per clip.
+/// A row per clip of the file: its frames, how many were checked and failed, its worst.
+fn clips_table(o: &mut String, r: &HtmlReport<'_>, rows: &[Row<'_>]) {
     o.push_str(
         "<h2>Clips</h2>\n<table id=\"clips\">\n<tr><th class=\"l\">clip</th>\
         <th>frames</th><th>fps</th><th>checked</th><th>failed</th><th>verdict</th>\
@@ -516,8 +535,10 @@ pub fn html_report(r: &HtmlReport<'_>) -> String {
         );
     }
     o.push_str("</table>\n");
+}
 
-    // Per frame, worst first.
+/// A row per checked frame, worst first, with its figures and thumbnails.
+fn frames_table(o: &mut String, r: &HtmlReport<'_>, rows: &[Row<'_>]) {
     o.push_str(
         "<h2>Frames (worst first)</h2>\n<table id=\"frames\">\n<tr><th>frame</th>\
         <th class=\"l\">clip</th><th>verdict</th><th>pixels differing</th>\
@@ -527,7 +548,7 @@ pub fn html_report(r: &HtmlReport<'_>) -> String {
         <th class=\"l\">difference</th></tr>\n",
     );
     let num = |v: Option<u64>| v.map_or_else(|| "-".to_string(), |v| v.to_string());
-    for row in &rows {
+    for row in rows {
         let c = row.image.map(|i| &i.comparison);
         let _ = write!(
             o,
@@ -601,9 +622,10 @@ pub fn html_report(r: &HtmlReport<'_>) -> String {
         o.push_str("</tr>\n");
     }
     o.push_str("</table>\n");
+}
 
-    o.push_str(
-        "<h2>Legend</h2>\n<div class=\"legend\" id=\"legend\">\n<ul>\n\
+/// What the report's figures mean, and the end of the document.
+const LEGEND: &str = "<h2>Legend</h2>\n<div class=\"legend\" id=\"legend\">\n<ul>\n\
          <li><b>verdict</b>: fail when the frame's graph rules or its image check failed \
          (the image check: at the recorded pattern, a colour channel more than 1/255 off at an \
          ordered pixel, or any difference in depth mode; off it, more than --max-error); \
@@ -624,10 +646,7 @@ pub fn html_report(r: &HtmlReport<'_>) -> String {
          thumbnail pixel covers.</li>\n\
          <li>Frames are sorted worst first: failing frames first, then by ordered pixels \
          differing, largest ordered difference, graph violations and pixels differing.</li>\n\
-         </ul>\n</div>\n</body>\n</html>\n",
-    );
-    o
-}
+         </ul>\n</div>\n</body>\n</html>\n";
 
 /// Writes `html` as `dir/index.html` (creating `dir`), atomically.
 pub fn write_report(dir: &Path, html: &str) -> Result<(), FramesError> {

@@ -184,8 +184,7 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         Some(name) => Some(
             baked
                 .clip(name)
-                .map_err(|e| anyhow::anyhow!("--clip {name}: {e}"))?
-                .clone(),
+                .map_err(|e| anyhow::anyhow!("--clip {name}: {e}"))?,
         ),
     };
     let recs = read_recordings(&a.recording)?;
@@ -202,7 +201,7 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
     let mut thumbs = BTreeMap::new();
     let images = match &a.scene {
         None => None,
-        Some(spec) => match image_check(&a, spec, &baked, &recs, clip.as_ref(), &mut thumbs) {
+        Some(spec) => match image_check(&a, spec, &baked, &recs, clip, &mut thumbs) {
             Ok(r) => Some(r),
             // The graph rules failed already (the files disagree): that is the verdict.
             Err(e) if graph.as_ref().is_some_and(|g| !g.ok) => {
@@ -244,53 +243,20 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             "max_error"
         }
     });
-    let verdict = format!(
-        "{}: {}",
-        a.baked.display(),
-        match code {
-            0 if unverified => "images NOT VERIFIED (--measure-only --allow-unverified)",
-            0 => "OK",
-            UNVERIFIED => "images NOT VERIFIED (--measure-only; exit 4 unless --allow-unverified)",
-            _ => "FAILED",
-        }
-    );
+    let verdict = verdict_line(&a.baked, code, unverified);
     if let Some(dir) = &a.report {
-        let html = html_report(&HtmlReport {
-            baked: hashed_file(&a.baked)?,
-            scene: a.scene.as_deref().map(scene_file).transpose()?,
-            recordings: a
-                .recording
-                .iter()
-                .map(|p| hashed_file(p))
-                .collect::<Result<_>>()?,
-            tool_version: env!("CARGO_PKG_VERSION"),
-            baked_tool_version: &baked.tool_version,
-            settings: settings_rows(&baked),
-            raster_profile: trisort_bake::figures::profile_summary(&baked.settings),
-            clips: &baked.clips,
-            clip: a.clip.as_deref(),
+        let what = Checked {
             ok,
-            verdict: verdict.clone(),
+            verdict: &verdict,
             graph: graph.as_ref(),
             images: images.as_ref(),
-            measure_only: a.measure_only,
             thumbnails: &thumbs,
-        });
-        trisort_reference::html::write_report(dir, &html)?;
+        };
+        write_html(&a, dir, &baked, what)?;
     }
     if a.json {
         let mut v = json_report(ok, graph.as_ref(), images.as_ref());
-        for f in v["frames"].as_array_mut().into_iter().flatten() {
-            let clip = f["frame"]
-                .as_u64()
-                .and_then(|n| baked.clip_of_frame(n as u32))
-                .map(|(_, c)| c.name.clone());
-            f["clip"] = json!(clip);
-        }
-        v["clip"] = json!(a.clip);
-        if let Some(dir) = &a.report {
-            v["report"] = json!(dir.join("index.html").display().to_string());
-        }
+        add_clips_json(&mut v, &a, &baked);
         if let Some(dir) = &a.frames_dir {
             v["frames_dir"] = json!(dir.display().to_string());
         }
@@ -319,25 +285,102 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             "{}",
             text_report(&a.baked, graph.as_ref(), images.as_ref(), a.measure_only)
         );
-        let name = &baked.environment.name;
-        match (&environment, &a.environment) {
-            (Some(Some(what)), Some(spec)) => {
-                println!("environment: FAILED: the stored light ({name:?}) is not {spec}: {what}")
-            }
-            (Some(None), Some(spec)) => println!("environment: OK (the stored light is {spec})"),
-            _ if graph.is_some() && name == "studio" => {
-                println!("environment: checked with the graph rules (the built-in studio)")
-            }
-            _ => println!(
-                "environment: {name:?}, not checked (give --environment FILE.hdr, the light it was baked with)"
-            ),
-        }
+        print_environment(&a, &baked, environment.as_ref(), graph.is_some());
         if let Some(dir) = &a.report {
             println!("report: {}", dir.join("index.html").display());
         }
         println!("{verdict}");
     }
     Ok(ExitCode::from(code))
+}
+
+/// The text report's line on the stored light: `environment` is its difference from the
+/// light `--environment` names (`None`: not asked); `graph`: whether the graph rules ran
+/// (they check a file that names the built-in studio).
+fn print_environment(
+    a: &VerifyArgs,
+    baked: &Baked,
+    environment: Option<&Option<String>>,
+    graph: bool,
+) {
+    let name = &baked.environment.name;
+    match (environment, &a.environment) {
+        (Some(Some(what)), Some(spec)) => {
+            println!("environment: FAILED: the stored light ({name:?}) is not {spec}: {what}")
+        }
+        (Some(None), Some(spec)) => println!("environment: OK (the stored light is {spec})"),
+        _ if graph && name == "studio" => {
+            println!("environment: checked with the graph rules (the built-in studio)")
+        }
+        _ => println!(
+            "environment: {name:?}, not checked (give --environment FILE.hdr, the light it was baked with)"
+        ),
+    }
+}
+
+/// What the checks found, for the HTML report.
+struct Checked<'a> {
+    ok: bool,
+    verdict: &'a str,
+    graph: Option<&'a trisort_verify::GraphReport>,
+    images: Option<&'a (ImageReport, ImageCheck)>,
+    thumbnails: &'a BTreeMap<u32, Thumbnails>,
+}
+
+/// `--report DIR`: the HTML sign-off report as DIR/index.html.
+fn write_html(a: &VerifyArgs, dir: &Path, baked: &Baked, what: Checked<'_>) -> Result<()> {
+    let html = html_report(&HtmlReport {
+        baked: hashed_file(&a.baked)?,
+        scene: a.scene.as_deref().map(scene_file).transpose()?,
+        recordings: a
+            .recording
+            .iter()
+            .map(|p| hashed_file(p))
+            .collect::<Result<_>>()?,
+        tool_version: env!("CARGO_PKG_VERSION"),
+        baked_tool_version: &baked.tool_version,
+        settings: settings_rows(baked),
+        raster_profile: trisort_bake::figures::profile_summary(&baked.settings),
+        clips: &baked.clips,
+        clip: a.clip.as_deref(),
+        ok: what.ok,
+        verdict: what.verdict.to_string(),
+        graph: what.graph,
+        images: what.images,
+        measure_only: a.measure_only,
+        thumbnails: what.thumbnails,
+    });
+    trisort_reference::html::write_report(dir, &html)?;
+    Ok(())
+}
+
+/// `--json`'s clip keys: `clip` (the one given) and each frame's `clip`; and `report`.
+fn add_clips_json(v: &mut Value, a: &VerifyArgs, baked: &Baked) {
+    for f in v["frames"].as_array_mut().into_iter().flatten() {
+        let clip = f["frame"]
+            .as_u64()
+            .and_then(|n| baked.clip_of_frame(n as u32))
+            .map(|(_, c)| c.name.clone());
+        f["clip"] = json!(clip);
+    }
+    v["clip"] = json!(a.clip);
+    if let Some(dir) = &a.report {
+        v["report"] = json!(dir.join("index.html").display().to_string());
+    }
+}
+
+/// The verdict's last line: the file and OK, FAILED or NOT VERIFIED as exit `code` says.
+fn verdict_line(baked: &Path, code: u8, unverified: bool) -> String {
+    format!(
+        "{}: {}",
+        baked.display(),
+        match code {
+            0 if unverified => "images NOT VERIFIED (--measure-only --allow-unverified)",
+            0 => "OK",
+            UNVERIFIED => "images NOT VERIFIED (--measure-only; exit 4 unless --allow-unverified)",
+            _ => "FAILED",
+        }
+    )
 }
 
 /// BLAKE3 of a file's bytes, hex.
