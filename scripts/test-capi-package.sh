@@ -51,7 +51,7 @@ if [ "$with_export" = 1 ]; then
   export_soname="$(readelf -d "$export_lib" | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p')"
   [ "$export_soname" = libtrisort_export.so.0 ] ||
     fail "$export_lib: SONAME is '$export_soname', not libtrisort_export.so.0"
-  for symbol in trisort_export_order trisort_open_path trisort_last_error; do
+  for symbol in trisort_export_order trisort_open_path trisort_last_error trisort_clip_find; do
     nm -D --defined-only "$export_lib" | grep -qw "$symbol" || fail "$export_lib lacks $symbol"
   done
 fi

@@ -355,3 +355,79 @@ fn c_host_reports_a_bad_file_and_exits_non_zero() {
         "{err}"
     );
 }
+
+/// `host --clip NAME` draws only that clip's frames (ABI 6: `trisort_clip_find`,
+/// `trisort_clip_frames`), named by the file's frame numbers and equal to the same frames of a
+/// run over every frame; an unknown name fails listing the file's clips. The demo bake is
+/// rewritten as two clips, "approach" (frames 0..2) and "orbit" (2..6).
+#[test]
+fn c_host_draws_one_clip_of_a_bundle() {
+    if !c_toolchain() {
+        return;
+    }
+    let Some(dir) = gpu_tempdir() else { return };
+    let d = dir.path();
+    let host = build_host(d);
+    demo_bake(d);
+    let kind = trisort_format::FileKind::Baked;
+    let mut baked: trisort_format::Baked =
+        trisort_format::read_file(kind, &d.join("car.baked")).unwrap();
+    assert_eq!(baked.frames.len(), 6);
+    let whole = baked.clips[0].clone();
+    baked.clips = vec![
+        trisort_format::Clip {
+            name: "approach".into(),
+            count: 2,
+            ..whole.clone()
+        },
+        trisort_format::Clip {
+            name: "orbit".into(),
+            first: 2,
+            count: 4,
+            path_first: 2,
+            ..whole
+        },
+    ];
+    baked.check_structure().unwrap();
+    let bundle = d.join("bundle.baked");
+    trisort_format::write_file_atomic(kind, &bundle, &baked).unwrap();
+
+    let (all, orbit) = (d.join("all"), d.join("orbit"));
+    run_host(&host, &bundle, &all, "blend", &[]);
+    run_host(
+        &host,
+        &bundle,
+        &orbit,
+        "blend",
+        &[Path::new("--clip"), Path::new("orbit")],
+    );
+    let mut names: Vec<String> = std::fs::read_dir(&orbit)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    let want: Vec<String> = (2..6).map(|f| format!("frame-{f:05}.png")).collect();
+    assert_eq!(names, want);
+    for name in &want {
+        let (count, max, _) = differing(&orbit.join(name), &all.join(name), 0);
+        assert_eq!(
+            (count, max),
+            (0, 0),
+            "{name}: the clip's frame is the file's frame"
+        );
+    }
+
+    std::fs::create_dir_all(d.join("none")).unwrap();
+    let out = Command::new(&host)
+        .arg(&bundle)
+        .arg(d.join("none"))
+        .args(["blend", "--clip", "door"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("\"door\"") && err.contains("approach, orbit"),
+        "{err}"
+    );
+}

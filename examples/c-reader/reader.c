@@ -143,7 +143,26 @@ int main(int argc, char **argv) {
   }
   printf("digest_frames %016llx\n", (unsigned long long)digest);
 
-  /* Refusals: a frame out of range and a depth range outside the enum. */
+  /* The clips (ABI 6): the camera paths the file bundles, each a run of its frames. */
+  uint32_t clips = 0;
+  if (trisort_clip_count(h, &clips) != TRISORT_STATUS_OK) return fail("clip_count");
+  printf("clips %u\n", clips);
+  for (uint32_t k = 0; k < clips; k++) {
+    char name[80]; /* names are at most 64 bytes */
+    size_t len = 0;
+    uint32_t first = 0, count = 0, found = 0;
+    double fps = 0.0;
+    if (trisort_clip_name(h, k, name, sizeof name, &len) != TRISORT_STATUS_OK)
+      return fail("clip_name");
+    if (trisort_clip_frames(h, k, &first, &count) != TRISORT_STATUS_OK) return fail("clip_frames");
+    TrisortStatus s = trisort_clip_fps(h, k, &fps);
+    if (s != TRISORT_STATUS_OK && s != TRISORT_STATUS_ABSENT) return fail("clip_fps");
+    if (trisort_clip_find(h, name, &found) != TRISORT_STATUS_OK || found != k)
+      return fail("clip_find");
+    printf("clip %s frames %u+%u fps %.17g\n", name, first, count, fps);
+  }
+
+  /* Refusals: a frame out of range, a depth range outside the enum, a clip out of range. */
   float p[16];
   if (trisort_frame_projection(h, info.frame_count, 1.0, TRISORT_DEPTH_RANGE_ZERO_TO_ONE, p) !=
       TRISORT_STATUS_OUT_OF_RANGE) {
@@ -152,6 +171,11 @@ int main(int argc, char **argv) {
   }
   if (trisort_frame_projection(h, 0, 1.0, 7u, p) != TRISORT_STATUS_OUT_OF_RANGE) {
     fprintf(stderr, "reader: depth range 7 was not refused\n");
+    return 1;
+  }
+  uint32_t first = 0, count = 0;
+  if (trisort_clip_frames(h, clips, &first, &count) != TRISORT_STATUS_OUT_OF_RANGE) {
+    fprintf(stderr, "reader: a clip out of range was not refused\n");
     return 1;
   }
   printf("refusals ok\n");
