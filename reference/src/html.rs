@@ -358,7 +358,11 @@ fn head_and_files(o: &mut String, r: &HtmlReport<'_>) {
     let _ = writeln!(
         o,
         "<p id=\"verdict\" class=\"banner {}\" data-ok=\"{}\">{}</p>",
-        if r.ok { "pass" } else { "fail" },
+        match (r.ok, r.measure_only) {
+            (false, _) => "fail",
+            (true, true) => "measured",
+            (true, false) => "pass",
+        },
         r.ok,
         escape(&r.verdict)
     );
@@ -493,7 +497,7 @@ fn clips_table(o: &mut String, r: &HtmlReport<'_>, rows: &[Row<'_>]) {
     o.push_str(
         "<h2>Clips</h2>\n<table id=\"clips\">\n<tr><th class=\"l\">clip</th>\
         <th>frames</th><th>fps</th><th>checked</th><th>failed</th><th>verdict</th>\
-        <th>worst frame</th><th>max diff</th><th>pixels differing</th><th>holes</th></tr>\n",
+        <th>worst frame</th><th>max diff</th><th>pixels differing (sum)</th><th>holes (sum)</th></tr>\n",
     );
     for c in r.clips {
         let mine: Vec<&Row> = rows.iter().filter(|row| row.clip == c.name).collect();
