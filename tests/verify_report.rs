@@ -275,6 +275,10 @@ fn verify_clip_checks_that_clips_frames_only() {
     // --frames counts within the clip.
     assert_eq!(frames("--clip b --frames 1..2"), [b(2)]);
     assert_eq!(frames("--clip a"), [(0, "a".to_string())]);
+    // Frames drawn elsewhere for one clip are named within it, as `play --clip` writes them.
+    run(d, &args("play two.baked --clip b --out-dir b-frames"), true);
+    assert!(d.join("b-frames/frame-00001.png").is_file());
+    assert_eq!(frames("--clip b --frames-dir b-frames"), [b(1), b(2)]);
     let out = run(
         d,
         &args(&format!(

@@ -67,8 +67,10 @@ pub struct ImageReport {
 pub enum Frames<'a> {
     /// Played here by the player on the verifying device.
     Play,
-    /// Drawn elsewhere: PNGs in a directory (`--frames-dir`).
-    Dir(&'a Path),
+    /// Drawn elsewhere: PNGs in a directory (`--frames-dir`), frame `f` in the file named
+    /// `frame-NNNNN.png` with NNNNN = `f` − the second field (the first frame of the clip
+    /// played, as `play --clip NAME --out-dir` numbers them; 0 for the whole file).
+    Dir(&'a Path, u32),
     /// Played on another device (`--backend`/`--limits`), one frame at a time as it is
     /// checked.
     Elsewhere(&'a HeadlessRenderer<'a>),
@@ -110,7 +112,9 @@ pub fn verify_images(
     for f in what.frames {
         let v = match what.source {
             Frames::Play => verifier.verify(f),
-            Frames::Dir(dir) => verifier.verify_captured(f, read_captured(dir, f, check.size)?),
+            Frames::Dir(dir, base) => {
+                verifier.verify_captured(f, read_captured(dir, f, base, check.size)?)
+            }
             Frames::Elsewhere(player) => player
                 .render(f)
                 .map_err(ReferenceError::from)
@@ -124,19 +128,25 @@ pub fn verify_images(
     Ok(report)
 }
 
-/// Frame `f` as drawn elsewhere: `DIR/frame-NNNNN.png` (the name `play --out-dir` gives it),
-/// which must be `size`, as RGBA8. A missing, unreadable or wrong-size file is an error
-/// naming it.
-fn read_captured(dir: &Path, f: u32, size: (u32, u32)) -> Result<Vec<u8>, FramesError> {
-    let path = dir.join(format!("frame-{f:05}.png"));
+/// Frame `f` as drawn elsewhere: `DIR/frame-NNNNN.png` with NNNNN = `f − base` (the name
+/// `play --out-dir` gives it; with `--clip`, numbered within the clip that starts at frame
+/// `base`), which must be `size`, as RGBA8. A missing, unreadable or wrong-size file is an
+/// error naming it.
+fn read_captured(dir: &Path, f: u32, base: u32, size: (u32, u32)) -> Result<Vec<u8>, FramesError> {
+    let path = dir.join(format!("frame-{:05}.png", f - base));
     let captured = |problem: String| FramesError::Captured {
         path: path.clone(),
         problem,
     };
     if !path.is_file() {
         return Err(captured(format!(
-            "frame {f} is missing (--frames-dir holds one PNG per checked frame, named \
-             frame-NNNNN.png as play --out-dir writes them)"
+            "frame {f}{} is missing (--frames-dir holds one PNG per checked frame, named \
+             frame-NNNNN.png as play --out-dir writes them)",
+            if base == 0 {
+                String::new()
+            } else {
+                format!(" (frame {} of the clip)", f - base)
+            }
         )));
     }
     let image = image::open(&path)

@@ -91,7 +91,8 @@ pub struct VerifyArgs {
     diff_all: bool,
     /// Check frames drawn elsewhere (another GPU, the target device, a browser) instead of
     /// playing them here: PNGs named as `play --out-dir` writes them (`frame-NNNNN.png`), at
-    /// the checked size. Needs `--scene`.
+    /// the checked size (with `--clip`, numbered within the clip, as `play --clip` writes
+    /// them). Needs `--scene`.
     #[arg(long, value_name = "DIR", requires = "scene")]
     frames_dir: Option<PathBuf>,
     /// Check material variant NAME (as `play --variant NAME` plays it): the player and the
@@ -575,7 +576,7 @@ fn image_check(
         .map(|g| elsewhere_player(a, g, baked, &check))
         .transpose()?;
     let captured = match (a.frames_dir.as_deref(), &elsewhere) {
-        (Some(dir), _) => Frames::Dir(dir),
+        (Some(dir), _) => Frames::Dir(dir, first),
         (None, Some(player)) => Frames::Elsewhere(player),
         (None, None) => Frames::Play,
     };
