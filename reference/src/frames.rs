@@ -217,6 +217,10 @@ pub struct PlayFrames<'a> {
     pub offset: [f64; 2],
     /// Material variant.
     pub variant: Option<&'a str>,
+    /// The file frame numbered 0 (a clip's first frame; 0 for the file's own numbering):
+    /// frame `f` is written as `frame-NNNNN.png` and comes back as frame NNNNN = `f −
+    /// numbered_from`, so a clip of a bundle plays to the names a bake of its path alone does.
+    pub numbered_from: u32,
 }
 
 /// How [`play_frames_to`] played: the player's binding tier, draw path, texture bytes and
@@ -265,11 +269,13 @@ pub fn play_frames_to(
     let mut out = Vec::with_capacity(what.frames.len());
     for f in what.frames {
         let r = renderer.render(f)?;
+        let local = f - what.numbered_from;
         if let Some(d) = what.out_dir {
-            write_png(&d.join(format!("frame-{f:05}.png")), w, h, &r.rgba8)?;
+            write_png(&d.join(format!("frame-{local:05}.png")), w, h, &r.rgba8)?;
         }
         each(f);
         out.push(RenderedFrame {
+            frame: local,
             rgba8: Vec::new(),
             ..r
         });

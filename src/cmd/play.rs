@@ -8,10 +8,10 @@ use clap::Args;
 use serde_json::json;
 use trisort_format::{Baked, FileKind};
 use trisort_gpu::{DeviceBackend, DeviceLimits, Gpu, GpuOptions, Shading, ToneMap};
-use trisort_player::headless::{HeadlessConfig, HeadlessRenderer, RenderedFrame};
+use trisort_player::headless::{HeadlessConfig, RenderedFrame};
 use trisort_player::{Mode, SelfCheck, SelfCheckFrame};
 
-use trisort_reference::frames::{play_frames_to, write_png, PlayFrames, PlayedPath};
+use trisort_reference::frames::{play_frames_to, PlayFrames, PlayedPath};
 
 use crate::common::{
     parse_range, parse_size, parse_subpixel_offset, print_json, progress_bar, FrameRange,
@@ -146,6 +146,7 @@ pub fn play_frames(
         out_dir,
         offset: [0.0, 0.0],
         variant: None,
+        numbered_from: 0,
     };
     Ok(play_with_progress(gpu, what)?.0)
 }
@@ -159,60 +160,6 @@ fn play_with_progress(gpu: &Gpu, what: PlayFrames<'_>) -> Result<(Vec<RenderedFr
         eprintln!("trisort: warning: {w}");
     }
     Ok(played)
-}
-
-/// [`play_with_progress`] with the frames numbered from `base` (the first frame of the clip
-/// played): frame `f` of the file is written as `frame-NNNNN.png` with NNNNN = `f - base`
-/// and comes back as frame `f - base`, so a clip of a bundle plays to the names a bake of its
-/// path alone plays to.
-fn play_numbered(
-    gpu: &Gpu,
-    what: PlayFrames<'_>,
-    base: u32,
-) -> Result<(Vec<RenderedFrame>, PlayedPath)> {
-    if base == 0 {
-        return play_with_progress(gpu, what);
-    }
-    // `play_frames_to` names the PNGs by the file's frames: play without writing, then write
-    // each frame under its clip-local name.
-    let renderer = HeadlessRenderer::new(gpu, what.baked, what.config)?;
-    renderer.set_subpixel_offset(what.offset);
-    renderer.set_variant(what.variant)?;
-    let player = renderer.player();
-    let path = PlayedPath {
-        bindings: player.bindings().name(),
-        draw_path: player.config().draw_path.name(),
-        texture_bytes: player.texture_bytes(),
-        warnings: player.warnings().to_vec(),
-    };
-    for w in &path.warnings {
-        eprintln!("trisort: warning: {w}");
-    }
-    if let Some(d) = what.out_dir {
-        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
-    }
-    // One untimed render first: the first draw compiles pipelines (as `play_frames_to`).
-    if !what.frames.is_empty() {
-        renderer.render(what.frames.start)?;
-    }
-    let bar = progress_bar(what.frames.len() as u64, "play");
-    let (w, h) = what.config.size;
-    let mut out = Vec::with_capacity(what.frames.len());
-    for f in what.frames {
-        let r = renderer.render(f)?;
-        let local = f - base;
-        if let Some(d) = what.out_dir {
-            write_png(&d.join(format!("frame-{local:05}.png")), w, h, &r.rgba8)?;
-        }
-        bar.inc(1);
-        out.push(RenderedFrame {
-            frame: local,
-            rgba8: Vec::new(),
-            ..r
-        });
-    }
-    bar.finish_and_clear();
-    Ok((out, path))
 }
 
 /// Checks the device against the bake's raster profile at `samples` with the projection moved
@@ -292,9 +239,10 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
         out_dir: a.out_dir.as_deref(),
         offset,
         variant: a.variant.as_deref(),
+        numbered_from: base,
     };
-    let (frames, path) = play_numbered(&gpu, what, base)
-        .with_context(|| format!("playing {}", a.baked.display()))?;
+    let (frames, path) =
+        play_with_progress(&gpu, what).with_context(|| format!("playing {}", a.baked.display()))?;
     let checks = if a.self_check {
         Some(self_check_frames(&gpu, &baked, &config, offset, range)?)
     } else {
