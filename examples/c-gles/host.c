@@ -537,7 +537,7 @@ int main(int argc, char **argv) {
         return 2;
     }
     if (pbr && !shaders) die("--shading pbr needs --shaders DIR (trisort export-shaders --lang glsl-es-300 -o DIR)");
-    if (trisort_abi_version() != TRISORT_ABI_VERSION) die("libtrisort_capi's ABI differs from trisort.h");
+    if (trisort_abi_version() < TRISORT_ABI_VERSION) die("libtrisort_capi is older than trisort.h (ABI version below the header's)");
     check(trisort_open_path(argv[1], &h), "trisort_open_path");
     check(trisort_info(h, &info), "trisort_info");
     count = info.frame_count;
