@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds the web player into web/dist/: the wasm module (release), its wasm-bindgen glue
+# Builds the web player: the npm package in web/pkg (@trisort/player: the wasm module, its
+# wasm-bindgen glue and types, the tarball `npm pack` makes) and web/dist/: the glue and wasm
 # (pkg/), the page, and the demo car's bake (demo.baked, as `trisort demo` bakes it but with
 # the `browser` raster profile: SwiftShader snaps corners to 4 bits and takes a sample's depth
 # elsewhere in its pixel) when it is missing or stale. Serve the folder and open it: python3 -m http.server -d web/dist 8080
@@ -8,10 +9,31 @@ cd "$(dirname "$0")/.."
 bash scripts/ensure-web.sh
 target="${CARGO_TARGET_DIR:-target}"
 out=web/dist
-cargo build --quiet -p trisort-web --target wasm32-unknown-unknown --release
-mkdir -p "$out/pkg"
-wasm-bindgen --target web --no-typescript --out-dir "$out/pkg" \
-  "$target/wasm32-unknown-unknown/release/trisort_web.wasm"
+# TRISORT_WASM_PROFILE=wasm-release builds with the root Cargo.toml's size profile (fat LTO,
+# one codegen unit, opt-level "s"; BENCHMARKS § Web player).
+profile="${TRISORT_WASM_PROFILE:-release}"
+cargo build --quiet -p trisort-web --target wasm32-unknown-unknown --profile "$profile"
+# The npm package (web/pkg, @trisort/player): index.js and index.d.ts are written by hand;
+# wasm/ is wasm-bindgen's module and its types, generated here. Same inputs, same bytes: the
+# tarball holds no time stamp of ours (npm pack sets every file's time to its fixed date).
+pkg=web/pkg
+version=$(sed -n '/^\[workspace.package\]/,/^\[/s/^version = "\(.*\)"/\1/p' Cargo.toml)
+pkg_version=$(node -p 'require("./web/pkg/package.json").version')
+if [ "$pkg_version" != "$version" ]; then
+  echo "web/pkg/package.json has version $pkg_version, the workspace $version" >&2
+  exit 1
+fi
+rm -rf "$pkg/wasm" && mkdir -p "$pkg/wasm" "$out/pkg"
+wasm_dir=$profile
+[ "$profile" = dev ] && wasm_dir=debug
+wasm-bindgen --target web --out-dir "$pkg/wasm" \
+  "$target/wasm32-unknown-unknown/$wasm_dir/trisort_web.wasm"
+rm -f "$pkg/wasm/trisort_web_bg.wasm.d.ts"
+cp LICENSE-MIT LICENSE-APACHE THIRD-PARTY-NOTICES.md "$pkg/"
+rm -f "$pkg"/trisort-player-*.tgz
+(cd "$pkg" && npm pack --silent >/dev/null)
+# The demo page imports the wasm-bindgen module directly (web/www/main.js).
+cp "$pkg/wasm/trisort_web.js" "$pkg/wasm/trisort_web_bg.wasm" "$out/pkg/"
 cp web/www/index.html web/www/main.js "$out/"
 cargo build --quiet --bin trisort
 # Bake again when missing, unreadable by this trisort (an older format version) or baked for
@@ -24,4 +46,5 @@ if [ "$profile" != browser ]; then
   "$target/debug/trisort" bake demo --path demo --size 256x256 --samples 4 \
     --raster-profile browser -o "$out/demo.baked"
 fi
-echo "web player in $out/ ($(du -h "$out/pkg/trisort_web_bg.wasm" | cut -f1) of wasm)"
+wasm_bytes=$(stat -c %s "$out/pkg/trisort_web_bg.wasm")
+echo "web player in $out/ and $pkg/$(cd "$pkg" && ls trisort-player-*.tgz) ($wasm_bytes bytes of wasm, $profile)"

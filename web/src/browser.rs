@@ -8,7 +8,7 @@ use trisort_gpu::{Gpu, UncapturedError};
 use trisort_player::{OnScreen, OnScreenSettings};
 use wasm_bindgen::prelude::*;
 
-use crate::{clip_figures, BrowserBackend, FrameFigures};
+use crate::{clip_figures, BrowserBackend, ErrorKind, FrameFigures};
 
 /// Reports a Rust panic on the browser console instead of an opaque "unreachable".
 #[wasm_bindgen(start)]
@@ -37,8 +37,25 @@ pub struct WebPlayer {
     uncaptured: UncapturedError,
 }
 
-fn js_error(e: impl std::fmt::Display) -> JsError {
-    JsError::new(&e.to_string())
+/// A JavaScript `Error` with `message` and a `kind` property naming `kind` ([`ErrorKind`]):
+/// what the npm package's wrapper maps to its error classes without reading the message.
+fn js_error(kind: ErrorKind, message: impl std::fmt::Display) -> JsValue {
+    let e = js_sys::Error::new(&message.to_string());
+    // Setting a property on a fresh Error object cannot fail.
+    let _ = js_sys::Reflect::set(&e, &JsValue::from_str("kind"), &kind.name().into());
+    e.into()
+}
+
+fn format_error(e: impl std::fmt::Display) -> JsValue {
+    js_error(ErrorKind::Format, e)
+}
+
+fn device_error(e: impl std::fmt::Display) -> JsValue {
+    js_error(ErrorKind::Device, e)
+}
+
+fn option_error(e: impl std::fmt::Display) -> JsValue {
+    js_error(ErrorKind::Option, e)
 }
 
 #[wasm_bindgen]
@@ -55,6 +72,10 @@ impl WebPlayer {
     ///
     /// `shading` (`pbr`, the default, or `basic`) and `tonemap` (`neutral`, the default, or
     /// `aces`) light it as `trisort play --shading --tonemap` does.
+    ///
+    /// Every error this type throws is a JavaScript `Error` with a `kind` property
+    /// ([`ErrorKind`]): `format` for bytes that are not a readable baked file, `device` for
+    /// the browser's graphics, `option` for an unknown option value, clip or variant.
     #[allow(
         clippy::too_many_arguments,
         reason = "the signature is the page's JavaScript API (`WebPlayer.open`)"
@@ -68,15 +89,15 @@ impl WebPlayer {
         zbuffer: bool,
         shading: Option<String>,
         tonemap: Option<String>,
-    ) -> Result<WebPlayer, JsError> {
-        let backend: BrowserBackend = backend.parse().map_err(|e: String| JsError::new(&e))?;
+    ) -> Result<WebPlayer, JsValue> {
+        let backend: BrowserBackend = backend.parse().map_err(option_error)?;
         let shading: trisort_gpu::Shading =
-            (shading.as_deref().unwrap_or("pbr").parse()).map_err(js_error)?;
+            (shading.as_deref().unwrap_or("pbr").parse()).map_err(option_error)?;
         let tone_map: trisort_gpu::ToneMap =
-            (tonemap.as_deref().unwrap_or("neutral").parse()).map_err(js_error)?;
-        let mode: Mode = mode.parse().map_err(js_error)?;
+            (tonemap.as_deref().unwrap_or("neutral").parse()).map_err(option_error)?;
+        let mode: Mode = mode.parse().map_err(option_error)?;
         let mut baked: Baked =
-            trisort_player::baked_from_bytes(&bytes, Path::new(&name)).map_err(js_error)?;
+            trisort_player::baked_from_bytes(&bytes, Path::new(&name)).map_err(format_error)?;
         drop(bytes);
         if zbuffer {
             baked = trisort_player::self_check::zbuffer_baked(&baked);
@@ -88,7 +109,7 @@ impl WebPlayer {
         let (instance, backend_name) = instance_for(backend).await?;
         let surface = instance
             .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
-            .map_err(|e| js_error(format!("{backend_name} surface for the canvas: {e}")))?;
+            .map_err(|e| device_error(format!("{backend_name} surface for the canvas: {e}")))?;
         let gpu = Gpu::open_async(
             &instance,
             Some(&surface),
@@ -96,9 +117,9 @@ impl WebPlayer {
             DeviceLimits::Adapter,
         )
         .await
-        .map_err(js_error)?;
+        .map_err(device_error)?;
         let uncaptured = UncapturedError::install(&gpu.device);
-        let setup = configure_surface(&gpu, &surface, (width, height)).map_err(js_error)?;
+        let setup = configure_surface(&gpu, &surface, (width, height)).map_err(device_error)?;
         let blit = Blit::new(&gpu.device, setup.view_format, mode);
         let settings = OnScreenSettings {
             shading,
@@ -106,7 +127,7 @@ impl WebPlayer {
             ..OnScreenSettings::recorded(&baked, mode)
         };
         let on_screen =
-            OnScreen::new(&gpu, &baked, &blit, (width, height), settings).map_err(js_error)?;
+            OnScreen::new(&gpu, &baked, &blit, (width, height), settings).map_err(device_error)?;
         let warnings = on_screen.player().warnings().to_vec();
         let fps = baked.fps;
         let robust = baked.settings.robust;
@@ -128,7 +149,7 @@ impl WebPlayer {
 
     /// Draws frame `frame` and presents it on the canvas. The canvas holds the frame until the
     /// page's task ends, so a caller can copy it (`drawImage`) right after this returns.
-    pub fn render(&mut self, frame: u32) -> Result<(), JsError> {
+    pub fn render(&mut self, frame: u32) -> Result<(), JsValue> {
         let texture = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
             | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
@@ -138,14 +159,14 @@ impl WebPlayer {
                 match self.surface.get_current_texture() {
                     wgpu::CurrentSurfaceTexture::Success(t)
                     | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-                    _ => return Err(JsError::new("the canvas's surface is unavailable")),
+                    _ => return Err(device_error("the canvas's surface is unavailable")),
                 }
             }
             wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
                 return Ok(());
             }
             wgpu::CurrentSurfaceTexture::Validation => {
-                return Err(js_error(format!(
+                return Err(device_error(format!(
                     "wgpu: {}",
                     self.uncaptured.take().unwrap_or_default()
                 )))
@@ -153,9 +174,9 @@ impl WebPlayer {
         };
         self.on_screen
             .submit(&self.gpu, &self.blit, &texture, self.view_format, frame)
-            .map_err(js_error)?;
+            .map_err(device_error)?;
         if let Some(e) = self.uncaptured.take() {
-            return Err(js_error(format!("wgpu: {e}")));
+            return Err(device_error(format!("wgpu: {e}")));
         }
         self.gpu.queue.present(texture);
         Ok(())
@@ -219,21 +240,21 @@ impl WebPlayer {
     /// The file's frames clip `name` spans, `[first, count]`: frames `first .. first +
     /// count` (frame numbers are the file's everywhere). An unknown name is an error listing
     /// the clips.
-    pub fn clip_range(&self, name: &str) -> Result<Vec<u32>, JsError> {
+    pub fn clip_range(&self, name: &str) -> Result<Vec<u32>, JsValue> {
         let c = self.named(name)?;
         Ok(vec![c.first, c.count])
     }
 
     /// The frame rate clip `name` was baked at (`undefined` where the file does not say).
-    pub fn clip_fps(&self, name: &str) -> Result<Option<f64>, JsError> {
+    pub fn clip_fps(&self, name: &str) -> Result<Option<f64>, JsValue> {
         Ok(self.named(name)?.fps)
     }
 
     /// Selects the clip named `name`: the page then plays, scrubs and steps within its
     /// frames ([`WebPlayer::clip_first`], [`WebPlayer::clip_length`]) at its rate. An unknown
     /// name is an error listing the clips, and the selection stays.
-    pub fn set_clip(&mut self, name: &str) -> Result<(), JsError> {
-        self.clip = trisort_player::clip_index(self.clips_of(), name).map_err(js_error)?;
+    pub fn set_clip(&mut self, name: &str) -> Result<(), JsValue> {
+        self.clip = trisort_player::clip_index(self.clips_of(), name).map_err(option_error)?;
         Ok(())
     }
 
@@ -274,12 +295,12 @@ impl WebPlayer {
     /// Plays the materials of variant `name` from the next frame on (an empty name: the
     /// default materials). Refused, with the reason, for a variant that would change what is
     /// visible (alpha mode, opacity, transmission, sidedness); the materials stay as they were.
-    pub fn set_variant(&self, name: &str) -> Result<(), JsError> {
+    pub fn set_variant(&self, name: &str) -> Result<(), JsValue> {
         let name = (!name.is_empty()).then_some(name);
         self.on_screen
             .player()
             .set_variant(&self.gpu.queue, name)
-            .map_err(js_error)
+            .map_err(option_error)
     }
 
     /// The raster profile the file was baked for (`exact`, `conformant`, `snap4`, `browser`):
@@ -345,15 +366,15 @@ impl WebPlayer {
         &self.clips_of()[self.clip]
     }
 
-    fn named(&self, name: &str) -> Result<&trisort_format::Clip, JsError> {
-        let k = trisort_player::clip_index(self.clips_of(), name).map_err(js_error)?;
+    fn named(&self, name: &str) -> Result<&trisort_format::Clip, JsValue> {
+        let k = trisort_player::clip_index(self.clips_of(), name).map_err(option_error)?;
         Ok(&self.clips_of()[k])
     }
 }
 
 /// The instance for `backend`, and the API's name. `Auto` asks the browser for a WebGPU
 /// adapter first and falls back to WebGL2 without touching the canvas.
-async fn instance_for(backend: BrowserBackend) -> Result<(wgpu::Instance, &'static str), JsError> {
+async fn instance_for(backend: BrowserBackend) -> Result<(wgpu::Instance, &'static str), JsValue> {
     let webgl2 = || {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = wgpu::Backends::GL;
@@ -367,7 +388,7 @@ async fn instance_for(backend: BrowserBackend) -> Result<(wgpu::Instance, &'stat
     match backend {
         BrowserBackend::WebGl2 => Ok(webgl2()),
         BrowserBackend::WebGpu if wgpu::util::is_browser_webgpu_supported().await => Ok(webgpu()),
-        BrowserBackend::WebGpu => Err(JsError::new(
+        BrowserBackend::WebGpu => Err(device_error(
             "this browser offers no WebGPU adapter (try ?backend=webgl2)",
         )),
         BrowserBackend::Auto if wgpu::util::is_browser_webgpu_supported().await => Ok(webgpu()),

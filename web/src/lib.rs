@@ -65,6 +65,32 @@ impl FromStr for BrowserBackend {
     }
 }
 
+/// What kind of failure an error thrown to JavaScript reports: its `kind` property, which the
+/// npm package (`web/pkg`) maps to its error classes (`TrisortFormatError`, …).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// The bytes are not a baked file this player reads: damaged, cut short, another format
+    /// version.
+    Format,
+    /// The browser's graphics: no WebGPU adapter, no surface for the canvas, a device that
+    /// cannot play the file, a GPU error while drawing.
+    Device,
+    /// An option or a name the caller chose: an unknown backend, mode, shading, tone map,
+    /// clip or variant, or a variant the bake refuses.
+    Option,
+}
+
+impl ErrorKind {
+    /// The `kind` property's value: `format`, `device` or `option`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ErrorKind::Format => "format",
+            ErrorKind::Device => "device",
+            ErrorKind::Option => "option",
+        }
+    }
+}
+
 /// One frame's figures as the page shows them under the canvas.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameFigures {
@@ -145,6 +171,12 @@ mod tests {
         );
         let err = "vulkan".parse::<BrowserBackend>().unwrap_err();
         assert!(err.contains("'vulkan'") && err.contains("webgl2"), "{err}");
+    }
+
+    #[test]
+    fn error_kinds_are_the_packages_codes() {
+        let names = [ErrorKind::Format, ErrorKind::Device, ErrorKind::Option].map(ErrorKind::name);
+        assert_eq!(names, ["format", "device", "option"]);
     }
 
     #[test]

@@ -40,6 +40,41 @@ node web/test/browser.mjs --dist web/dist --native "$out/native" --frames "$list
   --out "$out/browser" --backend webgl2 --bad-file truncated.baked \
   --variant-file variants.baked --variant "Torched Graphite" \
   --clip-file clips.baked --clip orbit > "$out/browser.json"
+# The npm package (web/pkg, packed by web/build.sh) installed from its tarball into a fresh
+# throwaway project, as an app installs it, and run there: imported by name, the demo bake
+# opened with the options object and frame 0 drawn (compared with the native player's under
+# the PBR gate below), a truncated file rejected with TrisortFormatError, a bad option and an
+# unknown clip with TrisortOptionError.
+consumer=web/test/pkg-consumer
+tarball=$(cd web/pkg && ls trisort-player-*.tgz)
+rm -rf "$consumer/node_modules" "$consumer/package.json" "$consumer/package-lock.json"
+printf '{ "name": "trisort-pkg-consumer", "private": true, "type": "module",\n  "dependencies": { "@trisort/player": "file:../../pkg/%s" } }\n' \
+  "$tarball" > "$consumer/package.json"
+(cd "$consumer" && npm install --no-audit --no-fund --silent --prefer-offline)
+node web/test/pkg.mjs --consumer "$consumer" --dist web/dist --native "$out/native" \
+  --bad-file truncated.baked > "$out/package.json"
+node - "$out/package.json" "${TRISORT_WEB_MAX_OVER1_NATIVE:-0.0125}" <<'JS'
+const fs = require("fs");
+const r = JSON.parse(fs.readFileSync(process.argv[2], "utf8"));
+const maxOver1 = Number(process.argv[3]);
+const bad = [];
+const is = (f, cls, code) => f && f.class === cls && f.code === code && f.is_trisort && f.is_error;
+if (r.backend !== "WebGL2" || r.frames < 1 || r.lit === 0) bad.push("the demo bake did not play");
+if (r.over1_native > maxOver1 * r.pixels) {
+  bad.push(`frame 0 differs from the native player in ${r.over1_native} pixels by more than 1/255`);
+}
+if (!is(r.truncated, "TrisortFormatError", "format") || !r.truncated.message.includes("truncated.baked")) {
+  bad.push(`a truncated file was not refused with TrisortFormatError naming it: ${JSON.stringify(r.truncated)}`);
+}
+if (!is(r.bad_option, "TrisortOptionError", "option")) bad.push(`backend "vulkan": ${JSON.stringify(r.bad_option)}`);
+if (!is(r.no_canvas, "TrisortOptionError", "option")) bad.push(`no canvas: ${JSON.stringify(r.no_canvas)}`);
+if (!is(r.unknown_clip, "TrisortOptionError", "option")) bad.push(`unknown clip: ${JSON.stringify(r.unknown_clip)}`);
+if (!r.format_is_class || !r.option_is_class) bad.push("the error classes do not extend TrisortError");
+if (r.console_errors.length) bad.push(`console errors: ${r.console_errors.join("; ")}`);
+if (bad.length) { console.error("package test failed:\n  " + bad.join("\n  ")); process.exit(1); }
+console.log(`package test: @trisort/player installed from its tarball plays ${r.frames} frames on ${r.backend} ` +
+  `(frame 0: ${r.over1_native} px over 1/255 from native); TrisortFormatError: ${r.truncated.message}`);
+JS
 # Exit 3 means "verified and some frame failed the recorded pattern's tolerance": expected on
 # another rasterizer; the gate below reads the figures instead.
 "$trisort" verify "$baked" --scene demo --frames-dir "$out/browser" --json \

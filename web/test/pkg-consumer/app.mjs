@@ -1,0 +1,68 @@
+// A page that uses the npm package as an app would (web/test/pkg.mjs drives it): imports it by
+// its name, opens the demo bake with the options object, draws a frame, and checks the typed
+// errors. window.runPackageTest(options) returns what the test gates.
+import {
+  TrisortPlayer, TrisortError, TrisortFormatError, TrisortOptionError,
+} from "@trisort/player";
+
+async function fetchBytes(url) {
+  const r = await fetch(url);
+  if (!r.ok) throw new Error(`${url}: HTTP ${r.status}`);
+  return new Uint8Array(await r.arrayBuffer());
+}
+
+// The RGBA pixels of a canvas or image.
+function pixels(source) {
+  const ctx = new OffscreenCanvas(source.width, source.height).getContext("2d", { colorSpace: "srgb" });
+  ctx.drawImage(source, 0, 0);
+  return ctx.getImageData(0, 0, source.width, source.height).data;
+}
+
+// How `promise` (or function) fails: its class, code and message; null when it does not.
+async function failure(f) {
+  try {
+    await f();
+    return null;
+  } catch (e) {
+    return {
+      class: e.constructor.name, code: e.code, message: e.message,
+      is_trisort: e instanceof TrisortError, is_error: e instanceof Error,
+    };
+  }
+}
+
+window.runPackageTest = async ({ file, badFile, backend, native, frame }) => {
+  const canvas = document.getElementById("canvas");
+  const data = await fetchBytes(file);
+  const player = await TrisortPlayer.open({
+    canvas, data, name: file, backend, mode: "blend", shading: "pbr", tonemap: "neutral",
+  });
+  const ms = player.render(frame);
+  const ours = pixels(canvas);
+  const bmp = await createImageBitmap(await (await fetch(native)).blob(), {
+    colorSpaceConversion: "none", premultiplyAlpha: "none",
+  });
+  const theirs = pixels(bmp);
+  let over1 = 0, lit = 0;
+  for (let i = 0; i < ours.length; i += 4) {
+    let d = 0;
+    for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(ours[i + c] - theirs[i + c]));
+    if (d > 1) over1++;
+    if (ours[i] + ours[i + 1] + ours[i + 2] > 0) lit++;
+  }
+  const bad = await fetchBytes(badFile);
+  const result = {
+    backend: player.backend, frames: player.frameCount, width: player.width, height: player.height,
+    clips: player.clips(), stats: player.frameStats(frame), ms, pixels: ours.length / 4,
+    lit, over1_native: over1,
+    truncated: await failure(() => TrisortPlayer.open({ canvas: document.createElement("canvas"), data: bad, name: badFile, backend })),
+    bad_option: await failure(() => TrisortPlayer.open({ canvas, data, backend: "vulkan" })),
+    no_canvas: await failure(() => TrisortPlayer.open({ data })),
+    unknown_clip: await failure(() => player.setClip("no-such-clip")),
+    format_is_class: TrisortFormatError.prototype instanceof TrisortError,
+    option_is_class: TrisortOptionError.prototype instanceof TrisortError,
+  };
+  player.free();
+  return result;
+};
+window.packageLoaded = true;
