@@ -27,8 +27,11 @@ if [ "${1:-}" = "--browser" ]; then
     echo "trisort: installing ${missing[*]}" >&2
     bash scripts/apt-install.sh --no-install-recommends "${missing[@]}"
   fi
-  if [ ! -d web/test/node_modules/playwright-core ]; then
-    echo "trisort: installing playwright-core (npm) into web/test/node_modules" >&2
+  # web/test/package.json pins them: playwright-core drives Chromium, typescript checks the
+  # npm package's types, binaryen's wasm-opt is measured in BENCHMARKS § Web player.
+  if [ ! -d web/test/node_modules/playwright-core ] || [ ! -d web/test/node_modules/typescript ] ||
+    [ ! -d web/test/node_modules/binaryen ]; then
+    echo "trisort: installing playwright-core, typescript, binaryen (npm) into web/test/node_modules" >&2
     (cd web/test && npm install --no-audit --no-fund --silent)
   fi
 fi

@@ -44,13 +44,15 @@ node web/test/browser.mjs --dist web/dist --native "$out/native" --frames "$list
 # throwaway project, as an app installs it, and run there: imported by name, the demo bake
 # opened with the options object and frame 0 drawn (compared with the native player's under
 # the PBR gate below), a truncated file rejected with TrisortFormatError, a bad option and an
-# unknown clip with TrisortOptionError.
+# unknown clip with TrisortOptionError; and its types compile in an app's TypeScript.
 consumer=web/test/pkg-consumer
 tarball=$(cd web/pkg && ls trisort-player-*.tgz)
 rm -rf "$consumer/node_modules" "$consumer/package.json" "$consumer/package-lock.json"
 printf '{ "name": "trisort-pkg-consumer", "private": true, "type": "module",\n  "dependencies": { "@trisort/player": "file:../../pkg/%s" } }\n' \
   "$tarball" > "$consumer/package.json"
 (cd "$consumer" && npm install --no-audit --no-fund --silent --prefer-offline)
+# Its types as an app's TypeScript reads them (types.ts: strict, a wrong option refused).
+(cd "$consumer" && ../node_modules/.bin/tsc -p .)
 node web/test/pkg.mjs --consumer "$consumer" --dist web/dist --native "$out/native" \
   --bad-file truncated.baked > "$out/package.json"
 node - "$out/package.json" "${TRISORT_WEB_MAX_OVER1_NATIVE:-0.0125}" <<'JS'
