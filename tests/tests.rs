@@ -19,6 +19,7 @@ mod extremes;
 mod extremes_no_lost_work;
 mod format_reader;
 mod format_upgrade;
+mod gpu_budget;
 mod long_paths;
 mod merge_car;
 mod record_cli;

@@ -6,6 +6,7 @@
 
 use wgpu::util::DeviceExt;
 
+use crate::scene_gpu::budget::{sized_buffer, GpuBytes, GpuKind, SceneBudget};
 use crate::scene_gpu::{FrameData, SharedBindings, DATA_WIDTH};
 
 /// The bind group layout of group 0 on the texture tier.
@@ -105,21 +106,36 @@ pub(crate) fn write_data_texture(queue: &wgpu::Queue, texture: &wgpu::Texture, b
     );
 }
 
+/// What [`bind_group`] uploads besides the shared bindings, and where it counts what it
+/// creates.
+pub(crate) struct TierData<'a> {
+    pub(crate) data: &'a FrameData,
+    pub(crate) material_bytes: &'a [u8],
+    pub(crate) frames: usize,
+    pub(crate) budget: &'a SceneBudget,
+    pub(crate) allocated: &'a mut GpuBytes,
+}
+
 /// The texture tier's layout and bind group, and the stride of its per-frame node uniform
-/// (the frame uniform's).
+/// (the frame uniform's); the first-node uniforms sized by the budget, everything counted.
 pub(crate) fn bind_group(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     shared: SharedBindings<'_>,
-    data: &FrameData,
-    material_bytes: &[u8],
-    frames: usize,
+    tier: TierData<'_>,
 ) -> (
     wgpu::BindGroupLayout,
     wgpu::BindGroup,
     u64,
     crate::scene_gpu::MaterialStore,
 ) {
+    let TierData {
+        data,
+        material_bytes,
+        frames,
+        budget,
+        allocated,
+    } = tier;
     debug_assert_eq!(data.node_stride, data.node_count * 64);
     let stride = data.frame_stride as usize;
     let mut base = vec![0u8; stride * frames.max(1)];
@@ -127,14 +143,19 @@ pub(crate) fn bind_group(
         let first = (f as u64 * data.node_count) as u32;
         base[f * stride..][..4].copy_from_slice(&first.to_le_bytes());
     }
-    let base_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("first node of each frame"),
-        contents: &base,
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
+    let base_buffer = sized_buffer(
+        device,
+        "first node of each frame",
+        budget.bytes.buffer(GpuKind::FirstNodes),
+        &base,
+        wgpu::BufferUsages::UNIFORM,
+    );
     let (material_texture, materials) =
         data_texture(device, queue, "material texels", material_bytes);
-    let (_, nodes) = data_texture(device, queue, "node matrix texels", &data.node_bytes);
+    let (node_texture, nodes) = data_texture(device, queue, "node matrix texels", &data.node_bytes);
+    allocated.count_buffer(GpuKind::FirstNodes, &base_buffer);
+    allocated.count_texture(GpuKind::Materials, &material_texture);
+    allocated.count_texture(GpuKind::NodeMatrices, &node_texture);
     let layout = texture_tier_layout(device);
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("trisort scene (data textures)"),

@@ -65,16 +65,33 @@ impl Indices {
     }
 }
 
+/// The index format [`index_buffer`] chooses: u16 when [`Baked::fits_u16`], unless
+/// `force_u32`.
+pub fn index_format(baked: &Baked, force_u32: bool) -> wgpu::IndexFormat {
+    if baked.fits_u16() && !force_u32 {
+        wgpu::IndexFormat::Uint16
+    } else {
+        wgpu::IndexFormat::Uint32
+    }
+}
+
+/// Number of indirect commands [`frame_commands`] lists: every frame's draws.
+pub fn command_count(baked: &Baked) -> usize {
+    (0..baked.frames.len())
+        .map(|f| baked.frame_draws(f).len())
+        .sum()
+}
+
 /// The index buffer of `baked` in `order`: `geometry.triangles[copies[k]]` for each copy,
-/// copies reversed for [`Order::BackToFront`]. u16 when [`Baked::fits_u16`], unless
-/// `force_u32`. Requires `baked.check_structure()` to hold.
+/// copies reversed for [`Order::BackToFront`], in [`index_format`]. Requires
+/// `baked.check_structure()` to hold.
 pub fn index_buffer(baked: &Baked, order: Order, force_u32: bool) -> Indices {
     let tris = &baked.geometry.triangles;
     let copies: Box<dyn Iterator<Item = &u32>> = match order {
         Order::FrontToBack => Box::new(baked.copies.iter()),
         Order::BackToFront => Box::new(baked.copies.iter().rev()),
     };
-    if baked.fits_u16() && !force_u32 {
+    if index_format(baked, force_u32) == wgpu::IndexFormat::Uint16 {
         let mut out = Vec::with_capacity(baked.copies.len() * 3);
         for &c in copies {
             out.extend(tris[c as usize].iter().map(|&v| v as u16));
@@ -97,7 +114,7 @@ pub fn frame_commands(
     order: Order,
 ) -> (Vec<DrawIndexedIndirectArgs>, Vec<FrameWindow>) {
     let total = baked.copies.len() as u32 * 3;
-    let mut draws = Vec::new();
+    let mut draws = Vec::with_capacity(command_count(baked));
     let mut windows = Vec::with_capacity(baked.frames.len());
     for f in 0..baked.frames.len() {
         let first = draws.len() as u32;

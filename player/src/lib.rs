@@ -24,6 +24,7 @@
 //! recorder of calls).
 #![deny(missing_docs)]
 
+pub mod budget;
 pub mod commands;
 pub mod config;
 pub mod draw_calls;
@@ -34,6 +35,7 @@ pub mod on_screen;
 mod player;
 pub mod self_check;
 
+pub use budget::GpuBudget;
 pub use config::{playback_warnings, DrawPath, PlayerConfig};
 pub use draw_calls::{Call, CallLog, DrawCalls};
 pub use error::PlayerError;

@@ -4,8 +4,10 @@ use std::ops::Range;
 use std::path::Path;
 
 use trisort_format::{Baked, Clip, DrawIndexedIndirectArgs, FileKind, FrameWindow, Material};
-use trisort_gpu::scene_gpu::{Bindings, SceneGpu, ScenePipeline, View};
-use wgpu::util::DeviceExt;
+use trisort_gpu::scene_gpu::budget::sized_buffer;
+use trisort_gpu::scene_gpu::{Bindings, GpuBytes, GpuKind, SceneGpu, ScenePipeline, View};
+
+use crate::budget::GpuBudget;
 
 use crate::commands::{frame_commands, index_buffer, Order};
 use crate::config::{playback_warnings, DrawPath, PlayerConfig};
@@ -46,6 +48,10 @@ pub fn baked_from_bytes(bytes: &[u8], name: &Path) -> Result<Baked, PlayerError>
 /// order, and every frame's `DrawIndexedIndirectArgs` back to back in one indirect buffer.
 pub struct Player {
     scene: SceneGpu,
+    /// [`Player::gpu_budget`].
+    budget: GpuBudget,
+    /// [`Player::gpu_bytes_allocated`].
+    allocated: GpuBytes,
     bindings: Bindings,
     pipeline: wgpu::RenderPipeline,
     index_buffer: wgpu::Buffer,
@@ -137,38 +143,37 @@ impl Player {
         } else {
             Order::FrontToBack
         };
+        // The scene's budget plus the index and indirect buffers: every buffer below is sized
+        // from it, and counted as it is created.
+        let budget = GpuBudget::from_scene(scene.budget(), baked, force_u32);
+        let mut allocated = scene.allocated().clone();
         let indices = index_buffer(baked, order, force_u32);
         let index_count = indices.len() as u32;
-        let index_bytes: &[u8] = if indices.is_empty() {
-            &[0u8; 4]
-        } else {
-            indices.bytes()
-        };
-        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("trisort sorted indices"),
-            contents: index_bytes,
+        let index_buffer = sized_buffer(
+            device,
+            "trisort sorted indices",
+            budget.bytes.buffer(GpuKind::Indices),
+            indices.bytes(),
             // COPY_SRC: so tests and tools can read back what is drawn.
-            usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_SRC,
-        });
+            wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_SRC,
+        );
+        allocated.count_buffer(GpuKind::Indices, &index_buffer);
         let (commands, windows) = frame_commands(baked, order);
-        let zero = [DrawIndexedIndirectArgs::default()];
-        let command_bytes: &[u8] = if commands.is_empty() {
-            bytemuck::cast_slice(&zero)
-        } else {
-            bytemuck::cast_slice(&commands)
-        };
-        let indirect = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("trisort frame windows"),
-            contents: command_bytes,
+        let indirect = sized_buffer(
+            device,
+            "trisort frame windows",
+            budget.bytes.buffer(GpuKind::Indirect),
+            bytemuck::cast_slice(&commands),
             // WebGL2 has no indirect buffers: the direct path draws from the CPU copy, and
             // keeps this one only for tools that read it back.
-            usage: match config.draw_path {
+            match config.draw_path {
                 DrawPath::MultiDrawIndirect => {
                     wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC
                 }
                 DrawPath::Direct => wgpu::BufferUsages::COPY_SRC,
             },
-        });
+        );
+        allocated.count_buffer(GpuKind::Indirect, &indirect);
         let pipeline = create_pipeline(device, &scene.layout, &config, bindings);
 
         if let Some(Some(e)) = trisort_gpu::poll_ready(scope.pop()) {
@@ -176,6 +181,8 @@ impl Player {
         }
         Ok(Player {
             scene,
+            budget,
+            allocated,
             bindings,
             pipeline,
             index_format: indices.format(),
@@ -364,6 +371,18 @@ impl Player {
     /// prefiltered environment ([`SceneGpu::texture_bytes`]).
     pub fn texture_bytes(&self) -> u64 {
         self.scene.texture_bytes()
+    }
+
+    /// The GPU memory this player was sized from: [`GpuBudget::from_scene`] for this device
+    /// and tier, the figure `inspect` reports for a device with WebGPU's default limits.
+    pub fn gpu_budget(&self) -> &GpuBudget {
+        &self.budget
+    }
+
+    /// Bytes of every buffer and texture the player created (its scene's and its own), by
+    /// kind, counted from the wgpu objects where they were created.
+    pub fn gpu_bytes_allocated(&self) -> &GpuBytes {
+        &self.allocated
     }
 
     /// Shifts the projection of every frame by `offset` pixels (x right, y down) at the

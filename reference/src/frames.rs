@@ -233,6 +233,12 @@ pub struct PlayedPath {
     pub draw_path: &'static str,
     /// GPU bytes of the scene's textures and environment (`SceneGpu::texture_bytes`).
     pub texture_bytes: u64,
+    /// Every buffer and texture the player created, by kind
+    /// (`trisort_player::Player::gpu_bytes_allocated`).
+    pub gpu_bytes_allocated: trisort_gpu::scene_gpu::GpuBytes,
+    /// Milliseconds the player took to load: creating it (every buffer, texture and the
+    /// pipeline) and waiting until the GPU has its uploads.
+    pub load_ms: f64,
     /// The player's warnings (e.g. a size other than the recorded one).
     pub warnings: Vec<String>,
 }
@@ -246,7 +252,11 @@ pub fn play_frames_to(
     what: PlayFrames<'_>,
     mut each: impl FnMut(u32),
 ) -> Result<(Vec<RenderedFrame>, PlayedPath), FramesError> {
+    let started = std::time::Instant::now();
     let renderer = HeadlessRenderer::new(gpu, what.baked, what.config)?;
+    gpu.queue.submit([]);
+    let _ = gpu.device.poll(wgpu::PollType::wait_indefinitely());
+    let load_ms = started.elapsed().as_secs_f64() * 1e3;
     renderer.set_subpixel_offset(what.offset);
     renderer.set_variant(what.variant)?;
     let player = renderer.player();
@@ -254,6 +264,8 @@ pub fn play_frames_to(
         bindings: player.bindings().name(),
         draw_path: player.config().draw_path.name(),
         texture_bytes: player.texture_bytes(),
+        gpu_bytes_allocated: player.gpu_bytes_allocated().clone(),
+        load_ms,
         warnings: player.warnings().to_vec(),
     };
     if let Some(d) = what.out_dir {

@@ -9,6 +9,85 @@ use serde_json::json;
 use trisort_format::{FileKind, Recording};
 
 use crate::common::{load_scene, print_json};
+use trisort_gpu::scene_gpu::budget::{PORTABLE_MAX_TEXTURE_DIMENSION, PORTABLE_OFFSET_ALIGNMENT};
+use trisort_gpu::scene_gpu::{Bindings, GpuBytes};
+use trisort_player::GpuBudget;
+
+/// GPU bytes as JSON: `textures`, `buffers`, `total`, and by kind `buffers_by_kind` and
+/// `textures_by_kind` (`play --json`'s `gpu_bytes_allocated`, and each tier of `inspect`'s
+/// `gpu_bytes`).
+pub(crate) fn gpu_bytes_json(bytes: &GpuBytes) -> serde_json::Value {
+    let kinds = |it: &mut dyn Iterator<Item = (trisort_gpu::scene_gpu::GpuKind, u64)>| {
+        it.map(|(k, b)| (k.name().to_string(), json!(b)))
+            .collect::<serde_json::Map<_, _>>()
+    };
+    json!({
+        "textures": bytes.textures(),
+        "buffers": bytes.buffers(),
+        "total": bytes.total(),
+        "buffers_by_kind": kinds(&mut bytes.buffer_kinds()),
+        "textures_by_kind": kinds(&mut bytes.texture_kinds()),
+    })
+}
+
+/// `inspect BAKED`'s `gpu_bytes`: what a player allocates on a device with WebGPU's default
+/// limits, on the storage tier (the three totals) and per tier (`tiers.storage`,
+/// `tiers.textures`: by kind, the index format, the texture arrays), with what it assumes.
+fn budget_json(budgets: &[GpuBudget; 2]) -> serde_json::Value {
+    let tier = |b: &GpuBudget| {
+        let mut v = gpu_bytes_json(&b.bytes);
+        let array = |k: usize| {
+            let (width, height, levels) = b.arrays[k];
+            json!({"width": width, "height": height, "levels": levels, "layers": b.layers[k]})
+        };
+        v["index_format"] = json!(match b.index_format {
+            wgpu::IndexFormat::Uint16 => "u16",
+            wgpu::IndexFormat::Uint32 => "u32",
+        });
+        v["texture_arrays"] = json!({"srgb": array(0), "linear": array(1), "format": "rgba8"});
+        v
+    };
+    let storage = &budgets[0].bytes;
+    json!({
+        "textures": storage.textures(),
+        "buffers": storage.buffers(),
+        "total": storage.total(),
+        "tier": "storage",
+        "tiers": {"storage": tier(&budgets[0]), "textures": tier(&budgets[1])},
+        "assumes": {
+            "max_texture_dimension_2d": PORTABLE_MAX_TEXTURE_DIMENSION,
+            "offset_alignment": PORTABLE_OFFSET_ALIGNMENT,
+            "gl": false,
+        },
+    })
+}
+
+/// The budget in `inspect`'s text: each tier's total, buffers and textures, and the textures
+/// by kind.
+fn print_budget(budgets: &[GpuBudget; 2]) {
+    let mb = |b: u64| match b {
+        0..1_000 => format!("{b} B"),
+        1_000..1_000_000 => format!("{:.1} kB", b as f64 / 1e3),
+        _ => format!("{:.2} MB", b as f64 / 1e6),
+    };
+    let tiers: Vec<String> = budgets
+        .iter()
+        .map(|b| {
+            format!(
+                "{} tier {} (buffers {}, textures {})",
+                b.config.bindings.name(),
+                mb(b.bytes.total()),
+                mb(b.bytes.buffers()),
+                mb(b.bytes.textures())
+            )
+        })
+        .collect();
+    println!("  GPU memory a player allocates: {}", tiers.join("; "));
+    let kinds: Vec<String> = (budgets[0].bytes.texture_kinds())
+        .map(|(k, b)| format!("{} {}", k.name(), mb(b)))
+        .collect();
+    println!("    storage tier's textures: {}", kinds.join(", "));
+}
 
 /// Arguments of `inspect`.
 #[derive(Args, Debug)]
@@ -100,6 +179,8 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
     // The camera paths of the file (a bundle has several): DESIGN's `clips[{name, frames,
     // fps}]`, `frames` the clip's count, with where it starts in the file and in its path.
     v["clips"] = trisort_bake::figures::clips_json(&baked);
+    let budgets = [Bindings::Storage, Bindings::Textures].map(|b| GpuBudget::portable(&baked, b));
+    v["gpu_bytes"] = budget_json(&budgets);
     if let Some(png) = &a.matrix {
         let m = trisort_bench::matrix::draw_matrix(&baked, png)?;
         let margin = trisort_bench::matrix::MARGIN;
@@ -115,6 +196,7 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
     } else {
         println!("{}: baked file, {} frames", a.file, baked.frames.len());
         print_clips(&baked.clips);
+        print_budget(&budgets);
         println!("{}", serde_json::to_string_pretty(&v)?);
     }
     Ok(ExitCode::SUCCESS)

@@ -377,6 +377,11 @@ fn print_play_json(
         "shading": p.config.shading.name(),
         "tonemap": p.config.tone_map.name(),
         "texture_bytes": p.path.texture_bytes,
+        // What the player created, counted where it was created (`inspect`'s `gpu_bytes`
+        // budgets it).
+        "gpu_bytes_allocated": super::inspect::gpu_bytes_json(&p.path.gpu_bytes_allocated),
+        // Creating the player and waiting for its uploads, in milliseconds.
+        "load_ms": p.path.load_ms,
         "variant": a.variant,
         // The clip played (`--clip`; null: the file's frames, numbered as in the file).
         "clip": p.clip.map(|c| &c.name),
@@ -412,6 +417,13 @@ fn print_play_text(a: &PlayArgs, p: &Played<'_>) {
         p.gpu.info.backend,
         p.path.bindings,
         p.path.draw_path
+    );
+    let allocated = &p.path.gpu_bytes_allocated;
+    println!(
+        "GPU memory allocated: {} bytes (buffers {}, textures {})",
+        allocated.total(),
+        allocated.buffers(),
+        allocated.textures()
     );
     if let Some(d) = &a.out_dir {
         println!("wrote {}", d.display());

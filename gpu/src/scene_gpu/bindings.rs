@@ -3,8 +3,8 @@
 //! group.
 
 use trisort_format::Geometry;
-use wgpu::util::DeviceExt;
 
+use super::budget::{sized_buffer, GpuBytes, GpuKind, SceneBudget};
 use super::materials::MaterialGpu;
 use super::uniforms::{FrameData, FrameUniform, LightingUniform};
 
@@ -216,24 +216,33 @@ pub(crate) struct SharedBindings<'a> {
     pub(crate) surface: [wgpu::BindGroupEntry<'a>; 6],
 }
 
-/// The storage tier's layout and bind group, and its node-matrix stride per frame.
+/// The storage tier's layout and bind group, and its node-matrix stride per frame; the
+/// buffers sized by `budget` and counted into `allocated`.
 pub(super) fn storage_bind_group(
     device: &wgpu::Device,
     shared: SharedBindings<'_>,
     data: &FrameData,
     materials: &[MaterialGpu],
+    budget: &SceneBudget,
+    allocated: &mut GpuBytes,
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup, u64, MaterialStore) {
-    let materials = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("materials"),
-        contents: bytemuck::cast_slice(materials),
+    let materials = sized_buffer(
+        device,
+        "materials",
+        budget.bytes.buffer(GpuKind::Materials),
+        bytemuck::cast_slice(materials),
         // COPY_DST: material variants rewrite it (`SceneGpu::set_materials`).
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-    });
-    let node_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("node matrices"),
-        contents: &data.node_bytes,
-        usage: wgpu::BufferUsages::STORAGE,
-    });
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+    );
+    let node_buffer = sized_buffer(
+        device,
+        "node matrices",
+        budget.bytes.buffer(GpuKind::NodeMatrices),
+        &data.node_bytes,
+        wgpu::BufferUsages::STORAGE,
+    );
+    allocated.count_buffer(GpuKind::Materials, &materials);
+    allocated.count_buffer(GpuKind::NodeMatrices, &node_buffer);
     let layout = bind_group_layout(device);
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("trisort scene"),

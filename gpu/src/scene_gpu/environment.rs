@@ -3,6 +3,8 @@
 use trisort_format::gpu_layout::environment_levels;
 use trisort_format::Environment;
 
+use super::budget::{GpuBytes, GpuKind, SceneBudget};
+
 /// The prefiltered environment on the GPU.
 pub(super) struct EnvironmentGpu {
     pub(super) view: wgpu::TextureView,
@@ -12,14 +14,16 @@ pub(super) struct EnvironmentGpu {
 }
 
 /// Uploads an environment's prefiltered radiance as an `Rgba16Float` texture, its levels as
-/// [`environment_levels`] gives them for the device's largest texture.
+/// [`environment_levels`] gives them for the budget's largest texture (the device's); counts
+/// it into `allocated`.
 pub(super) fn upload_environment(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     env: &Environment,
+    budget: &SceneBudget,
+    allocated: &mut GpuBytes,
 ) -> EnvironmentGpu {
-    let max_dim = device.limits().max_texture_dimension_2d;
-    let stored = environment_levels(env, max_dim);
+    let stored = environment_levels(env, budget.config.max_texture_dimension);
     let levels = stored.len() as u32;
     let (w0, h0) = (stored[0].width, stored[0].height);
     let texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -60,6 +64,7 @@ pub(super) fn upload_environment(
         );
         bytes += w as u64 * h as u64 * 8;
     }
+    allocated.count_texture(GpuKind::Environment, &texture);
     EnvironmentGpu {
         view: texture.create_view(&Default::default()),
         levels,

@@ -9,6 +9,7 @@
 //! over the scene's vertex buffer (`pipeline`).
 
 mod bindings;
+pub mod budget;
 mod environment;
 mod materials;
 mod peel;
@@ -18,6 +19,7 @@ mod uniforms;
 
 pub use bindings::{bind_group_layout, bind_group_layout_for, Bindings, DATA_WIDTH};
 pub(crate) use bindings::{sized_buffer_entry, surface_entries, MaterialStore, SharedBindings};
+pub use budget::{scene_budget, BudgetConfig, GpuBytes, GpuKind, SceneBudget};
 pub use materials::MaterialGpu;
 pub use peel::{begin_peel_pass, previous_key_entries};
 pub use pipeline::{vertex_layout, ScenePipeline, VERTEX_ATTRIBUTES};
@@ -29,12 +31,12 @@ pub use uniforms::{
 };
 
 use bindings::storage_bind_group;
+use budget::sized_buffer;
 use environment::upload_environment;
 use materials::material_table;
 use textures::{upload_textures, TexturePlace};
-use trisort_format::{FrameState, Geometry, Material, Vertex};
+use trisort_format::{FrameState, Geometry, Material};
 use uniforms::{frame_data, projection};
-use wgpu::util::DeviceExt;
 
 pub use trisort_format::gpu_layout::View;
 
@@ -77,6 +79,10 @@ pub struct SceneGpu {
     material_count: usize,
     /// [`SceneGpu::texture_bytes`].
     texture_bytes: u64,
+    /// [`SceneGpu::budget`].
+    budget: SceneBudget,
+    /// [`SceneGpu::allocated`].
+    allocated: GpuBytes,
 }
 
 impl SceneGpu {
@@ -92,7 +98,8 @@ impl SceneGpu {
     /// bind group serves every material. Node matrices are computed in f64 and cast once.
     /// Every texture's mips are uploaded as the geometry stores them: the geometry must pass
     /// [`Geometry::check_structure`] (which requires each texture's full chain), else this
-    /// may panic.
+    /// may panic. Every buffer and texture is sized by [`scene_budget`] for the device and
+    /// tier ([`SceneGpu::budget`]), and counted as it is created ([`SceneGpu::allocated`]).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -178,42 +185,45 @@ impl SceneGpu {
             lighting,
             visibility_only,
         } = upload;
-        let limits = device.limits();
-        let vertex_bytes: &[u8] = if geometry.vertices.is_empty() {
-            &[0u8; std::mem::size_of::<Vertex>()]
-        } else {
-            bytemuck::cast_slice(&geometry.vertices)
-        };
-        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("vertices"),
-            contents: vertex_bytes,
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-        let textures = upload_textures(device, queue, geometry, visibility_only);
+        let mut config = BudgetConfig::for_device(device, bindings);
+        config.visibility_only = visibility_only;
+        let budget = scene_budget(geometry, frames.len(), lighting.environment, config);
+        let mut allocated = GpuBytes::default();
+        let vertex_bytes: &[u8] = bytemuck::cast_slice(&geometry.vertices);
+        let vertices = sized_buffer(
+            device,
+            "vertices",
+            budget.bytes.buffer(GpuKind::Vertices),
+            vertex_bytes,
+            wgpu::BufferUsages::VERTEX,
+        );
+        allocated.count_buffer(GpuKind::Vertices, &vertices);
+        let textures = upload_textures(device, queue, geometry, &budget, &mut allocated);
         let sampler =
             trilinear_sampler(device, "material textures", wgpu::AddressMode::ClampToEdge);
-        let env = upload_environment(device, queue, lighting.environment);
+        let env = upload_environment(device, queue, lighting.environment, &budget, &mut allocated);
         // The environment wraps around in longitude (u) and stops at the poles (v).
         let environment_sampler =
             trilinear_sampler(device, "environment", wgpu::AddressMode::Repeat);
         let lighting_uniform = LightingUniform::new(&lighting, env.levels);
-        let lighting_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("lighting"),
-            contents: bytemuck::bytes_of(&lighting_uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        let lighting_buffer = sized_buffer(
+            device,
+            "lighting",
+            budget.bytes.buffer(GpuKind::Lighting),
+            bytemuck::bytes_of(&lighting_uniform),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        allocated.count_buffer(GpuKind::Lighting, &lighting_buffer);
         let materials = material_table(&geometry.materials, &textures.places);
-        // The texture tier packs every frame's matrices contiguously (64 bytes a node).
-        let node_align = match bindings {
-            Bindings::Storage => limits.min_storage_buffer_offset_alignment as u64,
-            Bindings::Textures => 64,
-        };
-        let data = frame_data(&limits, geometry, frames, view, node_align);
-        let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("frame uniforms"),
-            contents: &data.frame_bytes,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
+        let data = frame_data(geometry, frames, view, &budget);
+        let frame_buffer = sized_buffer(
+            device,
+            "frame uniforms",
+            budget.bytes.buffer(GpuKind::FrameUniforms),
+            &data.frame_bytes,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        allocated.count_buffer(GpuKind::FrameUniforms, &frame_buffer);
         let view_entry = |binding, view| wgpu::BindGroupEntry {
             binding,
             resource: wgpu::BindingResource::TextureView(view),
@@ -244,14 +254,20 @@ impl SceneGpu {
             ],
         };
         let (layout, bind_group, node_stride, material_store) = match bindings {
-            Bindings::Storage => storage_bind_group(device, shared, &data, &materials),
+            Bindings::Storage => {
+                storage_bind_group(device, shared, &data, &materials, &budget, &mut allocated)
+            }
             Bindings::Textures => crate::data_textures::bind_group(
                 device,
                 queue,
                 shared,
-                &data,
-                bytemuck::cast_slice(&materials),
-                frames.len(),
+                crate::data_textures::TierData {
+                    data: &data,
+                    material_bytes: bytemuck::cast_slice(&materials),
+                    frames: frames.len(),
+                    budget: &budget,
+                    allocated: &mut allocated,
+                },
             ),
         };
         SceneGpu {
@@ -272,7 +288,22 @@ impl SceneGpu {
             texture_places: textures.places,
             material_count: geometry.materials.len(),
             texture_bytes: textures.bytes + env.bytes,
+            budget,
+            allocated,
         }
+    }
+
+    /// The budget the scene was created from ([`scene_budget`] for this device and tier): its
+    /// strides, texture arrays and bytes by kind.
+    pub fn budget(&self) -> &SceneBudget {
+        &self.budget
+    }
+
+    /// Bytes of every buffer and texture the scene created, by kind, counted from the wgpu
+    /// objects as they were created (buffer sizes, texture extents × levels × format): equal
+    /// to [`SceneGpu::budget`]'s bytes unless the two disagree.
+    pub fn allocated(&self) -> &GpuBytes {
+        &self.allocated
     }
 
     /// Bytes of GPU memory the scene's textures take: both material texture arrays with every

@@ -3,8 +3,10 @@
 
 use trisort_format::Geometry;
 
+use trisort_format::gpu_layout::TextureArray;
 pub(crate) use trisort_format::gpu_layout::TexturePlace;
-use trisort_format::gpu_layout::{plan_texture_arrays, TextureArray};
+
+use super::budget::{GpuBytes, SceneBudget};
 
 /// The two material texture arrays.
 pub(super) struct Textures {
@@ -17,49 +19,48 @@ pub(super) struct Textures {
 }
 
 /// Uploads the material textures into two arrays, sRGB (`Rgba8UnormSrgb`) and linear
-/// (`Rgba8Unorm`), as [`plan_texture_arrays`] lays them out (each texture in the array of its
-/// colour space, layers as large as the array's largest texture clamped to the device's
-/// limit, full mip chains, smaller textures repeated from the top-left corner). An empty array
-/// gets one white texel; on GL an array has two layers at least (see the comment inside). With `visibility_only` ([`SceneGpu::for_visibility`](super::SceneGpu::for_visibility))
+/// (`Rgba8Unorm`), as the budget's plan ([`plan_texture_arrays`](trisort_format::gpu_layout::plan_texture_arrays), in [`SceneBudget::arrays`])
+/// lays them out (each texture in the array of its colour space, layers as large as the
+/// array's largest texture clamped to the device's limit, full mip chains, smaller textures
+/// repeated from the top-left corner), with [`SceneBudget::layers`] layers each. An empty
+/// array gets one white texel. With `visibility_only` ([`SceneGpu::for_visibility`](super::SceneGpu::for_visibility))
 /// the linear array is left empty (its textures placed at its layer 0, the white texel) unless
-/// a material's base-colour texture is linear.
+/// a material's base-colour texture is linear. Counts both arrays into `allocated`.
 pub(super) fn upload_textures(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     geometry: &Geometry,
-    visibility_only: bool,
+    budget: &SceneBudget,
+    allocated: &mut GpuBytes,
 ) -> Textures {
-    let max_dim = device.limits().max_texture_dimension_2d;
-    let plan = plan_texture_arrays(geometry, max_dim, visibility_only);
-    let (srgb, srgb_bytes) = upload_array(device, queue, geometry, &plan.srgb);
-    let (linear, linear_bytes) = upload_array(device, queue, geometry, &plan.linear);
+    let plan = &budget.arrays;
+    let srgb = upload_array(device, queue, geometry, &plan.srgb, budget.layers[0]);
+    let linear = upload_array(device, queue, geometry, &plan.linear, budget.layers[1]);
+    allocated.count_texture_layers(&srgb.0, &budget.layer_kinds[0]);
+    allocated.count_texture_layers(&linear.0, &budget.layer_kinds[1]);
     Textures {
-        srgb,
-        linear,
-        places: plan.places,
-        bytes: srgb_bytes + linear_bytes,
+        srgb: srgb.1,
+        linear: linear.1,
+        places: plan.places.clone(),
+        bytes: srgb.2 + linear.2,
     }
 }
 
-/// One array of [`upload_textures`], as [`plan_texture_arrays`] planned it; returns the view
-/// and its bytes.
+/// One array of [`upload_textures`], as [`plan_texture_arrays`](trisort_format::gpu_layout::plan_texture_arrays) planned it, with `layers`
+/// layers; returns the texture, its view and its bytes.
 fn upload_array(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     geometry: &Geometry,
     array: &TextureArray,
-) -> (wgpu::TextureView, u64) {
+    layers: u32,
+) -> (wgpu::Texture, wgpu::TextureView, u64) {
     let (tw, th, levels, linear) = (array.width, array.height, array.levels, array.linear);
     // wgpu's GL backend picks the GL texture target when the texture is made, from its
     // layer count alone: one layer becomes TEXTURE_2D, which a `texture_2d_array` binding
-    // (sampler2DArray) then samples as an incomplete texture, black. Two layers at least on
-    // GL make it TEXTURE_2D_ARRAY; the spare layer is never addressed.
-    let min_layers = if device.adapter_info().backend == wgpu::Backend::Gl {
-        2
-    } else {
-        1
-    };
-    let layers = array.layers().max(min_layers);
+    // (sampler2DArray) then samples as an incomplete texture, black. The budget gives two
+    // layers at least on GL (`BudgetConfig::min_array_layers`), which makes it
+    // TEXTURE_2D_ARRAY; the spare layer is never addressed.
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some(if linear {
             "linear textures"
@@ -127,5 +128,5 @@ fn upload_array(
         .map(|k| ((tw >> k).max(1) as u64) * ((th >> k).max(1) as u64) * 4)
         .sum::<u64>()
         * layers as u64;
-    (view, bytes)
+    (texture, view, bytes)
 }

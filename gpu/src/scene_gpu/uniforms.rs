@@ -5,6 +5,7 @@
 use trisort_format::gpu_layout::{node_count, node_matrices};
 use trisort_format::{FrameState, Geometry, Shading};
 
+use super::budget::SceneBudget;
 use super::View;
 pub use trisort_format::gpu_layout::{
     frame_uniform, projection, subpixel_shift, FrameUniform, Lighting, LightingUniform, LIGHT,
@@ -21,10 +22,6 @@ pub fn shading_constants(shading: Shading) -> &'static [(&'static str, f64)] {
     }
 }
 
-fn align(x: u64, a: u64) -> u64 {
-    x.div_ceil(a) * a
-}
-
 /// Every frame's uniform and node matrices, each frame at its stride (the device's dynamic
 /// offset alignments).
 pub(crate) struct FrameData {
@@ -35,20 +32,16 @@ pub(crate) struct FrameData {
     pub(crate) node_count: u64,
 }
 
-/// Computes [`FrameData`]: camera-relative node matrices in f64, cast once.
+/// Computes [`FrameData`] at the budget's strides: camera-relative node matrices in f64, cast
+/// once.
 pub(super) fn frame_data(
-    limits: &wgpu::Limits,
     geometry: &Geometry,
     frames: &[FrameState],
     view: View,
-    node_align: u64,
+    budget: &SceneBudget,
 ) -> FrameData {
-    let frame_stride = align(
-        std::mem::size_of::<FrameUniform>() as u64,
-        limits.min_uniform_buffer_offset_alignment as u64,
-    );
+    let (frame_stride, node_stride) = (budget.frame_stride, budget.node_stride);
     let node_count = node_count(geometry) as u64;
-    let node_stride = align(node_count * 64, node_align);
     let nframes = frames.len().max(1) as u64;
     let mut frame_bytes = vec![0u8; (frame_stride * nframes) as usize];
     let mut node_bytes = vec![0u8; (node_stride * nframes) as usize];
