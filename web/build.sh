@@ -9,10 +9,14 @@ cd "$(dirname "$0")/.."
 bash scripts/ensure-web.sh
 target="${CARGO_TARGET_DIR:-target}"
 out=web/dist
-# TRISORT_WASM_PROFILE=wasm-release builds with the root Cargo.toml's size profile (fat LTO,
-# one codegen unit, opt-level "s"; BENCHMARKS § Web player).
-profile="${TRISORT_WASM_PROFILE:-release}"
-cargo build --quiet -p trisort-web --target wasm32-unknown-unknown --profile "$profile"
+# The wasm-release profile (the root Cargo.toml: fat LTO, one codegen unit, opt-level "s"),
+# chosen by size and frame time (BENCHMARKS § Web player); TRISORT_WASM_PROFILE=release builds
+# without LTO (faster while working on the player). `cargo rustc --crate-type cdylib`: cargo
+# skips LTO for a crate that is also an rlib (web/Cargo.toml's crate-type, for the native
+# tests), so the wasm build asks for the cdylib alone.
+wasm_profile="${TRISORT_WASM_PROFILE:-wasm-release}"
+cargo rustc --quiet -p trisort-web --lib --crate-type cdylib --target wasm32-unknown-unknown \
+  --profile "$wasm_profile"
 # The npm package (web/pkg, @trisort/player): index.js and index.d.ts are written by hand;
 # wasm/ is wasm-bindgen's module and its types, generated here. Same inputs, same bytes: the
 # tarball holds no time stamp of ours (npm pack sets every file's time to its fixed date).
@@ -24,11 +28,19 @@ if [ "$pkg_version" != "$version" ]; then
   exit 1
 fi
 rm -rf "$pkg/wasm" && mkdir -p "$pkg/wasm" "$out/pkg"
-wasm_dir=$profile
-[ "$profile" = dev ] && wasm_dir=debug
+wasm_dir=$wasm_profile
+[ "$wasm_profile" = dev ] && wasm_dir=debug
 wasm-bindgen --target web --out-dir "$pkg/wasm" \
   "$target/wasm32-unknown-unknown/$wasm_dir/trisort_web.wasm"
 rm -f "$pkg/wasm/trisort_web_bg.wasm.d.ts"
+# TRISORT_WASM_OPT=-Oz (or other wasm-opt flags) runs binaryen's wasm-opt (web/test's pinned
+# npm binaryen) over the module: BENCHMARKS § Web player has what it saves and costs.
+if [ -n "${TRISORT_WASM_OPT:-}" ]; then
+  [ -x web/test/node_modules/.bin/wasm-opt ] || bash scripts/ensure-web.sh --browser-only
+  # shellcheck disable=SC2086 # the flags are words
+  web/test/node_modules/.bin/wasm-opt $TRISORT_WASM_OPT "$pkg/wasm/trisort_web_bg.wasm" \
+    -o "$pkg/wasm/trisort_web_bg.wasm"
+fi
 cp LICENSE-MIT LICENSE-APACHE THIRD-PARTY-NOTICES.md "$pkg/"
 rm -f "$pkg"/trisort-player-*.tgz
 (cd "$pkg" && npm pack --silent >/dev/null)
@@ -47,4 +59,4 @@ if [ "$profile" != browser ]; then
     --raster-profile browser -o "$out/demo.baked"
 fi
 wasm_bytes=$(stat -c %s "$out/pkg/trisort_web_bg.wasm")
-echo "web player in $out/ and $pkg/$(cd "$pkg" && ls trisort-player-*.tgz) ($wasm_bytes bytes of wasm, $profile)"
+echo "web player in $out/ and $pkg/$(cd "$pkg" && ls trisort-player-*.tgz) ($wasm_bytes bytes of wasm, $wasm_profile${TRISORT_WASM_OPT:+, wasm-opt $TRISORT_WASM_OPT})"
