@@ -30,6 +30,13 @@ fail() { echo "test-capi-package: $*" >&2; exit 1; }
 step() { echo "test-capi-package: $*" >&2; }
 start=$(date +%s)
 
+# A small bake from the CLI the cargo tests built (no rebuild when they ran before), before
+# the install below builds libtrisort_capi.so over the tests' copy (which would make cargo
+# compile trisort-capi and link the CLI again).
+baked="$work/car.baked"
+cargo run -q --bin trisort -- bake demo:3000 --path orbit:frames=3,degrees=90 --size 64x48 \
+  -o "$baked" >/dev/null 2>&1 || fail "baking the test file failed"
+
 prefix="$work/prefix"
 profile="${TRISORT_CAPI_PROFILE:-dev}"
 # libtrisort_export (--with-export-order) too with TRISORT_CAPI_EXPORT=1: its build needs the
@@ -39,6 +46,15 @@ with_export="${TRISORT_CAPI_EXPORT:-0}"
 export_args=()
 [ "$with_export" = 1 ] && export_args=(--with-export-order)
 bash scripts/install-capi.sh --prefix "$prefix" --profile "$profile" "${export_args[@]}"
+# The aarch64 cross-build (cargo, both cores) runs in the background while the checks and the
+# C and C++ examples below build and run (gcc, CMake, CTest: mostly one core, no cargo, so no
+# wait on cargo's lock on target/); its library is checked at the end.
+arm="$work/prefix-aarch64"
+if [ "$aarch64" = 1 ]; then
+  bash scripts/install-capi.sh --prefix "$arm" --target aarch64-unknown-linux-gnu \
+    --profile "$profile" >"$work/install-aarch64.log" 2>&1 &
+  cross=$!
+fi
 lib="$prefix/lib/libtrisort.so"
 soname="$(readelf -d "$lib" | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p')"
 [ "$soname" = libtrisort.so.0 ] || fail "$lib: SONAME is '$soname', not libtrisort.so.0"
@@ -60,21 +76,6 @@ if nm -D --defined-only "$lib" | grep -qw trisort_export_order; then
   fail "$lib (player only) exports trisort_export_order"
 fi
 step "SONAME $soname, no libstdc++ ($(ldd "$lib" | wc -l) libraries: $(ldd "$lib" | awk '{print $1}' | tr '\n' ' '))"
-
-# A small bake from the CLI the cargo tests built (no rebuild when they ran before).
-baked="$work/car.baked"
-cargo run -q --bin trisort -- bake demo:3000 --path orbit:frames=3,degrees=90 --size 64x48 \
-  -o "$baked" >/dev/null 2>&1 || fail "baking the test file failed"
-
-# The aarch64 cross-build (cargo, both cores) runs in the background while the C and C++
-# examples below build and run (gcc, CMake, CTest: mostly one core, no cargo, so no wait on
-# cargo's lock on target/); its library is checked at the end.
-arm="$work/prefix-aarch64"
-if [ "$aarch64" = 1 ]; then
-  bash scripts/install-capi.sh --prefix "$arm" --target aarch64-unknown-linux-gnu \
-    --profile "$profile" >"$work/install-aarch64.log" 2>&1 &
-  cross=$!
-fi
 
 # The C host: CMake and pkg-config builds, each run on the bake; their frames are equal.
 cmake -S examples/c-gles -B "$work/c-cmake" -DCMAKE_PREFIX_PATH="$prefix" \

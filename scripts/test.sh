@@ -22,10 +22,6 @@ export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp/xdg-runtime-$(id -u)}"
 mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 export TRISORT_SCENES="${TRISORT_SCENES:-$(pwd)/../shared/scenes}"
 cargo test --workspace --all-targets "$@"
-# The C library installed as a C/C++ build takes it: SONAME, pkg-config, CMake, the C++
-# example, and the aarch64 cross-build run under qemu-aarch64 (README § Installing the C
-# library).
-bash scripts/test-capi-package.sh
 # The web player in headless Chromium (installs Chromium, Node's playwright-core and the
 # wasm-bindgen CLI when missing). TRISORT_SKIP_BROWSER=1 skips it on a developer machine;
 # CI refuses to skip it.
@@ -38,3 +34,10 @@ if [ "${TRISORT_SKIP_BROWSER:-}" = 1 ]; then
 else
   bash web/test/run.sh
 fi
+# The C library installed as a C/C++ build takes it: SONAME, pkg-config, CMake, the C++
+# example, and the aarch64 cross-build run under qemu-aarch64 (README § Installing the C
+# library). Last: its install builds libtrisort_capi.so with the library's own dependency
+# features over the tests' copy in target/debug/deps (a cdylib's file name carries no hash),
+# so a `cargo build --bin trisort` after it (web/build.sh's) would compile trisort-capi,
+# trisort-capi-export and link the CLI again.
+bash scripts/test-capi-package.sh
