@@ -47,6 +47,10 @@ node web/test/browser.mjs --dist web/dist --native "$out/native" --frames "$list
 # unknown clip with TrisortOptionError; and its types compile in an app's TypeScript.
 consumer=web/test/pkg-consumer
 tarball=$(cd web/pkg && ls trisort-player-*.tgz)
+# Packed again from the same files, the tarball must be the same bytes (no time stamps).
+repack=$(mkdir -p "$out/repack" && cd "$out/repack" && pwd)
+(cd web/pkg && npm pack --silent --pack-destination "$repack" >/dev/null)
+cmp "web/pkg/$tarball" "$repack/$tarball" || { echo "npm pack is not reproducible" >&2; exit 1; }
 rm -rf "$consumer/node_modules" "$consumer/package.json" "$consumer/package-lock.json"
 printf '{ "name": "trisort-pkg-consumer", "private": true, "type": "module",\n  "dependencies": { "@trisort/player": "file:../../pkg/%s" } }\n' \
   "$tarball" > "$consumer/package.json"
