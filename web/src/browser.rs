@@ -389,7 +389,7 @@ async fn instance_for(backend: BrowserBackend) -> Result<(wgpu::Instance, &'stat
         BrowserBackend::WebGl2 => Ok(webgl2()),
         BrowserBackend::WebGpu if wgpu::util::is_browser_webgpu_supported().await => Ok(webgpu()),
         BrowserBackend::WebGpu => Err(device_error(
-            "this browser offers no WebGPU adapter (try ?backend=webgl2)",
+            "this browser offers no WebGPU adapter (backend webgl2 needs none)",
         )),
         BrowserBackend::Auto if wgpu::util::is_browser_webgpu_supported().await => Ok(webgpu()),
         BrowserBackend::Auto => Ok(webgl2()),

@@ -44,7 +44,8 @@ node web/test/browser.mjs --dist web/dist --native "$out/native" --frames "$list
 # throwaway project, as an app installs it, and run there: imported by name, the demo bake
 # opened with the options object and frame 0 drawn (compared with the native player's under
 # the PBR gate below), a truncated file rejected with TrisortFormatError, a bad option and an
-# unknown clip with TrisortOptionError; and its types compile in an app's TypeScript.
+# unknown clip with TrisortOptionError, WebGPU without an adapter with TrisortDeviceError; and
+# its types compile in an app's TypeScript.
 consumer=web/test/pkg-consumer
 tarball=$(cd web/pkg && ls trisort-player-*.tgz)
 # Packed again from the same files, the tarball must be the same bytes (no time stamps).
@@ -75,6 +76,8 @@ if (!is(r.truncated, "TrisortFormatError", "format") || !r.truncated.message.inc
 if (!is(r.bad_option, "TrisortOptionError", "option")) bad.push(`backend "vulkan": ${JSON.stringify(r.bad_option)}`);
 if (!is(r.no_canvas, "TrisortOptionError", "option")) bad.push(`no canvas: ${JSON.stringify(r.no_canvas)}`);
 if (!is(r.unknown_clip, "TrisortOptionError", "option")) bad.push(`unknown clip: ${JSON.stringify(r.unknown_clip)}`);
+// WebGPU is not enabled there: no adapter must be a TrisortDeviceError (opening is fine too).
+if (r.webgpu && !is(r.webgpu, "TrisortDeviceError", "device")) bad.push(`backend "webgpu": ${JSON.stringify(r.webgpu)}`);
 if (!r.format_is_class || !r.option_is_class) bad.push("the error classes do not extend TrisortError");
 if (r.console_errors.length) bad.push(`console errors: ${r.console_errors.join("; ")}`);
 if (bad.length) { console.error("package test failed:\n  " + bad.join("\n  ")); process.exit(1); }

@@ -59,6 +59,10 @@ window.runPackageTest = async ({ file, badFile, backend, native, frame }) => {
     bad_option: await failure(() => TrisortPlayer.open({ canvas, data, backend: "vulkan" })),
     no_canvas: await failure(() => TrisortPlayer.open({ data })),
     unknown_clip: await failure(() => player.setClip("no-such-clip")),
+    // Where this browser has no WebGPU adapter (pkg.mjs does not enable it): TrisortDeviceError.
+    webgpu: await failure(async () => {
+      (await TrisortPlayer.open({ canvas: document.createElement("canvas"), data, backend: "webgpu" })).free();
+    }),
     format_is_class: TrisortFormatError.prototype instanceof TrisortError,
     option_is_class: TrisortOptionError.prototype instanceof TrisortError,
   };
