@@ -78,6 +78,16 @@ impl RobustV4 {
                 profile: RasterProfile::named(ProfileName::Exact),
             };
         }
+        if !self.tolerance.is_finite() {
+            // A corrupted tolerance stays what it is, so the structure check refuses it
+            // rather than the migration turning it into a plausible box.
+            return Robust {
+                patterns: self.patterns,
+                tolerance: self.tolerance,
+                conservative: true,
+                profile: RasterProfile::named(ProfileName::Snap4),
+            };
+        }
         let reach = |bits: u32| 0.5 * 0.5f32.powi(bits as i32);
         let bits = (4..=16).find(|&b| reach(b) <= self.tolerance).unwrap_or(16);
         let name = if bits <= 4 {
@@ -191,6 +201,9 @@ mod tests {
             (7, 8)
         );
         assert_eq!(r.sample_box(), 1.0 / 256.0);
+        // A NaN tolerance is kept, for the structure check to refuse.
+        let r = old(true, f32::NAN).migrate();
+        assert!(r.tolerance.is_nan());
         let r = old(false, 0.125).migrate();
         assert_eq!(r.profile.name, ProfileName::Exact);
         assert!(!r.conservative);
