@@ -164,12 +164,8 @@ fn read_captured(dir: &Path, f: u32, base: u32, size: (u32, u32)) -> Result<Vec<
     Ok(image.into_raw())
 }
 
-/// Writes an RGBA8 image as PNG atomically.
-pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<(), FramesError> {
-    let write = |problem: String| FramesError::Write {
-        path: path.to_path_buf(),
-        problem,
-    };
+/// PNG bytes of an RGBA8 image (what [`write_png`] writes; the HTML report embeds them).
+pub fn encode_png(rgba8: &[u8], width: u32, height: u32) -> Result<Vec<u8>, image::ImageError> {
     let mut bytes = Vec::new();
     image::write_buffer_with_format(
         &mut std::io::Cursor::new(&mut bytes),
@@ -178,8 +174,17 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<(
         height,
         image::ExtendedColorType::Rgba8,
         image::ImageFormat::Png,
-    )
-    .map_err(|e| write(format!("encoding: {e}")))?;
+    )?;
+    Ok(bytes)
+}
+
+/// Writes an RGBA8 image as PNG atomically.
+pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<(), FramesError> {
+    let write = |problem: String| FramesError::Write {
+        path: path.to_path_buf(),
+        problem,
+    };
+    let bytes = encode_png(rgba8, width, height).map_err(|e| write(format!("encoding: {e}")))?;
     trisort_format::container::write_bytes_atomic(path, &bytes).map_err(|e| write(e.to_string()))
 }
 

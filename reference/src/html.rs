@@ -76,22 +76,12 @@ pub fn thumbnails(v: &VerifiedFrame, size: (u32, u32)) -> Result<Thumbnails, Fra
     })
 }
 
-/// PNG bytes of an RGBA8 image.
+/// PNG bytes of an RGBA8 thumbnail.
 fn png(rgba8: &[u8], width: u32, height: u32) -> Result<Vec<u8>, FramesError> {
-    let mut bytes = Vec::new();
-    image::write_buffer_with_format(
-        &mut std::io::Cursor::new(&mut bytes),
-        rgba8,
-        width,
-        height,
-        image::ExtendedColorType::Rgba8,
-        image::ImageFormat::Png,
-    )
-    .map_err(|e| FramesError::Write {
+    crate::frames::encode_png(rgba8, width, height).map_err(|e| FramesError::Write {
         path: "thumbnail.png".into(),
         problem: format!("encoding: {e}"),
-    })?;
-    Ok(bytes)
+    })
 }
 
 /// The heat map at `thumb` size: each thumbnail pixel shows the largest colour-channel
