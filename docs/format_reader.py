@@ -12,12 +12,13 @@ import json
 import struct
 import sys
 
-# Versions this reader understands (FORMAT.md § Compatibility): 6; 5 (no clips); 4 (no raster
+# Versions this reader understands (FORMAT.md § Compatibility): 7; 6 (no texture blocks); 5
+# (no clips); 4 (no raster
 # profile in
 # `Robust`); 3 (no vertex tangent and
 # uv1, no material texture slots and PBR factors, no texture colour space and mips, no
 # environment); 2 (no `robust`, no `Geometry.variants`, no `fps` either).
-FORMAT_VERSIONS = (2, 3, 4, 5, 6)
+FORMAT_VERSIONS = (2, 3, 4, 5, 6, 7)
 ORDER_VERSION = 1
 
 
@@ -105,6 +106,7 @@ LAYOUT = ["paper", "compact"]
 BRIDGE = ["hidden", "ignored", "visible"]
 SEEDING = ["interval", "paper"]
 ALPHA_MODE = ["Opaque", "Mask", "Blend"]
+BLOCK_FORMAT = ["Etc2Rgb8", "Etc2Rgba8", "Astc4x4", "Bc7"]
 PROFILE_NAME = ["exact", "conformant", "snap4", "browser"]
 DEPTH_AT = ["sample", "pixel"]
 
@@ -176,6 +178,10 @@ def read_baked(p, version):
         if version >= 4:
             t["srgb"] = p.boolean()
             t["mips"] = p.seq(p.bytes)
+        t["blocks"] = None
+        if version >= 7:
+            t["blocks"] = p.option(lambda: {"format": p.enum(BLOCK_FORMAT),
+                                            "levels": p.seq(p.bytes)})
         return t
 
     g["textures"] = p.seq(texture)
@@ -225,6 +231,24 @@ def level_size(width, height, k):
     return max(1, width >> k), max(1, height >> k)
 
 
+def check_blocks(k, t):
+    """A block-compressed texture (version 7): power-of-two size, no RGBA8 levels stored, a
+    full chain of levels, each of whole 4x4 blocks covering its level."""
+    w, h = t["width"], t["height"]
+    if w == 0 or h == 0 or w & (w - 1) or h & (h - 1):
+        raise Bad("texture %d: %dx%d blocks, not a power-of-two size" % (k, w, h))
+    if t["rgba8"] or t["mips"]:
+        raise Bad("texture %d: blocks and RGBA8 levels both stored" % k)
+    block = 8 if t["blocks"]["format"] == "Etc2Rgb8" else 16
+    levels = t["blocks"]["levels"]
+    if len(levels) != max(w, h).bit_length():
+        raise Bad("texture %d: %d block levels for %dx%d" % (k, len(levels), w, h))
+    for level, data in enumerate(levels):
+        lw, lh = level_size(w, h, level)
+        if len(data) != ((lw + 3) // 4) * ((lh + 3) // 4) * block:
+            raise Bad("texture %d block level %d: %d bytes for %dx%d" % (k, level, len(data), lw, lh))
+
+
 def check_lengths(b, version):
     """The lengths FORMAT.md states, checked again: every texture level and environment level
     has the bytes (halves) its size needs, every texture (from version 4) has its full mip
@@ -232,6 +256,11 @@ def check_lengths(b, version):
     g = b["geometry"]
     for k, t in enumerate(g["textures"]):
         w, h = t["width"], t["height"]
+        if t["blocks"] is not None:
+            # Version 7: the levels as GPU blocks (8 bytes a 4x4 block for ETC2 RGB8, else 16),
+            # the RGBA8 levels empty; decoding them is for a texture decoder, not this reader.
+            check_blocks(k, t)
+            continue
         if w == 0 or h == 0 or len(t["rgba8"]) != w * h * 4:
             raise Bad("texture %d: %dx%d with %d bytes" % (k, w, h, len(t["rgba8"])))
         full = max(w, h).bit_length() - 1

@@ -42,10 +42,14 @@ fn files_of_the_two_previous_versions_play_verify_and_upgrade_unchanged() {
     let Some(dir) = gpu_tempdir() else { return };
     let d = dir.path();
     assert_eq!(
-        FORMAT_VERSION, 6,
-        "a new version: add a file of version 5's successor here"
+        FORMAT_VERSION, 7,
+        "a new version: add a file of version 6's successor here"
     );
-    for (file, version) in [("format4.baked", 4), ("format5.baked", 5)] {
+    for (file, version) in [
+        ("format4.baked", 4),
+        ("format5.baked", 5),
+        ("format6.baked", 6),
+    ] {
         std::fs::copy(data(file), d.join(file)).unwrap();
         assert_eq!(version_of(&d.join(file)), version, "{file}");
         let info = run_json(d, &["inspect", file]);

@@ -98,7 +98,7 @@
  * says what the loaded library reads): a file of another version is refused with
  * `TRISORT_STATUS_FORMAT` and a message saying to bake it again.
  */
-#define TRISORT_FORMAT_VERSION 6
+#define TRISORT_FORMAT_VERSION 7
 
 /**
  * `TrisortRasterProfile.name`: the recorded pattern only (`--raster-profile exact`).

@@ -39,7 +39,7 @@ use serde::Serialize;
 /// second texture coordinate, texture colour spaces and mip chains, and the baked file's
 /// [`crate::Environment`]; 5, [`crate::Robust`] ends with the bake's
 /// [`crate::RasterProfile`].
-pub const FORMAT_VERSION: u32 = 6;
+pub const FORMAT_VERSION: u32 = 7;
 
 /// Decompressed payloads larger than this are refused (16 GiB).
 pub const MAX_PAYLOAD: u64 = 16 << 30;
@@ -163,12 +163,26 @@ pub trait Stored: DeserializeOwned {
         let _ = raw;
         Err(format!("format version {version} is not migrated"))
     }
+
+    /// Completes a decoded value: decodes what the file stores compressed (block-compressed
+    /// textures, [`Geometry::decode_blocks`](crate::Geometry::decode_blocks)).
+    fn after_decode(&mut self) -> Result<(), crate::StructureError> {
+        Ok(())
+    }
 }
 
-impl Stored for crate::Recording {}
+impl Stored for crate::Recording {
+    fn after_decode(&mut self) -> Result<(), crate::StructureError> {
+        self.geometry.decode_blocks()
+    }
+}
 
 impl Stored for crate::Baked {
     const OLDEST: u32 = crate::legacy::OLDEST_READABLE;
+
+    fn after_decode(&mut self) -> Result<(), crate::StructureError> {
+        self.geometry.decode_blocks()
+    }
 
     fn decode_older(version: u32, raw: &[u8]) -> Result<Self, String> {
         crate::legacy::decode_baked(version, raw)
@@ -283,22 +297,29 @@ fn decode_with<T: Stored>(
         "the checksum matches, so another trisort build of format version {version} with a \
          different layout probably wrote it: record or merge it again with this trisort"
     );
-    if version != FORMAT_VERSION {
-        return T::decode_older(version, &raw).map_err(|e| FormatError::Payload {
+    let mut value = if version != FORMAT_VERSION {
+        T::decode_older(version, &raw).map_err(|e| FormatError::Payload {
             path: p(),
             reason: format!("decoding version {version} failed: {e}; {rewrite}"),
-        });
-    }
-    let (value, rest) = postcard::take_from_bytes::<T>(&raw).map_err(|e| FormatError::Payload {
+        })?
+    } else {
+        let (value, rest) =
+            postcard::take_from_bytes::<T>(&raw).map_err(|e| FormatError::Payload {
+                path: p(),
+                reason: format!("decoding failed: {e}; {rewrite}"),
+            })?;
+        if !rest.is_empty() {
+            return Err(FormatError::Payload {
+                path: p(),
+                reason: format!("{} trailing bytes; {rewrite}", rest.len()),
+            });
+        }
+        value
+    };
+    value.after_decode().map_err(|e| FormatError::Payload {
         path: p(),
-        reason: format!("decoding failed: {e}; {rewrite}"),
+        reason: e.to_string(),
     })?;
-    if !rest.is_empty() {
-        return Err(FormatError::Payload {
-            path: p(),
-            reason: format!("{} trailing bytes; {rewrite}", rest.len()),
-        });
-    }
     Ok(value)
 }
 
@@ -448,15 +469,15 @@ mod tests {
         assert!(matches!(
             err,
             FormatError::Version {
-                found: 5,
-                supported: 6,
-                oldest: 6,
+                found: 6,
+                supported: 7,
+                oldest: 7,
                 ..
             }
         ));
         assert_eq!(
             err.to_string(),
-            "old.baked: format version 5 is not supported (this trisort reads version 6); \
+            "old.baked: format version 6 is not supported (this trisort reads version 7); \
              record or merge it again with this trisort"
         );
         // A baked file reads back to version 4 (migrated), not version 3.
@@ -465,7 +486,7 @@ mod tests {
             decode::<crate::Baked>(FileKind::Baked, &bytes, Path::new("old.baked")).unwrap_err();
         assert!(
             err.to_string()
-                .contains("format version 3 is not supported (this trisort reads versions 4 to 6)"),
+                .contains("format version 3 is not supported (this trisort reads versions 4 to 7)"),
             "{err}"
         );
     }

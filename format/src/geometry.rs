@@ -205,8 +205,10 @@ impl Material {
     }
 }
 
-/// A decoded texture: tightly packed RGBA8, rows top to bottom, with its mip chain.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// A decoded texture: tightly packed RGBA8, rows top to bottom, with its mip chain; and,
+/// in a baked file made with `--textures`, the same levels as GPU blocks ([`Texture::blocks`]),
+/// which the file stores in place of the RGBA8 levels.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 pub struct Texture {
     /// Name (image name or URI from the source file; may be empty).
     pub name: String,
@@ -226,6 +228,30 @@ pub struct Texture {
     /// [`Geometry::check_structure`] requires it, and the GPU upload uses these levels as
     /// stored, so the file is the one source of every texture's mips.
     pub mips: Vec<Vec<u8>>,
+    /// The levels block-compressed (`bake`/`merge --textures`): then [`Texture::rgba8`] and
+    /// [`Texture::mips`] hold these blocks decoded, and a file stores the blocks alone
+    /// (reading decodes them: [`Geometry::decode_blocks`]). `None`: RGBA8 only.
+    pub blocks: Option<crate::blocks::TextureBlocks>,
+}
+
+/// A file stores a block-compressed texture's blocks and leaves its RGBA8 levels empty:
+/// reading decodes them again ([`Geometry::decode_blocks`]).
+impl Serialize for Texture {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let compressed = self.blocks.is_some();
+        let none: &[u8] = &[];
+        let no_mips: &[Vec<u8>] = &[];
+        let mut st = s.serialize_struct("Texture", 7)?;
+        st.serialize_field("name", &self.name)?;
+        st.serialize_field("width", &self.width)?;
+        st.serialize_field("height", &self.height)?;
+        st.serialize_field("rgba8", if compressed { none } else { &self.rgba8 })?;
+        st.serialize_field("srgb", &self.srgb)?;
+        st.serialize_field("mips", if compressed { no_mips } else { &self.mips })?;
+        st.serialize_field("blocks", &self.blocks)?;
+        st.end()
+    }
 }
 
 impl Texture {
@@ -422,6 +448,11 @@ impl Geometry {
                     tex.width, tex.height
                 )));
             }
+            if let Some(blocks) = &tex.blocks {
+                blocks.check(tex.width, tex.height).map_err(|e| {
+                    crate::Part::Geometry.error(format!("texture {t} {:?}: {e}", tex.name))
+                })?;
+            }
             if tex.rgba8.len() as u64 != tex.width as u64 * tex.height as u64 * 4 {
                 return Err(crate::Part::Geometry
                     .error(format!("texture {t} has the wrong number of bytes")));
@@ -448,6 +479,27 @@ impl Geometry {
                     )));
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// Decodes every block-compressed texture whose RGBA8 levels are empty (as a file stores
+    /// it) into [`Texture::rgba8`] and [`Texture::mips`], after checking its blocks
+    /// ([`crate::blocks::TextureBlocks::check`]). What reading a file does before
+    /// [`Geometry::check_structure`].
+    pub fn decode_blocks(&mut self) -> Result<(), crate::StructureError> {
+        for (t, tex) in self.textures.iter_mut().enumerate() {
+            let Some(blocks) = &tex.blocks else { continue };
+            if !tex.rgba8.is_empty() || !tex.mips.is_empty() {
+                continue;
+            }
+            blocks.check(tex.width, tex.height).map_err(|e| {
+                crate::Part::Geometry.error(format!("texture {t} {:?}: {e}", tex.name))
+            })?;
+            let mut levels =
+                (0..blocks.levels.len()).map(|k| blocks.decode_level(tex.width, tex.height, k));
+            tex.rgba8 = levels.next().unwrap_or_default();
+            tex.mips = levels.collect();
         }
         Ok(())
     }
@@ -508,6 +560,7 @@ mod tests {
             rgba8,
             srgb: true,
             mips,
+            blocks: None,
         }
     }
 

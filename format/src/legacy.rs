@@ -1,19 +1,73 @@
 //! Baked files of earlier format versions, read and migrated in memory (docs/FORMAT.md §
-//! Compatibility policy): version 5 (no clips) and version 4 (no clips, no raster profile).
+//! Compatibility policy): version 6 (no block-compressed textures), version 5 (nor clips) and
+//! version 4 (nor a raster profile).
 //! Recordings are not migrated: they are intermediate files, recorded again.
 
 use serde::Deserialize;
 
 use crate::baked::{DrawIndexedIndirectArgs, FrameWindow, MergeInfo, MergeStats};
 use crate::camera::FrameState;
-use crate::geometry::Geometry;
+use crate::geometry::{Geometry, Material, MaterialVariant, Node, Texture, Vertex};
 use crate::recording::{DeviceInfo, Edge, ProfileName, RasterProfile, RecordSettings, Robust};
 use crate::{Baked, Clip, Environment, Hash};
 
 /// The oldest baked-file version this reader migrates.
 pub const OLDEST_READABLE: u32 = 4;
 
-/// A baked file of version 4 or 5: every field of today's [`Baked`] but the clips, with the
+/// A texture of versions 4 to 6: RGBA8 levels only.
+#[derive(Deserialize)]
+struct TextureV6 {
+    name: String,
+    width: u32,
+    height: u32,
+    rgba8: Vec<u8>,
+    srgb: bool,
+    mips: Vec<Vec<u8>>,
+}
+
+/// The geometry of versions 4 to 6: today's, with [`TextureV6`].
+#[derive(Deserialize)]
+struct GeometryV6 {
+    vertices: Vec<Vertex>,
+    triangles: Vec<[u32; 3]>,
+    materials: Vec<Material>,
+    textures: Vec<TextureV6>,
+    nodes: Vec<Node>,
+    variants: Vec<MaterialVariant>,
+}
+
+impl From<GeometryV6> for Geometry {
+    fn from(g: GeometryV6) -> Geometry {
+        let textures = (g.textures.into_iter())
+            .map(|t| Texture {
+                name: t.name,
+                width: t.width,
+                height: t.height,
+                rgba8: t.rgba8,
+                srgb: t.srgb,
+                mips: t.mips,
+                blocks: None,
+            })
+            .collect();
+        Geometry {
+            vertices: g.vertices,
+            triangles: g.triangles,
+            materials: g.materials,
+            textures,
+            nodes: g.nodes,
+            variants: g.variants,
+        }
+    }
+}
+
+/// A baked file of version 6: today's [`Baked`] with [`GeometryV6`].
+#[derive(Deserialize)]
+struct BakedV6 {
+    before: BakedBefore6<RecordSettings>,
+    clips: Vec<Clip>,
+}
+
+/// A baked file of version 4 or 5: every field of version 6 but the clips, with the
 /// settings of its version.
 #[derive(Deserialize)]
 struct BakedBefore6<S> {
@@ -25,7 +79,7 @@ struct BakedBefore6<S> {
     device: DeviceInfo,
     merge: MergeInfo,
     stats: MergeStats,
-    geometry: Geometry,
+    geometry: GeometryV6,
     scene_ids: Vec<u32>,
     copies: Vec<u32>,
     draws: Vec<DrawIndexedIndirectArgs>,
@@ -140,7 +194,7 @@ impl<S: Into<RecordSettings>> BakedBefore6<S> {
             device: self.device,
             merge: self.merge,
             stats: self.stats,
-            geometry: self.geometry,
+            geometry: self.geometry.into(),
             scene_ids: self.scene_ids,
             copies: self.copies,
             draws: self.draws,
@@ -154,7 +208,7 @@ impl<S: Into<RecordSettings>> BakedBefore6<S> {
     }
 }
 
-/// Decodes the postcard payload `raw` of a baked file of format `version` (4 or 5) and
+/// Decodes the postcard payload `raw` of a baked file of format `version` (4 to 6) and
 /// migrates it; `None` for a version this reader does not migrate. The error is postcard's,
 /// or trailing bytes.
 pub(crate) fn decode_baked(version: u32, raw: &[u8]) -> Option<Result<Baked, String>> {
@@ -169,6 +223,17 @@ pub(crate) fn decode_baked(version: u32, raw: &[u8]) -> Option<Result<Baked, Str
         Ok(old.migrate())
     }
     match version {
+        6 => Some(
+            postcard::take_from_bytes::<BakedV6>(raw)
+                .map_err(|e| e.to_string())
+                .and_then(|(old, rest)| match rest.len() {
+                    0 => Ok(Baked {
+                        clips: old.clips,
+                        ..old.before.migrate()
+                    }),
+                    n => Err(format!("{n} trailing bytes")),
+                }),
+        ),
         5 => Some(take::<RecordSettings>(raw)),
         4 => Some(take::<SettingsV4>(raw)),
         _ => None,

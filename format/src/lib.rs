@@ -13,6 +13,7 @@
 #![deny(missing_docs)]
 
 pub mod baked;
+pub mod blocks;
 pub mod camera;
 pub mod clip;
 pub mod container;
@@ -26,6 +27,7 @@ pub mod recording;
 pub mod structure;
 
 pub use baked::{Baked, DrawIndexedIndirectArgs, FrameWindow, MatrixCell, MergeInfo, MergeStats};
+pub use blocks::{BlockFormat, TextureBlocks};
 pub use camera::{world_transforms, Camera, FrameState, NodePose};
 pub use clip::Clip;
 #[cfg(not(target_arch = "wasm32"))]

@@ -53,6 +53,7 @@ pub(crate) fn flat_texture(rgba: [u8; 4], size: u32, srgb: bool) -> Texture {
         rgba8: rgba.repeat((size * size) as usize),
         srgb,
         mips: Vec::new(),
+        blocks: None,
     })
 }
 

@@ -62,6 +62,7 @@ pub fn texture_with_mips(
         rgba8: level0,
         srgb,
         mips,
+        blocks: None,
     };
     (texture, dropped)
 }

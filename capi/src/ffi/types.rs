@@ -34,7 +34,7 @@ pub const TRISORT_ABI_VERSION: u32 = 6;
 /// The baked-file format version this header's library reads (`trisort_format_version()`
 /// says what the loaded library reads): a file of another version is refused with
 /// `TRISORT_STATUS_FORMAT` and a message saying to bake it again.
-pub const TRISORT_FORMAT_VERSION: u32 = 6;
+pub const TRISORT_FORMAT_VERSION: u32 = 7;
 const _: () = assert!(TRISORT_FORMAT_VERSION == trisort_format::FORMAT_VERSION);
 
 /// `TrisortRasterProfile.name`: the recorded pattern only (`--raster-profile exact`).
