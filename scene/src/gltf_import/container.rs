@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::draco::{self, DracoPrimitive};
+use super::ktx2;
 use super::meshopt::{self, Compression};
 use super::Importer;
 use crate::SceneError;
@@ -24,12 +25,55 @@ const HANDLED_EXTENSIONS: &[&str] = &[
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
     draco::EXTENSION,
+    // A texture's image in another format, preferred to its `source` (see `image_sources`).
+    ktx2::EXTENSION,
+    WEBP,
     // Each variant's material table is stored with the geometry (`Geometry::variants`).
     VARIANTS,
 ];
 
 /// The material variants extension, whose names `inspect` lists.
 const VARIANTS: &str = "KHR_materials_variants";
+
+/// WebP images (decoded by the `image` crate's pure-Rust WebP decoder).
+pub(super) const WEBP: &str = "EXT_texture_webp";
+
+/// The texture extensions that give a texture an image of their own, in order of preference.
+pub(super) const IMAGE_EXTENSIONS: [&str; 2] = [ktx2::EXTENSION, WEBP];
+
+/// Points each texture with an image extension ([`IMAGE_EXTENSIONS`]) at that extension's
+/// image: it is preferred to the texture's `source`, the fallback for viewers without the
+/// extension, which such a texture may lack (gltfpack and glTF Transform write none). The
+/// `gltf` crate then validates the index and every reader of `source` sees the image used.
+fn image_sources(root: &mut gltf::json::Root, file: &Path) -> Result<(), SceneError> {
+    for (t, texture) in root.textures.iter_mut().enumerate() {
+        let Some(others) = texture.extensions.as_ref().map(|e| &e.others) else {
+            continue;
+        };
+        let Some((name, ext)) =
+            (IMAGE_EXTENSIONS.iter()).find_map(|&name| others.get(name).map(|ext| (name, ext)))
+        else {
+            continue;
+        };
+        let source = ext.get("source");
+        match source
+            .and_then(serde_json::Value::as_u64)
+            .map(u32::try_from)
+        {
+            Some(Ok(image)) if image != u32::MAX => texture.source = gltf::json::Index::new(image),
+            _ => {
+                return Err(SceneError::Malformed {
+                    file: file.to_path_buf(),
+                    problem: format!(
+                        "texture {t}: {name} source is {}, not an image index",
+                        source.map_or_else(|| "missing".to_string(), |v| v.to_string())
+                    ),
+                })
+            }
+        }
+    }
+    Ok(())
+}
 
 /// The names of the document's material variants (`extensions.KHR_materials_variants.variants[].name`),
 /// `""` for an unnamed one (or one whose name is not a string).
@@ -144,6 +188,7 @@ pub(super) fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>, Scen
             hint: "the file requires it and trisort does not implement it".into(),
         });
     }
+    image_sources(&mut root, file)?;
     // The `gltf` crate's validation refuses required extensions it does not know itself;
     // these are handled here.
     root.extensions_required

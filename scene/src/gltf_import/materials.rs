@@ -8,8 +8,8 @@ use trisort_format::{
     AlphaMode, Material, MaterialVariant, Texture, TextureSlot, TextureTransform,
 };
 
-use super::container::read_uri;
-use super::{label, Importer};
+use super::container::{read_uri, IMAGE_EXTENSIONS};
+use super::{ktx2, label, Importer};
 use crate::mips::texture_with_mips;
 use crate::SceneError;
 
@@ -305,12 +305,19 @@ impl Importer<'_> {
             ));
             tex_coord = 0;
         }
+        // An image extension's image when the texture has one (`container::image_sources`).
         let image = r.texture.source();
         let key = (image.index(), r.srgb);
         let texture = match cache.by_image.get(&key) {
             Some(&t) => t,
             None => {
-                let texture = self.decode_image(&image, r.srgb)?;
+                let mut via = label("texture", r.texture.index(), r.texture.name());
+                if let Some(ext) =
+                    (IMAGE_EXTENSIONS.iter()).find(|&&ext| r.texture.extension_value(ext).is_some())
+                {
+                    via = format!("{via} ({ext})");
+                }
+                let texture = self.decode_image(&image, r.srgb, &via)?;
                 cache.textures.push(texture);
                 let t = (cache.textures.len() - 1) as u32;
                 cache.by_image.insert(key, t);
@@ -383,8 +390,15 @@ impl Importer<'_> {
     }
 
     /// Loads and decodes an image to RGBA8 with its mip chain, stored from its first level no
-    /// larger than [`MAX_TEXTURE_SIZE`] (noted, with the bytes).
-    fn decode_image(&mut self, image: &gltf::Image, srgb: bool) -> Result<Texture, SceneError> {
+    /// larger than [`MAX_TEXTURE_SIZE`] (noted, with the bytes): PNG, JPEG or WebP through the
+    /// `image` crate, KTX2 (`KHR_texture_basisu`, by its MIME type or identifier) through
+    /// [`ktx2::decode`], level 0 only. `via` names the texture that uses it, for errors.
+    fn decode_image(
+        &mut self,
+        image: &gltf::Image,
+        srgb: bool,
+        via: &str,
+    ) -> Result<Texture, SceneError> {
         // Read the JSON directly: `gltf::Image::source` unwraps a missing mimeType or URI.
         let json = &self.doc.as_json().images[image.index()];
         let (bytes, uri): (Cow<[u8]>, Option<&str>) = match (&json.buffer_view, &json.uri) {
@@ -419,21 +433,23 @@ impl Importer<'_> {
             .name()
             .or(uri.filter(|u| !u.starts_with("data:")))
             .map_or_else(|| format!("image {}", image.index()), str::to_string);
-        let decoded = ::image::load_from_memory(&bytes)
-            .map_err(|e| self.image_error(image, &name, format!("cannot decode: {e}")))?
-            .into_rgba8();
-        let (width, height) = (decoded.width(), decoded.height());
+        let mime = json.mime_type.as_ref().map(|m| m.0.as_str());
+        let (width, height, texels) = if mime == Some(ktx2::MIME_TYPE)
+            || bytes.starts_with(&ktx2::IDENTIFIER)
+        {
+            ktx2::decode(&bytes)
+                .map_err(|p| self.image_error(image, &name, format!("{via}: {p}")))?
+        } else {
+            let decoded = ::image::load_from_memory(&bytes)
+                .map_err(|e| self.image_error(image, &name, format!("{via}: cannot decode: {e}")))?
+                .into_rgba8();
+            (decoded.width(), decoded.height(), decoded.into_raw())
+        };
         if width == 0 || height == 0 {
-            return Err(self.image_error(image, &name, "is empty".to_string()));
+            return Err(self.image_error(image, &name, format!("{via}: is empty")));
         }
-        let (texture, dropped) = texture_with_mips(
-            name,
-            width,
-            height,
-            decoded.into_raw(),
-            srgb,
-            MAX_TEXTURE_SIZE,
-        );
+        let (texture, dropped) =
+            texture_with_mips(name, width, height, texels, srgb, MAX_TEXTURE_SIZE);
         if dropped > 0 {
             let full: u64 = (0..=Texture::mip_count(width, height) as u32)
                 .map(|k| {

@@ -33,11 +33,16 @@
 //!   maps variants per primitive; where primitives sharing a material map it differently, a
 //!   primitive gets a copy of its material in a slot of its own (appended after the default
 //!   material, in order of first use), so one table per variant says it all.
-//! - **Textures**: every image a material slot uses, decoded (PNG or JPEG) to RGBA8, once per
-//!   colour space it is used in (sRGB for base colour and emissive, linear for the others),
-//!   in order of first use by the materials (slots in the order above), with its mip chain
-//!   ([`texture_with_mips`](crate::mips::texture_with_mips)); an image wider or taller
-//!   than 1024 is stored from its first mip level that fits, with a note giving the bytes.
+//! - **Textures**: every image a material slot uses, decoded (PNG, JPEG, WebP through
+//!   `EXT_texture_webp`, KTX2 with Basis Universal ETC1S or UASTC data through
+//!   `KHR_texture_basisu`, level 0 transcoded by the pure-Rust `basisu` crate, see `ktx2.rs`)
+//!   to RGBA8, the texels as stored; a texture's extension image is preferred to its `source`
+//!   (the fallback, which it may lack). Once per colour space it is used in (sRGB for base
+//!   colour and emissive, linear for the others), in order of first use by the materials
+//!   (slots in the order above), with its mip chain
+//!   ([`texture_with_mips`](crate::mips::texture_with_mips); a KTX2 file's own levels are
+//!   not read); an image wider or taller than 1024 is stored from its first mip level that
+//!   fits, with a note giving the bytes.
 //! - **Vertex attributes**: [`Vertex::uv`](trisort_format::Vertex::uv) is `TEXCOORD_0` and
 //!   [`Vertex::uv1`](trisort_format::Vertex::uv1) `TEXCOORD_1`, each read where a texture slot
 //!   of a material the primitive may show (its own or a variant's) samples that set, zero
@@ -56,8 +61,8 @@
 //!   decoded by meshoptimizer; their fallback buffers need no data), see `meshopt.rs`, and
 //!   Draco-compressed primitives (`KHR_draco_mesh_compression`, decoded by the pure-Rust
 //!   `draco-core` when a primitive of the scene is read), see `draco.rs`. A file whose
-//!   `extensionsRequired` names any other extension than these, the transmission and the
-//!   emissive-strength one is refused with [`SceneError::UnsupportedExtension`] naming it.
+//!   `extensionsRequired` names any other extension than these, the two texture image ones,
+//!   the transmission and the emissive-strength one is refused with [`SceneError::UnsupportedExtension`] naming it.
 //!
 //! # Triangle ids
 //!
@@ -92,6 +97,7 @@ mod animations;
 mod cameras;
 mod container;
 mod draco;
+mod ktx2;
 mod materials;
 mod meshopt;
 mod nodes;
