@@ -742,3 +742,45 @@ fn webp_textures_of_car_concept_import() {
     eprintln!("webp: lowest PSNR {lowest:.1} dB");
     assert!(differs, "lossy WebP gave the PNGs' texels exactly");
 }
+
+/// A texture's `KHR_texture_basisu` / `EXT_texture_webp` source that is not an image of the
+/// file is an error naming the texture, never a panic.
+#[test]
+fn bad_texture_extension_sources_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("src.gltf");
+    for (ext, source, problem) in [
+        (
+            "KHR_texture_basisu",
+            "\"x\"",
+            "texture 0: KHR_texture_basisu source is \"x\"",
+        ),
+        (
+            "EXT_texture_webp",
+            "-1",
+            "texture 0: EXT_texture_webp source is -1",
+        ),
+        (
+            "KHR_texture_basisu",
+            "7",
+            "textures[0].source: Index out of bounds",
+        ),
+    ] {
+        let gltf = format!(
+            r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["{ext}"],"extensionsRequired":["{ext}"],
+            "scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"material":0}}]}}],
+            "materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0}}}}}}],
+            "textures":[{{"extensions":{{"{ext}":{{"source":{source}}}}}}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}}],
+            "buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}}]}}"#
+        );
+        std::fs::write(&file, gltf).unwrap();
+        let err = load(&file).unwrap_err();
+        let text = err.to_string();
+        assert!(matches!(err, SceneError::Malformed { .. }), "{text}");
+        assert!(text.contains("src.gltf"), "{text}");
+        assert!(text.contains(problem), "{problem}: {text}");
+    }
+}
