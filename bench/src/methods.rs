@@ -147,6 +147,7 @@ impl<'g> PlayerMethod<'g> {
             device: None,
             shading: trisort_gpu::Shading::Pbr,
             tone_map: trisort_gpu::ToneMap::Neutral,
+            decode_textures: false,
         };
         let player = Player::new(&gpu.device, &gpu.queue, baked, config)?;
         let order = if mode.back_to_front() {

@@ -10,6 +10,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::blocks::{BlockFormat, OPAQUE_EAC_BLOCK};
 use crate::{
     AlphaMode, Environment, FrameState, Geometry, Material, Shading, Texture, TextureSlot,
     TextureTransform, ToneMap,
@@ -365,7 +366,9 @@ pub fn chain_levels(w: u32, h: u32) -> u32 {
 /// One material texture array: its size, levels and which textures are its layers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TextureArray {
-    /// The linear array (`Rgba8Unorm`); else the sRGB one (`Rgba8UnormSrgb`).
+    /// The linear array (`Rgba8Unorm`, or the unorm block format of
+    /// [`TextureArray::block_format`]); else the sRGB one (`Rgba8UnormSrgb`, or the sRGB block
+    /// format).
     pub linear: bool,
     /// Level 0 width of every layer: the largest member's, clamped to `max_dim`.
     pub width: u32,
@@ -406,6 +409,105 @@ impl TextureArray {
         let (size, bytes) = texture_level(t, level as usize);
         Some(tiled(bytes, size, self.level_size(level)))
     }
+}
+
+impl TextureArray {
+    /// The block format every layer can be uploaded in, with no decoding: where every member
+    /// stores blocks ([`Texture::blocks`]) of one family and the array's level 0 is a whole
+    /// number of blocks (a multiple of 4 texels each way). ETC2 RGB8 members with ETC2 RGBA8
+    /// ones make an [`BlockFormat::Etc2Rgba8`] array (each RGB8 block after
+    /// [`OPAQUE_EAC_BLOCK`]). `None` for an array without members, with a member stored as
+    /// RGBA8 only, with members of two families, or smaller than a block (all members 2×2, say).
+    pub fn block_format(&self, geometry: &Geometry) -> Option<BlockFormat> {
+        if self.members.is_empty()
+            || !self.width.is_multiple_of(4)
+            || !self.height.is_multiple_of(4)
+        {
+            return None;
+        }
+        let mut format: Option<BlockFormat> = None;
+        for &i in &self.members {
+            let f = geometry.textures.get(i)?.blocks.as_ref()?.format;
+            format = Some(match format {
+                None => f,
+                Some(g) if g == f => g,
+                Some(g) if g.family() == "etc2" && f.family() == "etc2" => BlockFormat::Etc2Rgba8,
+                Some(_) => return None,
+            });
+        }
+        format
+    }
+
+    /// Level `level` of layer `layer` as uploaded in block format `format` (the array's
+    /// [`TextureArray::block_format`]): rows of blocks covering the level, top to bottom
+    /// (`ceil(w / 4)` × `ceil(h / 4)` blocks, the level's physical size), each block
+    /// `(bx, by)` the member's block `(bx mod mbw, by mod mbh)` of its own level of the same
+    /// index (`mbw` × `mbh` its blocks; its last, 1×1, level beyond its chain), ETC2 RGB8
+    /// blocks of an ETC2 RGBA8 array after [`OPAQUE_EAC_BLOCK`] ([`tiled_blocks`]).
+    ///
+    /// Decoded, these are [`TextureArray::level_bytes`] texel for texel (cropped to the
+    /// level's size): members are powers of two and levels narrower than a block are stored
+    /// tiled to fill it, so repeating blocks repeats texels. `None` when the layer or level is
+    /// out of range, or the member has no blocks that `format` holds.
+    pub fn level_blocks(
+        &self,
+        geometry: &Geometry,
+        format: BlockFormat,
+        layer: u32,
+        level: u32,
+    ) -> Option<Vec<u8>> {
+        if level >= self.levels {
+            return None;
+        }
+        let t = geometry.textures.get(*self.members.get(layer as usize)?)?;
+        let blocks = t.blocks.as_ref()?;
+        let k = (level as usize).min(blocks.levels.len().checked_sub(1)?);
+        let (mw, mh) = Texture::level_size(t.width, t.height, k as u32);
+        let member = &blocks.levels[k];
+        let widened;
+        let member: &[u8] = match (blocks.format, format) {
+            (f, g) if f == g => member,
+            (BlockFormat::Etc2Rgb8, BlockFormat::Etc2Rgba8) => {
+                widened = member
+                    .chunks_exact(8)
+                    .flat_map(|b| OPAQUE_EAC_BLOCK.iter().chain(b))
+                    .copied()
+                    .collect::<Vec<u8>>();
+                &widened
+            }
+            _ => return None,
+        };
+        let (aw, ah) = self.level_size(level);
+        Some(tiled_blocks(
+            member,
+            format.block_bytes(),
+            (mw.div_ceil(4), mh.div_ceil(4)),
+            (aw.div_ceil(4), ah.div_ceil(4)),
+        ))
+    }
+}
+
+/// Rows of `mbw` × `mbh` blocks of `block_bytes` each, repeated over `abw` × `abh` blocks from
+/// the top-left block (cropped where the member is larger): block `(bx, by)` of the result is
+/// block `(bx mod mbw, by mod mbh)` of `blocks`. [`tiled`] for block-compressed levels.
+pub fn tiled_blocks(
+    blocks: &[u8],
+    block_bytes: usize,
+    (mbw, mbh): (u32, u32),
+    (abw, abh): (u32, u32),
+) -> Vec<u8> {
+    let row = mbw as usize * block_bytes;
+    let mut data = Vec::with_capacity(abw as usize * abh as usize * block_bytes);
+    for by in 0..abh {
+        let member_row = &blocks[(by % mbh) as usize * row..][..row];
+        let mut bx = 0;
+        while bx < abw {
+            let n = (abw - bx).min(mbw);
+            data.extend_from_slice(&member_row[..n as usize * block_bytes]);
+            bx += n;
+        }
+    }
+    data
 }
 
 /// The two material texture arrays and where each texture lies in them.
@@ -617,6 +719,156 @@ mod tests {
         assert_eq!((a.srgb.width, a.srgb.levels, a.srgb.layers()), (1, 1, 1));
         assert_eq!(a.srgb.level_bytes(&g, 0, 0), Some(vec![255u8; 4]));
         assert_eq!(a.srgb.level_bytes(&g, 1, 0), None);
+    }
+
+    /// A pseudo-random generator for test blocks (xorshift).
+    struct Bits(u64);
+
+    impl Bits {
+        fn byte(&mut self) -> u8 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 24) as u8
+        }
+    }
+
+    /// A block of `format` that any decoder reads: random BC7 of every mode (the mode's bit
+    /// set in the first byte), random ETC2; where `uniform`, one colour over the block (BC7
+    /// mode 6 with every index 0; ETC2 individual mode with equal halves and indices 0), which
+    /// is how a level smaller than a block is stored tiled.
+    fn block(bits: &mut Bits, format: BlockFormat, uniform: bool) -> Vec<u8> {
+        let mut b: Vec<u8> = (0..format.block_bytes()).map(|_| bits.byte()).collect();
+        let colour = b.len() - 8;
+        match (format, uniform) {
+            (BlockFormat::Bc7, false) => {
+                let mode = b[1] % 8;
+                b[0] = (b[0] & !((2u16 << mode) - 1) as u8) | (1 << mode);
+            }
+            (BlockFormat::Bc7, true) => {
+                b[0] = (b[0] & 0x80) | 0x40;
+                // Mode 6: 7 mode bits, 56 endpoint bits, 2 p-bits, then 63 index bits.
+                b[8] &= 0x01;
+                b[9..].fill(0);
+            }
+            (_, true) => {
+                for c in &mut b[colour..colour + 3] {
+                    *c = (*c & 0xf0) | (*c >> 4);
+                }
+                let table = b[colour + 3] >> 5;
+                b[colour + 3] = table << 5 | table << 2;
+                b[colour + 4..].fill(0);
+                // An EAC alpha block's indices (ETC2 RGBA8), all 0: one alpha.
+                if colour == 8 {
+                    b[2..colour].fill(0);
+                }
+            }
+            _ => {}
+        }
+        if format == BlockFormat::Etc2Rgba8 {
+            // An EAC multiplier of 0 is not for encoders to write.
+            b[1] |= 0x10;
+        }
+        b
+    }
+
+    /// A `w` × `h` texture stored as random `format` blocks (levels under 4 texels uniform),
+    /// with its levels decoded as reading a file decodes them.
+    fn texture_of_blocks(bits: &mut Bits, format: BlockFormat, w: u32, h: u32) -> Texture {
+        let levels: Vec<Vec<u8>> = (0..chain_levels(w, h))
+            .map(|k| {
+                let (lw, lh) = Texture::level_size(w, h, k);
+                let n = lw.div_ceil(4) * lh.div_ceil(4);
+                (0..n)
+                    .flat_map(|_| block(bits, format, lw < 4 || lh < 4))
+                    .collect()
+            })
+            .collect();
+        let blocks = crate::TextureBlocks { format, levels };
+        let mut decoded = (0..blocks.levels.len()).map(|k| blocks.decode_level(w, h, k));
+        Texture {
+            name: format!("{format} {w}x{h}"),
+            width: w,
+            height: h,
+            rgba8: decoded.next().unwrap(),
+            srgb: true,
+            mips: decoded.collect(),
+            blocks: Some(blocks),
+        }
+    }
+
+    /// Every layer and level of the sRGB array of `textures` in blocks, decoded, against the
+    /// RGBA8 upload of the same layer and level.
+    fn assert_blocks_decode_to_the_rgba8_upload(textures: Vec<Texture>, want: BlockFormat) {
+        let g = Geometry {
+            textures,
+            ..Default::default()
+        };
+        let a = plan_texture_arrays(&g, 8192, false).srgb;
+        assert_eq!(a.block_format(&g), Some(want));
+        for layer in 0..a.layers() {
+            for level in 0..a.levels {
+                let (w, h) = a.level_size(level);
+                let blocks = a.level_blocks(&g, want, layer, level).unwrap();
+                assert_eq!(blocks.len(), want.level_bytes(w, h));
+                assert!(
+                    want.decode(&blocks, w, h) == a.level_bytes(&g, layer, level).unwrap(),
+                    "layer {layer} ({}) level {level} ({w}x{h})",
+                    g.textures[a.members[layer as usize]].name
+                );
+            }
+            assert_eq!(a.level_blocks(&g, want, layer, a.levels), None);
+        }
+    }
+
+    #[test]
+    fn tiled_blocks_decode_to_the_tiled_texels() {
+        let mut bits = Bits(0x9e37_79b9_7f4a_7c15);
+        // The 16×8 member sets the layer (5 levels); the others repeat over it, the 4×16 one
+        // cropped at level 0 (it is taller than the layer), the 2×2 one from one tiled block,
+        // the 4×4 one past its chain from its 1×1 level.
+        let textures = [(16, 8), (4, 4), (8, 2), (2, 2), (4, 16), (1, 1)]
+            .map(|(w, h)| texture_of_blocks(&mut bits, BlockFormat::Bc7, w, h));
+        assert_blocks_decode_to_the_rgba8_upload(textures.to_vec(), BlockFormat::Bc7);
+        // ETC2 RGB8 members join RGBA8 ones after the opaque alpha block.
+        let textures = vec![
+            texture_of_blocks(&mut bits, BlockFormat::Etc2Rgb8, 8, 8),
+            texture_of_blocks(&mut bits, BlockFormat::Etc2Rgba8, 4, 4),
+            texture_of_blocks(&mut bits, BlockFormat::Etc2Rgb8, 2, 4),
+        ];
+        assert_blocks_decode_to_the_rgba8_upload(textures.clone(), BlockFormat::Etc2Rgba8);
+        let rgb = textures
+            .into_iter()
+            .filter(|t| t.blocks.as_ref().unwrap().format == BlockFormat::Etc2Rgb8);
+        assert_blocks_decode_to_the_rgba8_upload(rgb.collect(), BlockFormat::Etc2Rgb8);
+    }
+
+    #[test]
+    fn an_array_is_uploaded_in_blocks_only_when_every_member_has_them() {
+        let mut bits = Bits(7);
+        let bc7 = |bits: &mut Bits, w, h| texture_of_blocks(bits, BlockFormat::Bc7, w, h);
+        let format = |textures: Vec<Texture>| {
+            let g = Geometry {
+                textures,
+                ..Default::default()
+            };
+            plan_texture_arrays(&g, 8192, false).srgb.block_format(&g)
+        };
+        let mut plain = bc7(&mut bits, 4, 4);
+        plain.blocks = None;
+        let etc2 = texture_of_blocks(&mut bits, BlockFormat::Etc2Rgb8, 4, 4);
+        assert_eq!(format(vec![bc7(&mut bits, 4, 4), plain]), None);
+        assert_eq!(format(vec![bc7(&mut bits, 4, 4), etc2]), None);
+        // A layer smaller than a block stays RGBA8.
+        assert_eq!(
+            format(vec![bc7(&mut bits, 2, 2), bc7(&mut bits, 1, 2)]),
+            None
+        );
+        assert_eq!(format(vec![]), None);
+        assert_eq!(
+            format(vec![bc7(&mut bits, 2, 2), bc7(&mut bits, 4, 4)]),
+            Some(BlockFormat::Bc7)
+        );
     }
 
     #[test]

@@ -42,9 +42,14 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
 }
 
-/// Features trisort uses when the adapter has them.
+/// Features trisort uses when the adapter has them. The three texture-compression features
+/// let the player sample a baked file's block-compressed textures as stored
+/// ([`crate::scene_gpu::ArrayUpload`]); without them it uploads their decoded texels.
 pub fn wanted_features() -> wgpu::Features {
     wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+        | wgpu::Features::TEXTURE_COMPRESSION_BC
+        | wgpu::Features::TEXTURE_COMPRESSION_ETC2
+        | wgpu::Features::TEXTURE_COMPRESSION_ASTC
         | wgpu::Features::SHADER_EARLY_DEPTH_TEST
         | wgpu::Features::PRIMITIVE_INDEX
         | wgpu::Features::TIMESTAMP_QUERY

@@ -4,7 +4,7 @@
 use trisort_format::{Baked, DrawIndexedIndirectArgs};
 use trisort_gpu::scene_gpu::budget::buffer_size;
 use trisort_gpu::scene_gpu::{
-    scene_budget, Bindings, BudgetConfig, GpuBytes, GpuKind, SceneBudget,
+    scene_budget, ArrayUpload, Bindings, BudgetConfig, GpuBytes, GpuKind, SceneBudget,
 };
 
 use crate::commands::{command_count, index_format};
@@ -23,6 +23,9 @@ pub struct GpuBudget {
     pub layers: [u32; 2],
     /// Level 0 size and levels of the sRGB and the linear texture array.
     pub arrays: [(u32, u32, u32); 2],
+    /// How the sRGB and the linear texture array are uploaded: RGBA8, or their members'
+    /// blocks where the device has the compression feature ([`SceneBudget::uploads`]).
+    pub texture_uploads: [ArrayUpload; 2],
     /// Bytes by kind.
     pub bytes: GpuBytes,
 }
@@ -62,13 +65,21 @@ impl GpuBudget {
             layers: scene.layers,
             arrays: [&scene.arrays.srgb, &scene.arrays.linear]
                 .map(|a| (a.width, a.height, a.levels)),
+            texture_uploads: scene.uploads.clone(),
             bytes,
         }
     }
 
     /// [`GpuBudget::new`] for a device with WebGPU's default limits on tier `bindings`
-    /// ([`BudgetConfig::portable`]): what `inspect` reports.
+    /// ([`BudgetConfig::portable`]), which samples every block format: what `inspect` reports.
     pub fn portable(baked: &Baked, bindings: Bindings) -> GpuBudget {
         GpuBudget::new(baked, BudgetConfig::portable(bindings), false)
+    }
+
+    /// [`GpuBudget::portable`] on a device without texture compression (or played with
+    /// [`crate::PlayerConfig::decode_textures`]): block-compressed textures uploaded decoded,
+    /// as RGBA8 (`inspect`'s `textures_decoded`).
+    pub fn portable_decoded(baked: &Baked, bindings: Bindings) -> GpuBudget {
+        GpuBudget::new(baked, BudgetConfig::portable(bindings).decoded(), false)
     }
 }

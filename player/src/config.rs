@@ -73,6 +73,10 @@ pub struct PlayerConfig {
     pub shading: Shading,
     /// Tone map of [`Shading::Pbr`].
     pub tone_map: ToneMap,
+    /// Upload block-compressed textures as their decoded RGBA8 texels even where the device
+    /// samples their blocks ([`crate::Player::texture_uploads`]; `play --decode-textures`):
+    /// what a device without the compression feature draws, for comparison and tests.
+    pub decode_textures: bool,
 }
 
 impl PlayerConfig {
@@ -90,6 +94,7 @@ impl PlayerConfig {
             device: None,
             shading: Shading::Pbr,
             tone_map: ToneMap::Neutral,
+            decode_textures: false,
         }
     }
 

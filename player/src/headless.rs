@@ -46,6 +46,8 @@ pub struct HeadlessConfig {
     pub shading: Shading,
     /// Tone map ([`PlayerConfig::tone_map`]).
     pub tone_map: ToneMap,
+    /// Upload block-compressed textures decoded ([`PlayerConfig::decode_textures`]).
+    pub decode_textures: bool,
 }
 
 impl HeadlessConfig {
@@ -60,6 +62,7 @@ impl HeadlessConfig {
             force_u32: false,
             shading: Shading::Pbr,
             tone_map: ToneMap::Neutral,
+            decode_textures: false,
         }
     }
 }
@@ -125,6 +128,7 @@ impl<'g> HeadlessRenderer<'g> {
             device: Some(gpu.device_info()),
             shading: config.shading,
             tone_map: config.tone_map,
+            decode_textures: config.decode_textures,
         };
         let player = if config.force_u32 {
             Player::new_u32(&gpu.device, &gpu.queue, baked, player_config)?

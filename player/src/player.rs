@@ -5,7 +5,9 @@ use std::path::Path;
 
 use trisort_format::{Baked, Clip, DrawIndexedIndirectArgs, FileKind, FrameWindow, Material};
 use trisort_gpu::scene_gpu::budget::sized_buffer;
-use trisort_gpu::scene_gpu::{Bindings, GpuBytes, GpuKind, SceneGpu, ScenePipeline, View};
+use trisort_gpu::scene_gpu::{
+    ArrayUpload, Bindings, GpuBytes, GpuKind, SceneGpu, SceneOptions, ScenePipeline, View,
+};
 
 use crate::budget::GpuBudget;
 
@@ -125,17 +127,20 @@ impl Player {
         bindings
             .check_fits(&device.limits(), &baked.geometry, baked.frame_states.len())
             .map_err(PlayerError::DeviceTooSmall)?;
-        let scene = SceneGpu::with_lighting(
+        let scene = SceneGpu::with_options(
             device,
             queue,
             &baked.geometry,
             &baked.frame_states,
             view,
-            bindings,
-            trisort_gpu::Lighting {
-                shading: config.shading,
-                tone_map: config.tone_map,
-                environment: &baked.environment,
+            SceneOptions {
+                bindings,
+                lighting: trisort_gpu::Lighting {
+                    shading: config.shading,
+                    tone_map: config.tone_map,
+                    environment: &baked.environment,
+                },
+                decode_textures: config.decode_textures,
             },
         );
         let order = if config.mode.back_to_front() {
@@ -371,6 +376,15 @@ impl Player {
     /// prefiltered environment ([`SceneGpu::texture_bytes`]).
     pub fn texture_bytes(&self) -> u64 {
         self.scene.texture_bytes()
+    }
+
+    /// How the sRGB and the linear material texture array were uploaded: in their members'
+    /// block format ([`ArrayUpload::Blocks`]) where every member is stored as blocks of one
+    /// family and the device samples it, else as RGBA8 (decoded from the file's blocks where
+    /// it has them: always with [`PlayerConfig::decode_textures`]). `play --json` prints their
+    /// [`ArrayUpload::name`]s as `texture_upload`.
+    pub fn texture_uploads(&self) -> &[ArrayUpload; 2] {
+        &self.budget.texture_uploads
     }
 
     /// The GPU memory this player was sized from: [`GpuBudget::from_scene`] for this device

@@ -241,6 +241,9 @@ pub struct PlayedPath {
     /// Every buffer and texture the player created, by kind
     /// (`trisort_player::Player::gpu_bytes_allocated`).
     pub gpu_bytes_allocated: trisort_gpu::scene_gpu::GpuBytes,
+    /// How the player uploaded its sRGB and linear texture arrays
+    /// (`trisort_player::Player::texture_uploads`).
+    pub texture_uploads: [trisort_gpu::scene_gpu::ArrayUpload; 2],
     /// Milliseconds the player took to load: creating it (every buffer, texture and the
     /// pipeline) and waiting until the GPU has its uploads.
     pub load_ms: f64,
@@ -270,6 +273,7 @@ pub fn play_frames_to(
         draw_path: player.config().draw_path.name(),
         texture_bytes: player.texture_bytes(),
         gpu_bytes_allocated: player.gpu_bytes_allocated().clone(),
+        texture_uploads: player.texture_uploads().clone(),
         load_ms,
         warnings: player.warnings().to_vec(),
     };

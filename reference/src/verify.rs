@@ -243,6 +243,7 @@ impl<'g> ImageVerifier<'g> {
                     force_u32: false,
                     shading: check.shading,
                     tone_map: check.tone_map,
+                    decode_textures: false,
                 },
             )?)
         };

@@ -33,38 +33,59 @@ pub(crate) fn gpu_bytes_json(bytes: &GpuBytes) -> serde_json::Value {
 /// `inspect BAKED`'s `gpu_bytes`: what a player allocates on a device with WebGPU's default
 /// limits, on the storage tier (the three totals) and per tier (`tiers.storage`,
 /// `tiers.textures`: by kind, the index format, the texture arrays), with what it assumes.
-fn budget_json(budgets: &[GpuBudget; 2]) -> serde_json::Value {
-    let tier = |b: &GpuBudget| {
+/// Block-compressed textures count at their stored size (a device with the compression
+/// feature); `textures_decoded` is the texture bytes of `decoded`, the same budgets on a
+/// device without it.
+fn budget_json(budgets: &[GpuBudget; 2], decoded: &[GpuBudget; 2]) -> serde_json::Value {
+    let tier = |b: &GpuBudget, d: &GpuBudget| {
         let mut v = gpu_bytes_json(&b.bytes);
+        v["textures_decoded"] = json!(d.bytes.textures());
         let array = |k: usize| {
             let (width, height, levels) = b.arrays[k];
-            json!({"width": width, "height": height, "levels": levels, "layers": b.layers[k]})
+            json!({
+                "width": width, "height": height, "levels": levels, "layers": b.layers[k],
+                "format": b.texture_uploads[k].name(),
+            })
         };
         v["index_format"] = json!(match b.index_format {
             wgpu::IndexFormat::Uint16 => "u16",
             wgpu::IndexFormat::Uint32 => "u32",
         });
-        v["texture_arrays"] = json!({"srgb": array(0), "linear": array(1), "format": "rgba8"});
+        // `format`: both arrays' where they agree (`rgba8` for a file without blocks).
+        let [srgb, linear] = b.texture_uploads.clone().map(|u| u.name());
+        let format = if srgb == linear {
+            srgb
+        } else {
+            format!("srgb {srgb}, linear {linear}")
+        };
+        v["texture_arrays"] = json!({"srgb": array(0), "linear": array(1), "format": format});
         v
     };
     let storage = &budgets[0].bytes;
     json!({
         "textures": storage.textures(),
+        // A device without the compression feature of the file's blocks decodes them to RGBA8.
+        "textures_decoded": decoded[0].bytes.textures(),
         "buffers": storage.buffers(),
         "total": storage.total(),
         "tier": "storage",
-        "tiers": {"storage": tier(&budgets[0]), "textures": tier(&budgets[1])},
+        "tiers": {
+            "storage": tier(&budgets[0], &decoded[0]),
+            "textures": tier(&budgets[1], &decoded[1]),
+        },
         "assumes": {
             "max_texture_dimension_2d": PORTABLE_MAX_TEXTURE_DIMENSION,
             "offset_alignment": PORTABLE_OFFSET_ALIGNMENT,
             "gl": false,
+            // Block-compressed textures are sampled as stored (`textures`), not decoded.
+            "texture_compression": ["bc", "etc2", "astc"],
         },
     })
 }
 
 /// The budget in `inspect`'s text: each tier's total, buffers and textures, and the textures
 /// by kind.
-fn print_budget(budgets: &[GpuBudget; 2]) {
+fn print_budget(budgets: &[GpuBudget; 2], decoded: &[GpuBudget; 2]) {
     let mb = |b: u64| match b {
         0..1_000 => format!("{b} B"),
         1_000..1_000_000 => format!("{:.1} kB", b as f64 / 1e3),
@@ -87,6 +108,15 @@ fn print_budget(budgets: &[GpuBudget; 2]) {
         .map(|(k, b)| format!("{} {}", k.name(), mb(b)))
         .collect();
     println!("    storage tier's textures: {}", kinds.join(", "));
+    let (textures, unpacked) = (budgets[0].bytes.textures(), decoded[0].bytes.textures());
+    if textures != unpacked {
+        let [srgb, linear] = budgets[0].texture_uploads.clone().map(|u| u.name());
+        println!(
+            "    texture arrays sRGB {srgb}, linear {linear}: {} ({} decoded, on a device without the compression feature)",
+            mb(textures),
+            mb(unpacked)
+        );
+    }
 }
 
 /// Arguments of `inspect`.
@@ -179,8 +209,10 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
     // The camera paths of the file (a bundle has several): DESIGN's `clips[{name, frames,
     // fps}]`, `frames` the clip's count, with where it starts in the file and in its path.
     v["clips"] = trisort_bake::figures::clips_json(&baked);
-    let budgets = [Bindings::Storage, Bindings::Textures].map(|b| GpuBudget::portable(&baked, b));
-    v["gpu_bytes"] = budget_json(&budgets);
+    let tiers = [Bindings::Storage, Bindings::Textures];
+    let budgets = tiers.map(|b| GpuBudget::portable(&baked, b));
+    let decoded = tiers.map(|b| GpuBudget::portable_decoded(&baked, b));
+    v["gpu_bytes"] = budget_json(&budgets, &decoded);
     if let Some(png) = &a.matrix {
         let m = trisort_bench::matrix::draw_matrix(&baked, png)?;
         let margin = trisort_bench::matrix::MARGIN;
@@ -196,7 +228,7 @@ fn inspect_baked(a: &InspectArgs, path: &Path) -> Result<ExitCode> {
     } else {
         println!("{}: baked file, {} frames", a.file, baked.frames.len());
         print_clips(&baked.clips);
-        print_budget(&budgets);
+        print_budget(&budgets, &decoded);
         println!("{}", serde_json::to_string_pretty(&v)?);
     }
     Ok(ExitCode::SUCCESS)

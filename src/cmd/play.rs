@@ -88,6 +88,12 @@ pub struct PlayArgs {
     /// it such a device gets a warning naming what differs; `--json` has `profile_check`.
     #[arg(long)]
     strict_profile: bool,
+    /// Upload block-compressed textures (a file baked with `--textures etc2|astc|bc7`) as
+    /// their decoded RGBA8 texels even where the device samples the blocks: what a device
+    /// without the compression feature draws, and allocates, for comparison. `--json`'s
+    /// `texture_upload` says how each texture array was uploaded.
+    #[arg(long)]
+    decode_textures: bool,
     #[command(flatten)]
     shading: ShadingArgs,
     #[command(flatten)]
@@ -279,6 +285,9 @@ fn run_window(a: &PlayArgs) -> Result<ExitCode> {
             "--subpixel-offset and --self-check apply to headless playback, not --window"
         );
     }
+    if a.decode_textures {
+        anyhow::bail!("--decode-textures applies to headless playback, not --window");
+    }
     super::window::run(super::window::WindowArgs {
         baked: &a.baked,
         frames: a.frames,
@@ -303,6 +312,7 @@ fn headless_config(a: &PlayArgs, baked: &Baked) -> HeadlessConfig {
     config.glass_opacity = a.glass_opacity;
     config.shading = a.shading.shading;
     config.tone_map = a.shading.tonemap;
+    config.decode_textures = a.decode_textures;
     if let Some(s) = a.size {
         config.size = s;
     }
@@ -380,6 +390,13 @@ fn print_play_json(
         // What the player created, counted where it was created (`inspect`'s `gpu_bytes`
         // budgets it).
         "gpu_bytes_allocated": super::inspect::gpu_bytes_json(&p.path.gpu_bytes_allocated),
+        // How each material texture array was uploaded: `bc7`, `etc2-rgb8`, `etc2-rgba8`,
+        // `astc-4x4` (the file's blocks, sampled by the device), `rgba8`, or `rgba8 (decoded
+        // from etc2)` (without the device's compression feature, or with --decode-textures).
+        "texture_upload": {
+            "srgb": p.path.texture_uploads[0].name(),
+            "linear": p.path.texture_uploads[1].name(),
+        },
         // Creating the player and waiting for its uploads, in milliseconds.
         "load_ms": p.path.load_ms,
         "variant": a.variant,
@@ -420,10 +437,12 @@ fn print_play_text(a: &PlayArgs, p: &Played<'_>) {
     );
     let allocated = &p.path.gpu_bytes_allocated;
     println!(
-        "GPU memory allocated: {} bytes (buffers {}, textures {})",
+        "GPU memory allocated: {} bytes (buffers {}, textures {}; texture arrays sRGB {}, linear {})",
         allocated.total(),
         allocated.buffers(),
-        allocated.textures()
+        allocated.textures(),
+        p.path.texture_uploads[0].name(),
+        p.path.texture_uploads[1].name()
     );
     if let Some(d) = &a.out_dir {
         println!("wrote {}", d.display());

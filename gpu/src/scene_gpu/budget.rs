@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 use trisort_format::gpu_layout::{
     environment_levels, node_count, plan_texture_arrays, TextureArray, TextureArrays, DATA_WIDTH,
 };
-use trisort_format::{Environment, Geometry, Material, Vertex};
+use trisort_format::{BlockFormat, Environment, Geometry, Material, Vertex};
 
 use super::bindings::Bindings;
 use super::materials::MaterialGpu;
@@ -226,6 +226,104 @@ pub fn sized_buffer(
     buffer
 }
 
+/// The device features that sample block-compressed textures: BC, ETC2 and ASTC (LDR).
+pub const TEXTURE_COMPRESSION: wgpu::Features = wgpu::Features::TEXTURE_COMPRESSION_BC
+    .union(wgpu::Features::TEXTURE_COMPRESSION_ETC2)
+    .union(wgpu::Features::TEXTURE_COMPRESSION_ASTC);
+
+/// The device feature that samples `format`.
+pub fn compression_feature(format: BlockFormat) -> wgpu::Features {
+    match format {
+        BlockFormat::Bc7 => wgpu::Features::TEXTURE_COMPRESSION_BC,
+        BlockFormat::Etc2Rgb8 | BlockFormat::Etc2Rgba8 => wgpu::Features::TEXTURE_COMPRESSION_ETC2,
+        BlockFormat::Astc4x4 => wgpu::Features::TEXTURE_COMPRESSION_ASTC,
+    }
+}
+
+/// How a material texture array is uploaded: in its members' block format, or as RGBA8
+/// texels (decoded from the file's blocks where its members have them).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ArrayUpload {
+    /// RGBA8 texels (`Rgba8UnormSrgb` or `Rgba8Unorm`): the file's, or, for members stored
+    /// as blocks, those blocks decoded (as reading the file decodes them).
+    Rgba8 {
+        /// The block families (`bc7`, `etc2`, `astc`) of the members stored as blocks,
+        /// sorted; empty where no member is.
+        decoded_from: Vec<&'static str>,
+    },
+    /// Every member's blocks in this format ([`TextureArray::level_blocks`]).
+    Blocks(BlockFormat),
+}
+
+impl ArrayUpload {
+    /// How `array` of `geometry` is uploaded on a device with the compression features of
+    /// `features`: in [`TextureArray::block_format`] where the device has its feature
+    /// ([`compression_feature`]), else RGBA8.
+    pub fn choose(geometry: &Geometry, array: &TextureArray, features: wgpu::Features) -> Self {
+        match array.block_format(geometry) {
+            Some(f) if features.contains(compression_feature(f)) => ArrayUpload::Blocks(f),
+            _ => {
+                let mut decoded_from: Vec<&'static str> = (array.members.iter())
+                    .filter_map(|&i| geometry.textures.get(i)?.blocks.as_ref())
+                    .map(|b| b.format.family())
+                    .collect();
+                decoded_from.sort_unstable();
+                decoded_from.dedup();
+                ArrayUpload::Rgba8 { decoded_from }
+            }
+        }
+    }
+
+    /// The texture format of the array: sRGB or `linear`, RGBA8 or the block format.
+    pub fn texture_format(&self, linear: bool) -> wgpu::TextureFormat {
+        use wgpu::{AstcBlock, AstcChannel, TextureFormat as F};
+        let Self::Blocks(format) = self else {
+            return if linear {
+                F::Rgba8Unorm
+            } else {
+                F::Rgba8UnormSrgb
+            };
+        };
+        match (format, linear) {
+            (BlockFormat::Etc2Rgb8, true) => F::Etc2Rgb8Unorm,
+            (BlockFormat::Etc2Rgb8, false) => F::Etc2Rgb8UnormSrgb,
+            (BlockFormat::Etc2Rgba8, true) => F::Etc2Rgba8Unorm,
+            (BlockFormat::Etc2Rgba8, false) => F::Etc2Rgba8UnormSrgb,
+            (BlockFormat::Astc4x4, _) => F::Astc {
+                block: AstcBlock::B4x4,
+                channel: if linear {
+                    AstcChannel::Unorm
+                } else {
+                    AstcChannel::UnormSrgb
+                },
+            },
+            (BlockFormat::Bc7, true) => F::Bc7RgbaUnorm,
+            (BlockFormat::Bc7, false) => F::Bc7RgbaUnormSrgb,
+        }
+    }
+
+    /// Bytes of a `w` × `h` level: whole blocks, or 4 a texel.
+    pub fn level_bytes(&self, w: u32, h: u32) -> u64 {
+        match self {
+            Self::Blocks(format) => format.level_bytes(w, h) as u64,
+            Self::Rgba8 { .. } => w as u64 * h as u64 * 4,
+        }
+    }
+
+    /// What reports print (`play --json`'s `texture_upload`): the block format (`bc7`,
+    /// `etc2-rgb8`, `etc2-rgba8`, `astc-4x4`), `rgba8`, or `rgba8 (decoded from etc2)` where
+    /// members stored as blocks were decoded.
+    pub fn name(&self) -> String {
+        match self {
+            Self::Blocks(format) => format.to_string(),
+            Self::Rgba8 { decoded_from } if decoded_from.is_empty() => "rgba8".to_string(),
+            Self::Rgba8 { decoded_from } => {
+                format!("rgba8 (decoded from {})", decoded_from.join(", "))
+            }
+        }
+    }
+}
+
 /// What decides a scene's GPU sizes besides the file: the binding tier and the device's limits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BudgetConfig {
@@ -245,13 +343,20 @@ pub struct BudgetConfig {
     pub min_array_layers: u32,
     /// A visibility-only upload ([`SceneGpu::for_visibility`](super::SceneGpu::for_visibility)).
     pub visibility_only: bool,
+    /// The texture-compression features ([`TEXTURE_COMPRESSION`]) the device has and the
+    /// upload may use: an array whose members are all stored as blocks the device samples is
+    /// uploaded as those blocks ([`ArrayUpload::choose`]). Empty: every texture as RGBA8,
+    /// block-compressed ones decoded (`play --decode-textures`).
+    pub texture_compression: wgpu::Features,
 }
 
 impl BudgetConfig {
     /// A device with WebGPU's default limits ([`PORTABLE_MAX_TEXTURE_DIMENSION`],
-    /// [`PORTABLE_OFFSET_ALIGNMENT`]), not on GL: what `inspect` reports. Any device whose
-    /// largest texture is at least every texture of the file, and that is not GL, allocates
-    /// exactly this.
+    /// [`PORTABLE_OFFSET_ALIGNMENT`]), not on GL, that samples every block format
+    /// ([`TEXTURE_COMPRESSION`]): what `inspect` reports. Any device whose largest texture is
+    /// at least every texture of the file, that is not GL and that has the compression
+    /// feature of the file's blocks, allocates exactly this (without the feature:
+    /// [`BudgetConfig::decoded`]).
     pub fn portable(bindings: Bindings) -> BudgetConfig {
         BudgetConfig {
             bindings,
@@ -260,10 +365,21 @@ impl BudgetConfig {
             storage_alignment: PORTABLE_OFFSET_ALIGNMENT,
             min_array_layers: 1,
             visibility_only: false,
+            texture_compression: TEXTURE_COMPRESSION,
         }
     }
 
-    /// The figures of `device` (its limits and backend) on tier `bindings`.
+    /// This configuration with every block-compressed texture uploaded decoded, as RGBA8 (a
+    /// device without the compression features, or `play --decode-textures`).
+    pub fn decoded(self) -> BudgetConfig {
+        BudgetConfig {
+            texture_compression: wgpu::Features::empty(),
+            ..self
+        }
+    }
+
+    /// The figures of `device` (its limits, backend and texture-compression features) on
+    /// tier `bindings`.
     pub fn for_device(device: &wgpu::Device, bindings: Bindings) -> BudgetConfig {
         let limits = device.limits();
         let gl = device.adapter_info().backend == wgpu::Backend::Gl;
@@ -276,6 +392,7 @@ impl BudgetConfig {
                 .max(limits.min_storage_buffer_offset_alignment as u64),
             min_array_layers: if gl { 2 } else { 1 },
             visibility_only: false,
+            texture_compression: device.features() & TEXTURE_COMPRESSION,
         }
     }
 }
@@ -298,6 +415,9 @@ pub struct SceneBudget {
     /// What each layer of the sRGB and the linear array holds ([`layer_kinds`]; layers past
     /// the list: [`GpuKind::UnusedLayers`]).
     pub layer_kinds: [Vec<GpuKind>; 2],
+    /// How the sRGB and the linear array are uploaded ([`ArrayUpload::choose`] with
+    /// [`BudgetConfig::texture_compression`]).
+    pub uploads: [ArrayUpload; 2],
     /// Level sizes of the environment texture.
     pub environment_levels: Vec<(u32, u32)>,
     /// Bytes by kind of everything the scene creates.
@@ -347,13 +467,19 @@ pub fn texture_kind(materials: &[Material], t: usize) -> GpuKind {
     }
 }
 
-/// Bytes of an RGBA8 array of `array`'s size and levels with `layers` layers, by layer kind
-/// (layers past `kinds`: [`GpuKind::UnusedLayers`]).
-fn add_array(bytes: &mut GpuBytes, array: &TextureArray, layers: u32, kinds: &[GpuKind]) {
+/// Bytes of an array of `array`'s size and levels with `layers` layers uploaded as `upload`
+/// says, by layer kind (layers past `kinds`: [`GpuKind::UnusedLayers`]).
+fn add_array(
+    bytes: &mut GpuBytes,
+    array: &TextureArray,
+    upload: &ArrayUpload,
+    layers: u32,
+    kinds: &[GpuKind],
+) {
     let per_layer: u64 = (0..array.levels)
         .map(|k| {
             let (w, h) = array.level_size(k);
-            w as u64 * h as u64 * 4
+            upload.level_bytes(w, h)
         })
         .sum();
     for l in 0..layers as usize {
@@ -426,9 +552,11 @@ pub fn scene_budget(
         layer_kinds(&arrays.srgb, &materials),
         layer_kinds(&arrays.linear, &materials),
     ];
+    let uploads = [&arrays.srgb, &arrays.linear]
+        .map(|a| ArrayUpload::choose(geometry, a, config.texture_compression));
     for (k, array) in [&arrays.srgb, &arrays.linear].into_iter().enumerate() {
         layers[k] = array.layers().max(config.min_array_layers);
-        add_array(&mut bytes, array, layers[k], &layer_kinds[k]);
+        add_array(&mut bytes, array, &uploads[k], layers[k], &layer_kinds[k]);
     }
     let environment_levels: Vec<(u32, u32)> =
         environment_levels(environment, config.max_texture_dimension)
@@ -447,6 +575,7 @@ pub fn scene_budget(
         arrays,
         layers,
         layer_kinds,
+        uploads,
         environment_levels,
         bytes,
     }

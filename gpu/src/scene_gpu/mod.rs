@@ -19,7 +19,7 @@ mod uniforms;
 
 pub use bindings::{bind_group_layout, bind_group_layout_for, Bindings, DATA_WIDTH};
 pub(crate) use bindings::{sized_buffer_entry, surface_entries, MaterialStore, SharedBindings};
-pub use budget::{scene_budget, BudgetConfig, GpuBytes, GpuKind, SceneBudget};
+pub use budget::{scene_budget, ArrayUpload, BudgetConfig, GpuBytes, GpuKind, SceneBudget};
 pub use materials::MaterialGpu;
 pub use peel::{begin_peel_pass, previous_key_entries};
 pub use pipeline::{vertex_layout, ScenePipeline, VERTEX_ATTRIBUTES};
@@ -51,6 +51,21 @@ struct Upload<'a> {
     /// Only what decides visibility is read ([`SceneGpu::for_visibility`]): the linear texture
     /// array can stay one white texel.
     visibility_only: bool,
+    /// [`SceneOptions::decode_textures`].
+    decode_textures: bool,
+}
+
+/// How [`SceneGpu::with_options`] uploads a scene besides its geometry, frames and view.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneOptions<'a> {
+    /// How node matrices and materials are bound.
+    pub bindings: Bindings,
+    /// The light.
+    pub lighting: Lighting<'a>,
+    /// Upload block-compressed textures decoded, as RGBA8, even where the device samples
+    /// their blocks (`play --decode-textures`): what a device without the compression
+    /// feature draws, for comparison.
+    pub decode_textures: bool,
 }
 
 /// Scene resources on the GPU.
@@ -148,6 +163,7 @@ impl SceneGpu {
             bindings: Bindings::Storage,
             lighting: Lighting::default(),
             visibility_only: true,
+            decode_textures: false,
         };
         SceneGpu::upload(device, queue, upload)
     }
@@ -163,13 +179,36 @@ impl SceneGpu {
         bindings: Bindings,
         lighting: Lighting<'_>,
     ) -> SceneGpu {
+        let options = SceneOptions {
+            bindings,
+            lighting,
+            decode_textures: false,
+        };
+        SceneGpu::with_options(device, queue, geometry, frames, view, options)
+    }
+
+    /// [`SceneGpu::with_lighting`] with every option of `options`. Each material texture array
+    /// is uploaded in its members' block format where every member is stored as blocks of one
+    /// family and the device has that format's compression feature, unless
+    /// [`SceneOptions::decode_textures`]; else as RGBA8 texels, decoded from the blocks
+    /// ([`SceneBudget::uploads`] says which). The two sample alike: a conforming device decodes
+    /// ETC2 and BC7 blocks to the texels the file's decoder gives.
+    pub fn with_options(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        view: View,
+        options: SceneOptions<'_>,
+    ) -> SceneGpu {
         let upload = Upload {
             geometry,
             frames,
             view,
-            bindings,
-            lighting,
+            bindings: options.bindings,
+            lighting: options.lighting,
             visibility_only: false,
+            decode_textures: options.decode_textures,
         };
         SceneGpu::upload(device, queue, upload)
     }
@@ -184,9 +223,13 @@ impl SceneGpu {
             bindings,
             lighting,
             visibility_only,
+            decode_textures,
         } = upload;
         let mut config = BudgetConfig::for_device(device, bindings);
         config.visibility_only = visibility_only;
+        if decode_textures {
+            config = config.decoded();
+        }
         let budget = scene_budget(geometry, frames.len(), lighting.environment, config);
         let mut allocated = GpuBytes::default();
         let vertex_bytes: &[u8] = bytemuck::cast_slice(&geometry.vertices);

@@ -6,7 +6,7 @@ use trisort_format::Geometry;
 use trisort_format::gpu_layout::TextureArray;
 pub(crate) use trisort_format::gpu_layout::TexturePlace;
 
-use super::budget::{GpuBytes, SceneBudget};
+use super::budget::{texture_allocation_bytes, ArrayUpload, GpuBytes, SceneBudget};
 
 /// The two material texture arrays.
 pub(super) struct Textures {
@@ -18,8 +18,9 @@ pub(super) struct Textures {
     pub(super) bytes: u64,
 }
 
-/// Uploads the material textures into two arrays, sRGB (`Rgba8UnormSrgb`) and linear
-/// (`Rgba8Unorm`), as the budget's plan ([`plan_texture_arrays`](trisort_format::gpu_layout::plan_texture_arrays), in [`SceneBudget::arrays`])
+/// Uploads the material textures into two arrays, sRGB and linear, each in the format of
+/// [`SceneBudget::uploads`] (`Rgba8UnormSrgb` and `Rgba8Unorm`, or the members' blocks), as
+/// the budget's plan ([`plan_texture_arrays`](trisort_format::gpu_layout::plan_texture_arrays), in [`SceneBudget::arrays`])
 /// lays them out (each texture in the array of its colour space, layers as large as the
 /// array's largest texture clamped to the device's limit, full mip chains, smaller textures
 /// repeated from the top-left corner), with [`SceneBudget::layers`] layers each. An empty
@@ -34,8 +35,22 @@ pub(super) fn upload_textures(
     allocated: &mut GpuBytes,
 ) -> Textures {
     let plan = &budget.arrays;
-    let srgb = upload_array(device, queue, geometry, &plan.srgb, budget.layers[0]);
-    let linear = upload_array(device, queue, geometry, &plan.linear, budget.layers[1]);
+    let srgb = upload_array(
+        device,
+        queue,
+        geometry,
+        &plan.srgb,
+        &budget.uploads[0],
+        budget.layers[0],
+    );
+    let linear = upload_array(
+        device,
+        queue,
+        geometry,
+        &plan.linear,
+        &budget.uploads[1],
+        budget.layers[1],
+    );
     allocated.count_texture_layers(&srgb.0, &budget.layer_kinds[0]);
     allocated.count_texture_layers(&linear.0, &budget.layer_kinds[1]);
     Textures {
@@ -47,12 +62,17 @@ pub(super) fn upload_textures(
 }
 
 /// One array of [`upload_textures`], as [`plan_texture_arrays`](trisort_format::gpu_layout::plan_texture_arrays) planned it, with `layers`
-/// layers; returns the texture, its view and its bytes.
+/// layers, in the format `upload` says; returns the texture, its view and its bytes.
+///
+/// In a block format every level is written at its physical size, whole blocks (a level of
+/// 2×2 texels as its one 4×4 block), rows of blocks as
+/// [`TextureArray::level_blocks`] gives them.
 fn upload_array(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     geometry: &Geometry,
     array: &TextureArray,
+    upload: &ArrayUpload,
     layers: u32,
 ) -> (wgpu::Texture, wgpu::TextureView, u64) {
     let (tw, th, levels, linear) = (array.width, array.height, array.levels, array.linear);
@@ -75,15 +95,17 @@ fn upload_array(
         mip_level_count: levels,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: if linear {
-            wgpu::TextureFormat::Rgba8Unorm
-        } else {
-            wgpu::TextureFormat::Rgba8UnormSrgb
-        },
+        format: upload.texture_format(linear),
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
+    // A level of `w` × `h` blocks of `block_bytes` (1×1 texel blocks of 4 bytes for RGBA8).
+    let (block, block_bytes) = match upload {
+        ArrayUpload::Blocks(f) => (4, f.block_bytes() as u32),
+        ArrayUpload::Rgba8 { .. } => (1, 4),
+    };
     let write = |level: u32, layer: u32, w: u32, h: u32, data: &[u8]| {
+        let (bw, bh) = (w.div_ceil(block), h.div_ceil(block));
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &texture,
@@ -98,12 +120,12 @@ fn upload_array(
             data,
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
-                bytes_per_row: Some(w * 4),
-                rows_per_image: Some(h),
+                bytes_per_row: Some(bw * block_bytes),
+                rows_per_image: Some(bh),
             },
             wgpu::Extent3d {
-                width: w,
-                height: h,
+                width: bw * block,
+                height: bh * block,
                 depth_or_array_layers: 1,
             },
         );
@@ -111,10 +133,11 @@ fn upload_array(
     for layer in 0..array.members.len() as u32 {
         for k in 0..levels {
             let (aw, ah) = array.level_size(k);
-            let data = array
-                .level_bytes(geometry, layer, k)
-                .expect("a planned layer and level");
-            write(k, layer, aw, ah, &data);
+            let data = match upload {
+                ArrayUpload::Blocks(f) => array.level_blocks(geometry, *f, layer, k),
+                ArrayUpload::Rgba8 { .. } => array.level_bytes(geometry, layer, k),
+            };
+            write(k, layer, aw, ah, &data.expect("a planned layer and level"));
         }
     }
     if array.members.is_empty() {
@@ -124,9 +147,6 @@ fn upload_array(
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
     });
-    let bytes = (0..levels)
-        .map(|k| ((tw >> k).max(1) as u64) * ((th >> k).max(1) as u64) * 4)
-        .sum::<u64>()
-        * layers as u64;
+    let bytes = texture_allocation_bytes(&texture);
     (texture, view, bytes)
 }
