@@ -100,7 +100,7 @@ fn files_of_the_two_previous_versions_play_verify_and_upgrade_unchanged() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains(
-            "format3.baked: format version 3 is not supported (this trisort reads versions 4 to 6)"
+            "format3.baked: format version 3 is not supported (this trisort reads versions 4 to 7)"
         ),
         "{err}"
     );

@@ -194,8 +194,42 @@ impl Scene {
 }
 
 /// The hash behind [`Scene::hash`]: BLAKE3 of the geometry's postcard encoding.
+///
+/// The bytes are the geometry's postcard encoding as format 6 laid it out, textures without
+/// their `blocks` (format 7's block-compressed levels, which a scene never has: they are a
+/// baked file's way of storing its texels), so the hash of a scene is the one files baked
+/// before format 7 hold.
 fn geometry_hash(geometry: &Geometry) -> trisort_format::Hash {
-    let bytes = postcard::to_stdvec(geometry).expect("geometry serializes");
+    /// A texture's fields before format 7.
+    #[derive(serde::Serialize)]
+    struct TextureBytes<'a> {
+        name: &'a str,
+        width: u32,
+        height: u32,
+        rgba8: &'a [u8],
+        srgb: bool,
+        mips: &'a [Vec<u8>],
+    }
+    let g = geometry;
+    let textures: Vec<TextureBytes> = (g.textures.iter())
+        .map(|t| TextureBytes {
+            name: &t.name,
+            width: t.width,
+            height: t.height,
+            rgba8: &t.rgba8,
+            srgb: t.srgb,
+            mips: &t.mips,
+        })
+        .collect();
+    let fields = (
+        &g.vertices,
+        &g.triangles,
+        &g.materials,
+        &textures,
+        &g.nodes,
+        &g.variants,
+    );
+    let bytes = postcard::to_stdvec(&fields).expect("geometry serializes");
     trisort_format::hash_bytes(&bytes)
 }
 
