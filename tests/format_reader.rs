@@ -71,7 +71,7 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
     }
     assert_eq!(ours["stats_index_triangles"], inspect["index_triangles"]);
     assert_eq!(ours["triangles"], ours["unique_visible"]);
-    assert_eq!(ours["format_version"], 6);
+    assert_eq!(ours["format_version"], 7);
     // Version 5: the raster profile, as inspect reports it.
     let profile = &inspect["raster_profile"];
     assert_eq!(ours["raster_profile"]["name"], profile["name"]);
@@ -122,7 +122,11 @@ fn the_independent_reader_parses_a_fresh_bake_and_agrees_with_inspect() {
 fn the_independent_reader_reads_the_older_versions_in_tests_data() {
     let Some(python) = python() else { return };
     let dir = tempfile::tempdir().unwrap();
-    for (file, version) in [("format4.baked", 4), ("format5.baked", 5)] {
+    for (file, version) in [
+        ("format4.baked", 4),
+        ("format5.baked", 5),
+        ("format6.baked", 6),
+    ] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("tests/data")
             .join(file);
@@ -212,4 +216,41 @@ fn the_independent_reader_parses_an_order_file() {
     for key in ["frames", "ranges", "triangles", "split"] {
         assert_eq!(ours[key], v[key], "{key}");
     }
+}
+
+/// Version 7's block-compressed textures (`--textures`): the reader parses their blocks and
+/// checks every level's length; a file whose level is cut short is refused.
+#[test]
+fn the_independent_reader_parses_block_compressed_textures() {
+    let Some(python) = python() else { return };
+    let Some(dir) = gpu_tempdir() else { return };
+    let d = dir.path();
+    for format in ["etc2", "bc7"] {
+        let bake = format!(
+            "bake demo:400 --path orbit:frames=2,degrees=30 --size 32x32 --textures {format} \
+             -o {format}.baked"
+        );
+        run(d, &args(&bake), true);
+        let ours = read(python, &d.join(format!("{format}.baked")));
+        assert_eq!(ours["format_version"], 7, "{ours}");
+    }
+    // A level one block short, in a correct container: the reader's own length check.
+    let mut baked: trisort_format::Baked =
+        trisort_format::read_file(trisort_format::FileKind::Baked, &d.join("bc7.baked")).unwrap();
+    let blocks = baked.geometry.textures[0].blocks.as_mut().unwrap();
+    let level = &mut blocks.levels[0];
+    level.truncate(level.len() - 16);
+    let bytes = trisort_format::container::encode(trisort_format::FileKind::Baked, &baked);
+    std::fs::write(d.join("short.baked"), bytes).unwrap();
+    let out = run_reader(python, &d.join("short.baked"));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("block level 0"), "{err}");
+    // trisort refuses it too, naming the texture and the level.
+    let out = run(d, &["inspect", "short.baked"], false);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("short.baked") && err.contains("bc7 level 0"),
+        "{err}"
+    );
 }

@@ -25,6 +25,7 @@ mod merge_car;
 mod record_cli;
 mod self_check_cli;
 mod shard_cli;
+mod texture_upload_cli;
 mod variants_cli;
 mod verify_cli;
 mod verify_forged;

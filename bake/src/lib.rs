@@ -19,6 +19,7 @@ mod record;
 pub mod shard;
 mod source;
 pub mod spec;
+pub mod textures;
 
 pub use error::BakeError;
 pub use pipeline::{bake, finished_recording, merge_to_file, recording_path, Baking};
@@ -50,6 +51,8 @@ pub struct Settings {
     pub merge: MergeOptions,
     /// The light stored in the baked file.
     pub light: Light,
+    /// How the baked file stores its textures (`--textures`; RGBA8 by default).
+    pub textures: textures::TextureFormat,
 }
 
 impl Settings {
@@ -64,6 +67,7 @@ impl Settings {
             frames: None,
             merge: MergeOptions::default(),
             light: Light::Studio,
+            textures: textures::TextureFormat::Rgba8,
         }
     }
 }

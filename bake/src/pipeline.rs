@@ -7,6 +7,7 @@ use trisort_format::{Baked, Environment, FileKind, Phase, Recording};
 use trisort_gpu::Gpu;
 use trisort_merger::MergeOptions;
 
+use crate::textures::{TextureFormat, TextureReport};
 use crate::{record_to_file, BakeError, Events, RecordTarget, Settings, Working};
 
 /// Where a bake keeps the recording of `output`: `OUTPUT.rec` beside it (verify reads it).
@@ -46,21 +47,24 @@ pub fn finished_recording(
 }
 
 /// Merges `recordings` (read from `files`, which errors name), lights the result with
-/// `environment` and writes it to `output` atomically.
+/// `environment`, stores its textures as `textures` asks ([`crate::textures::compress`]) and
+/// writes it to `output` atomically.
 pub fn merge_to_file(
     recordings: &[Recording],
     files: &[String],
     opts: &MergeOptions,
     environment: Environment,
+    textures: TextureFormat,
     output: &Path,
-) -> Result<Baked, BakeError> {
+) -> Result<(Baked, TextureReport), BakeError> {
     let merged = trisort_merger::merge(recordings, opts).map_err(|error| BakeError::Merge {
         error,
         files: files.to_vec(),
     })?;
-    let baked = merged.lit(environment);
+    let mut baked = merged.lit(environment);
+    let report = crate::textures::compress(&mut baked.geometry, textures);
     trisort_format::write_file_atomic(FileKind::Baked, output, &baked)?;
-    Ok(baked)
+    Ok((baked, report))
 }
 
 /// A finished bake: the recording, the baked file and what each step took.
@@ -71,8 +75,10 @@ pub struct Baking {
     pub baked: Baked,
     /// Seconds recording took (reading the finished recording back, when reused).
     pub record_seconds: f64,
-    /// Seconds merging and writing took.
+    /// Seconds merging and writing took (compressing the textures included).
     pub merge_seconds: f64,
+    /// What became of the textures (`--textures`).
+    pub textures: TextureReport,
     /// Whether the recording was this bake's finished one, found beside the output
     /// ([`finished_recording`]): a bake killed while merging merges only when run again.
     pub recording_reused: bool,
@@ -118,12 +124,20 @@ pub fn bake(
     let t1 = Instant::now();
     let files = [rec_path.display().to_string()];
     let recordings = std::slice::from_ref(&recording);
-    let baked = merge_to_file(recordings, &files, &settings.merge, environment, output)?;
+    let (baked, textures) = merge_to_file(
+        recordings,
+        &files,
+        &settings.merge,
+        environment,
+        settings.textures,
+        output,
+    )?;
     Ok(Baking {
         recording,
         baked,
         record_seconds,
         merge_seconds: t1.elapsed().as_secs_f64(),
+        textures,
         recording_reused,
     })
 }

@@ -53,6 +53,7 @@ fn settings(
         frames: record.frames,
         merge: merge.options(),
         light: merge.light(),
+        textures: merge.textures,
     })
 }
 
@@ -83,6 +84,7 @@ pub fn run(a: BakeArgs) -> Result<ExitCode> {
         v["recording_reused"] = done.recording_reused.into();
         v["merge_seconds"] = merge_s.into();
         v["clips"] = clips_json(baked);
+        v["textures"] = done.textures.to_json();
         v["seconds"] = (record_s + merge_s).into();
         print_json(&v);
     } else {
@@ -99,6 +101,9 @@ pub fn run(a: BakeArgs) -> Result<ExitCode> {
             rec.scene_triangles
         );
         println!("{}", merge_summary(baked, merge_s));
+        if done.textures.format != trisort_bake::textures::TextureFormat::Rgba8 {
+            println!("{}", done.textures.summary());
+        }
         if baked.clips.len() > 1 || baked.clips[0].path_first > 0 {
             for c in &baked.clips {
                 let rate = c.fps.map(|f| format!(" at {f} fps")).unwrap_or_default();

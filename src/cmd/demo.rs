@@ -73,6 +73,7 @@ pub fn run(a: DemoArgs) -> Result<ExitCode> {
         record_seconds: record_s,
         merge_seconds: merge_s,
         recording_reused: reused,
+        textures: _,
     } = done;
     let report = trisort_verify::check_graph(std::slice::from_ref(&rec), &baked);
     let frames_dir = a.out_dir.join("frames");

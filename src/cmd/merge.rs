@@ -9,6 +9,7 @@ use trisort_format::{Bridge, Choice, FileKind, Layout, Seeding, Strategy};
 use trisort_merger::MergeOptions;
 
 use trisort_bake::inputs::{check_compatible, read_recordings};
+use trisort_bake::textures::TextureFormat;
 
 use crate::common::{choice_parser, option_parser, print_json};
 
@@ -46,6 +47,20 @@ pub struct MergeOpts {
     /// file named `studio`: `./studio`).
     #[arg(long, value_name = "studio|FILE.hdr", default_value = STUDIO)]
     pub environment: String,
+    /// How the baked file stores its textures: `rgba8` (uncompressed), `etc2` (OpenGL ES 3 and
+    /// mobile Vulkan GPUs), `astc` (4×4; needs a trisort built with `--features astc`) or
+    /// `bc7` (desktop GPUs). A player uploads the blocks where its device samples them and
+    /// decodes them elsewhere; a texture whose alpha decides visibility is compressed only if
+    /// its alpha stays exact, and one whose size is not a power of two stays RGBA8
+    /// (`--json` `textures` says which and the colour error).
+    #[arg(long, value_name = "rgba8|etc2|astc|bc7", default_value = "rgba8",
+          value_parser = parse_textures)]
+    pub textures: TextureFormat,
+}
+
+/// `--textures`' parser.
+fn parse_textures(s: &str) -> Result<TextureFormat, String> {
+    s.parse()
 }
 
 /// `--environment`'s name of the built-in studio.
@@ -135,14 +150,25 @@ pub fn run(a: MergeArgs) -> Result<ExitCode> {
         allow_mixed_devices: a.allow_mixed_devices,
         ..a.opts.options()
     };
-    let baked = trisort_bake::merge_to_file(&recs, &names, &opts, environment, &a.output)?;
+    let (baked, textures) = trisort_bake::merge_to_file(
+        &recs,
+        &names,
+        &opts,
+        environment,
+        a.opts.textures,
+        &a.output,
+    )?;
     let seconds = t0.elapsed().as_secs_f64();
     if a.json {
         let mut v = trisort_bake::figures::baked_json(&baked, seconds);
         v["clips"] = trisort_bake::figures::clips_json(&baked);
+        v["textures"] = textures.to_json();
         print_json(&v);
     } else {
         println!("{}", trisort_bake::figures::merge_summary(&baked, seconds));
+        if textures.format != TextureFormat::Rgba8 {
+            println!("{}", textures.summary());
+        }
         println!("wrote {}", a.output.display());
     }
     Ok(ExitCode::SUCCESS)

@@ -200,17 +200,20 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         g.frames.retain(|f| c.frames().contains(&f.frame));
     }
     let mut thumbs = BTreeMap::new();
+    let mut textures = None;
     let images = match &a.scene {
         None => None,
-        Some(spec) => match image_check(&a, spec, &baked, &recs, clip, &mut thumbs) {
-            Ok(r) => Some(r),
-            // The graph rules failed already (the files disagree): that is the verdict.
-            Err(e) if graph.as_ref().is_some_and(|g| !g.ok) => {
-                eprintln!("trisort: the images were not compared: {e:#}");
-                None
+        Some(spec) => {
+            match image_check(&a, spec, &baked, &recs, clip, &mut thumbs, &mut textures) {
+                Ok(r) => Some(r),
+                // The graph rules failed already (the files disagree): that is the verdict.
+                Err(e) if graph.as_ref().is_some_and(|g| !g.ok) => {
+                    eprintln!("trisort: the images were not compared: {e:#}");
+                    None
+                }
+                Err(e) => return Err(e),
             }
-            Err(e) => return Err(e),
-        },
+        }
     };
     let graph_ok =
         graph.as_ref().is_none_or(|g| g.ok) && environment.as_ref().is_none_or(|d| d.is_none());
@@ -262,6 +265,11 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             v["frames_dir"] = json!(dir.display().to_string());
         }
         v["image_check"] = json!(check);
+        // Block-compressed textures: what the image check drew them with, and their colour
+        // error against the scene's RGBA8 (null: the file stores RGBA8).
+        v["textures"] = textures
+            .as_ref()
+            .map_or(serde_json::Value::Null, |t| t.to_json());
         v["graph_check"] = json!(graph.as_ref().map(|g| g.checked));
         v["verified"] = json!(!unverified);
         v["environment"] = json!({
@@ -287,6 +295,17 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             text_report(&a.baked, graph.as_ref(), images.as_ref(), a.measure_only)
         );
         print_environment(&a, &baked, environment.as_ref(), graph.is_some());
+        if let Some(t) = &textures {
+            let worst = t.worst_psnr_db().map_or("unchanged".into(), |p| {
+                format!("worst PSNR {p:.1} dB against the scene's RGBA8")
+            });
+            println!(
+                "textures: {} stored as {} blocks, drawn decoded by both sides; alpha that \
+                 decides visibility equal to the scene's; colour {worst}",
+                t.compressed(),
+                t.format.name()
+            );
+        }
         if let Some(dir) = &a.report {
             println!("report: {}", dir.join("index.html").display());
         }
@@ -487,6 +506,7 @@ fn image_check(
     recs: &[Recording],
     clip: Option<&trisort_format::Clip>,
     thumbs: &mut BTreeMap<u32, Thumbnails>,
+    textures: &mut Option<trisort_bake::textures::TextureReport>,
 ) -> Result<(ImageReport, ImageCheck)> {
     let settings = recs.first().map_or(baked.settings, |r| r.settings);
     let mut scene = load_scene(spec)?;
@@ -497,6 +517,10 @@ fn image_check(
         files: &a.recording,
     };
     recorded_scene(&mut scene, spec, &recorded)?;
+    // Block-compressed textures: the reference draws the file's decoded texels once they
+    // are checked against the scene's (alpha that decides visibility exact; colour measured).
+    *textures = trisort_bake::textures::adopt_stored(scene.geometry_mut(), &baked.geometry)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.baked.display()))?;
     // A variant: the file and the scene both with the variant's material table (after the
     // hash checks, which are of the default materials).
     let with_variant;

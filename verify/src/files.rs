@@ -157,8 +157,39 @@ fn geometry_difference(recorded: &Geometry, baked: &Geometry) -> Option<String> 
     first("vertices", &recorded.vertices, &baked.vertices)
         .or_else(|| first("triangles", &recorded.triangles, &baked.triangles))
         .or_else(|| first("materials", &recorded.materials, &baked.materials))
-        .or_else(|| first("textures", &recorded.textures, &baked.textures))
+        .or_else(|| texture_difference(recorded, &baked.textures))
         .or_else(|| first("nodes", &recorded.nodes, &baked.nodes))
+}
+
+/// The first texture of `baked` that is not the recording's: equal, or (stored as blocks by
+/// `--textures`) of the same name, size and colour space with, where the recording's
+/// materials let its alpha decide visibility (a MASK or BLEND base colour), the same level-0
+/// alpha texel for texel. Colour may differ: the visibility recorded does not depend on it.
+fn texture_difference(recorded: &Geometry, baked: &[trisort_format::Texture]) -> Option<String> {
+    if recorded.textures.len() != baked.len() {
+        return Some(format!(
+            "{} textures instead of {}",
+            baked.len(),
+            recorded.textures.len()
+        ));
+    }
+    let alpha_decides = |t: usize| {
+        recorded.materials.iter().any(|m| {
+            m.alpha_mode != trisort_format::AlphaMode::Opaque
+                && m.base_color_texture == Some(t as u32)
+        })
+    };
+    let k = (recorded.textures.iter().zip(baked).enumerate()).position(|(k, (r, b))| {
+        if b.blocks.is_none() || r.blocks.is_some() {
+            return r != b;
+        }
+        let alpha = |t: &trisort_format::Texture| -> Vec<u8> {
+            t.rgba8.chunks_exact(4).map(|p| p[3]).collect()
+        };
+        (&r.name, r.width, r.height, r.srgb) != (&b.name, b.width, b.height, b.srgb)
+            || (alpha_decides(k) && alpha(r) != alpha(b))
+    })?;
+    Some(format!("textures {k} differs"))
 }
 
 /// Which part of a frame state differs: "camera" or "node poses".
