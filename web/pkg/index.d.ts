@@ -122,6 +122,81 @@ export class TrisortPlayer {
   setVariant(name: string | null): void;
   /** The wasm-bindgen object underneath (its API may change between versions). */
   readonly raw: import("./wasm/trisort_web.js").WebPlayer;
+  /** The file as a device-free `TrisortBake` (what `TrisortMesh` is built from). */
+  bake(): TrisortBake;
   /** Frees the GPU resources; the player cannot be used afterwards. */
+  free(): void;
+}
+
+/** The options of `TrisortBake.open`. */
+export interface BakeOptions {
+  data: Uint8Array | ArrayBuffer | ArrayBufferView;
+  /** Names the file in error messages (default "baked file"). */
+  name?: string;
+  wasm?: WasmSource;
+}
+
+/**
+ * A baked file decoded without a device: the typed arrays an app's own renderer draws it from.
+ * Each method returns a fresh copy. Layouts (README § Web player, "What a JS app gets"):
+ * vertex streams per vertex, the index buffer 3 per copy, ranges `[first_index, index_count]`
+ * in index units, matrices column-major 16 floats, materials 16 floats each.
+ */
+export class TrisortBake {
+  private constructor();
+  /**
+   * Loads the wasm module if needed and decodes the file.
+   * @throws {TrisortFormatError} a damaged, truncated or unsupported file
+   */
+  static open(options: BakeOptions): Promise<TrisortBake>;
+  /**
+   * Decodes the file synchronously (the wasm module must be loaded: `await initTrisort()`).
+   * @throws {TrisortFormatError} a damaged, truncated or unsupported file
+   * @throws {TrisortOptionError} the wasm module is not loaded yet
+   */
+  static fromBytes(data: Uint8Array | ArrayBuffer | ArrayBufferView, name?: string): TrisortBake;
+  readonly frameCount: number;
+  /** The recorded size (the projection's aspect is width / height). */
+  readonly width: number;
+  readonly height: number;
+  readonly vertexCount: number;
+  /** Distinct triangles: ids `0 .. triangleCount`. */
+  readonly triangleCount: number;
+  /** Triangles in the sorted index buffer (a triangle may have several copies). */
+  readonly copyCount: number;
+  readonly nodeCount: number;
+  readonly materialCount: number;
+  /** xyz per vertex, in its node's local space. */
+  positions(): Float32Array;
+  /** Unit normal per vertex, in its node's local space. */
+  normals(): Float32Array;
+  /** TEXCOORD_0 per vertex. */
+  uvs(): Float32Array;
+  /** The node moving each vertex. */
+  vertexNodes(): Uint32Array;
+  /** Each vertex's material. */
+  vertexMaterials(): Uint32Array;
+  /** The sorted index buffer, 3 per copy: back to front (default, `blend`) or as stored. */
+  indices(backToFront?: boolean): Uint32Array;
+  /** The triangle id of each copy of `indices(backToFront)`. */
+  copyTriangles(backToFront?: boolean): Uint32Array;
+  /** Frame `frame`'s draws over `indices(backToFront)`: `[first_index, index_count]` pairs. */
+  frameRanges(frame: number, backToFront?: boolean): Uint32Array;
+  /** Frame `frame`'s node matrices (view × world), 16 per node, column-major. */
+  nodeViewMatrices(frame: number): Float32Array;
+  /** Frame `frame`'s projection, column-major, clip depth [0, 1] (wgpu's). */
+  projection(frame: number): Float32Array;
+  /** Frame `frame`'s view (world → view) matrix in f64, column-major. */
+  view(frame: number): Float64Array;
+  /** Frame `frame`'s `[yfov, znear, zfar]` (zfar 0: infinite). */
+  cameraLens(frame: number): Float64Array;
+  /**
+   * 16 floats per material: base colour RGBA, emissive RGB, metallic, roughness, alpha mode
+   * (0 opaque, 1 mask, 2 blend), alpha cutoff, double-sided, transmission, played opacity,
+   * clearcoat, clearcoat roughness.
+   */
+  materialFactors(): Float32Array;
+  materialName(material: number): string;
+  readonly raw: import("./wasm/trisort_web.js").BakedData;
   free(): void;
 }

@@ -1,6 +1,6 @@
 // @trisort/player: trisort's web player as an ES module with an options-object API and typed
 // errors, over the wasm-bindgen module in wasm/ (built by web/build.sh). Types: index.d.ts.
-import init, { WebPlayer } from "./wasm/trisort_web.js";
+import init, { WebPlayer, BakedData } from "./wasm/trisort_web.js";
 
 /** Every error this package throws; `code` says which kind (`format`, `device`, `option`). */
 export class TrisortError extends Error {
@@ -76,6 +76,7 @@ function bytesOf(data) {
 }
 
 let ready = null;
+let loaded = false;
 
 /**
  * Loads the wasm module once (later calls return the same promise). `open` calls it; call it
@@ -84,7 +85,10 @@ let ready = null;
  */
 export function initTrisort(wasm) {
   if (!ready) {
-    ready = init(wasm === undefined ? undefined : { module_or_path: wasm }).catch((e) => {
+    ready = init(wasm === undefined ? undefined : { module_or_path: wasm }).then((m) => {
+      loaded = true;
+      return m;
+    }, (e) => {
       ready = null;
       throw new TrisortDeviceError(`loading the trisort wasm module: ${e && e.message ? e.message : e}`, { cause: e });
     });
@@ -95,12 +99,14 @@ export function initTrisort(wasm) {
 /** A baked file playing on a canvas. Make one with `await TrisortPlayer.open({ ... })`. */
 export class TrisortPlayer {
   #raw;
+  #source;
 
-  constructor(raw) {
+  constructor(raw, source = null) {
     if (!(raw instanceof WebPlayer)) {
       throw new TrisortOptionError("use `await TrisortPlayer.open({ canvas, data })`");
     }
     this.#raw = raw;
+    this.#source = source;
   }
 
   /** Opens `options.data` (a baked file's bytes) on `options.canvas`; see index.d.ts. */
@@ -121,7 +127,7 @@ export class TrisortPlayer {
     await initTrisort(options.wasm);
     try {
       const raw = await WebPlayer.open(canvas, bytes, name, backend, mode, !!options.zbuffer, shading, tonemap);
-      return new TrisortPlayer(raw);
+      return new TrisortPlayer(raw, { bytes, name });
     } catch (e) {
       throw wrap(e);
     }
@@ -184,7 +190,86 @@ export class TrisortPlayer {
   /** The wasm-bindgen object underneath (its API may change between versions). */
   get raw() { return this.#raw; }
 
+  /**
+   * The file this player plays as a device-free `TrisortBake` (decoded again from the bytes
+   * `open` was given): what `new TrisortMesh(...)` (`@trisort/player/three`) is built from.
+   */
+  bake() {
+    if (!this.#source) throw new TrisortOptionError("this player was freed");
+    return TrisortBake.fromBytes(this.#source.bytes, this.#source.name);
+  }
+
   /** Frees the player's GPU resources; the player cannot be used afterwards. */
+  free() {
+    if (this.#raw) {
+      this.#raw.free();
+      this.#raw = null;
+      this.#source = null;
+    }
+  }
+}
+
+/**
+ * A baked file decoded without a device: the typed arrays an app's own renderer draws it from
+ * (README § Web player, "What a JS app gets"). `await TrisortBake.open({ data })`, or
+ * `TrisortBake.fromBytes(data)` once `initTrisort()` has resolved.
+ */
+export class TrisortBake {
+  #raw;
+
+  constructor(raw) {
+    if (!(raw instanceof BakedData)) {
+      throw new TrisortOptionError("use `await TrisortBake.open({ data })` or `TrisortBake.fromBytes(data)`");
+    }
+    this.#raw = raw;
+  }
+
+  /** Loads the wasm module if needed and decodes `options.data` (`name` names it in errors). */
+  static async open(options) {
+    if (!options || typeof options !== "object") {
+      throw new TrisortOptionError("open: expected an options object { data, ... }");
+    }
+    const bytes = bytesOf(options.data);
+    await initTrisort(options.wasm);
+    return TrisortBake.fromBytes(bytes, options.name);
+  }
+
+  /** Decodes `data` synchronously; the wasm module must be loaded (`await initTrisort()`). */
+  static fromBytes(data, name = "baked file") {
+    const bytes = bytesOf(data);
+    if (!loaded) {
+      throw new TrisortOptionError("the wasm module is not loaded yet: await initTrisort() (or use TrisortBake.open)");
+    }
+    return new TrisortBake(call(() => BakedData.open(bytes, String(name))));
+  }
+
+  get frameCount() { return this.#raw.frame_count(); }
+  get width() { return this.#raw.width(); }
+  get height() { return this.#raw.height(); }
+  get vertexCount() { return this.#raw.vertex_count(); }
+  get triangleCount() { return this.#raw.triangle_count(); }
+  get copyCount() { return this.#raw.copy_count(); }
+  get nodeCount() { return this.#raw.node_count(); }
+  get materialCount() { return this.#raw.material_count(); }
+  positions() { return this.#raw.positions(); }
+  normals() { return this.#raw.normals(); }
+  uvs() { return this.#raw.uvs(); }
+  vertexNodes() { return this.#raw.vertex_nodes(); }
+  vertexMaterials() { return this.#raw.vertex_materials(); }
+  indices(backToFront = true) { return this.#raw.indices(backToFront); }
+  copyTriangles(backToFront = true) { return this.#raw.copy_triangles(backToFront); }
+  frameRanges(frame, backToFront = true) { return this.#raw.frame_ranges(frame, backToFront); }
+  nodeViewMatrices(frame) { return this.#raw.node_view_matrices(frame); }
+  projection(frame) { return this.#raw.projection(frame); }
+  view(frame) { return this.#raw.view(frame); }
+  cameraLens(frame) { return this.#raw.camera_lens(frame); }
+  materialFactors() { return this.#raw.material_factors(); }
+  materialName(m) { return this.#raw.material_name(m); }
+
+  /** The wasm-bindgen object underneath (its API may change between versions). */
+  get raw() { return this.#raw; }
+
+  /** Frees the decoded file. */
   free() {
     if (this.#raw) {
       this.#raw.free();

@@ -13,7 +13,11 @@ use std::fmt;
 use std::str::FromStr;
 
 #[cfg(target_arch = "wasm32")]
+mod bake;
+#[cfg(target_arch = "wasm32")]
 mod browser;
+#[cfg(target_arch = "wasm32")]
+pub use bake::BakedData;
 #[cfg(target_arch = "wasm32")]
 pub use browser::WebPlayer;
 

@@ -4,8 +4,13 @@
 // the options object, one frame drawn and compared with the native player's, the typed errors
 // provoked) and prints what it found as JSON. The caller gates.
 //
+// With --three, the same browser then opens three.html (three-app.mjs: `TrisortMesh` from
+// @trisort/player/three in three.js scenes, every frame of the file in the id-colour mode
+// checked against the z-buffer and against plain WebGL2) and adds what it found as "three".
+//
 //   node web/test/pkg.mjs --consumer web/test/pkg-consumer --dist web/dist --native DIR
 //        [--file demo.baked] [--bad-file truncated.baked] [--frame 0] [--backend webgl2]
+//        [--three yes]
 import { createServer } from "node:http";
 import { readFile } from "node:fs/promises";
 import { extname, join, normalize } from "node:path";
@@ -62,6 +67,15 @@ try {
     file: `/dist/${a.file}`, badFile: `/dist/${a["bad-file"]}`, backend: a.backend, frame,
     native: `/native/frame-${String(frame).padStart(5, "0")}.png`,
   });
+  if (a.three) {
+    const t0 = Date.now();
+    await page.goto(`http://127.0.0.1:${server.address().port}/three.html`);
+    await page.waitForFunction(() => window.threeLoaded || null).catch((e) => {
+      throw new Error(`the page did not load three.js and @trisort/player/three: ${e.message}\n${logs.join("\n")}`);
+    });
+    result.three = await page.evaluate((o) => window.runThreeTest(o), { file: `/dist/${a.file}` });
+    result.three.seconds = (Date.now() - t0) / 1000;
+  }
   result.console_errors = logs.filter((l) => l.startsWith("error") || l.startsWith("pageerror"));
   console.log(JSON.stringify(result, null, 1));
 } catch (e) {

@@ -53,17 +53,22 @@ repack=$(mkdir -p "$out/repack" && cd "$out/repack" && pwd)
 (cd web/pkg && npm pack --silent --pack-destination "$repack" >/dev/null)
 cmp "web/pkg/$tarball" "$repack/$tarball" || { echo "npm pack is not reproducible" >&2; exit 1; }
 rm -rf "$consumer/node_modules" "$consumer/package.json" "$consumer/package-lock.json"
-printf '{ "name": "trisort-pkg-consumer", "private": true, "type": "module",\n  "dependencies": { "@trisort/player": "file:../../pkg/%s" } }\n' \
+# three.js (the @trisort/player/three page) from the npm registry, pinned.
+printf '{ "name": "trisort-pkg-consumer", "private": true, "type": "module",\n  "dependencies": { "@trisort/player": "file:../../pkg/%s", "three": "0.187.0" } }\n' \
   "$tarball" > "$consumer/package.json"
 (cd "$consumer" && npm install --no-audit --no-fund --silent --prefer-offline)
 # Its types as an app's TypeScript reads them (types.ts: strict, a wrong option refused).
 (cd "$consumer" && ../node_modules/.bin/tsc -p .)
+# --three: then three.html (three-app.mjs) plays every frame through `TrisortMesh`
+# (@trisort/player/three) in three.js scenes, in the id-colour mode, beside a plain-WebGL2 draw of
+# the player's own ranges (about 9 s); gated below.
 node web/test/pkg.mjs --consumer "$consumer" --dist web/dist --native "$out/native" \
-  --bad-file truncated.baked > "$out/package.json"
-node - "$out/package.json" "${TRISORT_WEB_MAX_OVER1_NATIVE:-0.0125}" <<'JS'
+  --bad-file truncated.baked --three yes > "$out/package.json"
+node - "$out/package.json" "${TRISORT_WEB_MAX_OVER1_NATIVE:-0.0125}" "$frames" <<'JS'
 const fs = require("fs");
 const r = JSON.parse(fs.readFileSync(process.argv[2], "utf8"));
 const maxOver1 = Number(process.argv[3]);
+const frames = Number(process.argv[4]);
 const bad = [];
 const is = (f, cls, code) => f && f.class === cls && f.code === code && f.is_trisort && f.is_error;
 if (r.backend !== "WebGL2" || r.frames < 1 || r.lit === 0) bad.push("the demo bake did not play");
@@ -80,7 +85,36 @@ if (!is(r.unknown_clip, "TrisortOptionError", "option")) bad.push(`unknown clip:
 if (r.webgpu && !is(r.webgpu, "TrisortDeviceError", "device")) bad.push(`backend "webgpu": ${JSON.stringify(r.webgpu)}`);
 if (!r.format_is_class || !r.option_is_class) bad.push("the error classes do not extend TrisortError");
 if (r.console_errors.length) bad.push(`console errors: ${r.console_errors.join("; ")}`);
+// @trisort/player/three: gated, on every frame, 0 pixels differing between TrisortMesh's id
+// colours and plain WebGL2 drawing the player's own ranges in order (the same triangles in the
+// same order: another order, a missing or extra range changes pixels where triangles overlap),
+// drawn with WEBGL_multi_draw where the context has it. Reported, not gated: holes (a 1-sample
+// depth-tested draw vs the file's z-buffer twin) and order errors (the sorted draw vs that
+// depth-tested draw). The bake's order is exact at its recorded 4x sample pattern; a 1-sample
+// comparison takes pixel centres, off that pattern, so a few pixels per frame differ there
+// (and at 4x, SwiftShader's per-sample depth makes the reference itself wrong).
+const t = r.three;
+if (!t || !Array.isArray(t.frames)) {
+  bad.push(`the three.js page returned nothing: ${JSON.stringify(t)}`);
+} else {
+  if (t.frames.length !== frames) bad.push(`three.js: ${t.frames.length} frames of ${frames} checked`);
+  const off = t.frames.filter((f) => f.plain_webgl2_diff !== 0);
+  if (off.length) {
+    bad.push(`three.js: TrisortMesh differs from plain WebGL2 of the player's ranges in ${off.length} frames: ` +
+      off.map((f) => `frame ${f.frame}: ${f.plain_webgl2_diff} px`).join(", "));
+  }
+  if (t.frames.some((f) => f.covered === 0 || f.draws === 0)) bad.push("three.js: a frame drew nothing");
+  if (t.has_multi_draw && !t.multi_draw) bad.push("three.js: WEBGL_multi_draw exists but TrisortMesh did not use it");
+  if (t.pbr_lit === 0) bad.push("three.js: the MeshPhysicalMaterial frame drew nothing");
+}
 if (bad.length) { console.error("package test failed:\n  " + bad.join("\n  ")); process.exit(1); }
+const sum = (k) => t.frames.reduce((a, f) => a + f[k], 0);
+const worst = (k) => Math.max(...t.frames.map((f) => f[k]));
+console.log(`three.js ${t.three}: TrisortMesh = plain WebGL2 of the player's ranges in all ${t.frames.length} frames ` +
+  `(0 px differ; ${t.multi_draw ? "WEBGL_multi_draw" : "drawElements per range"}, ${t.seconds.toFixed(1)} s); ` +
+  `reported, not gated, 1 sample vs depth test: ${sum("holes")} holes (worst ${worst("holes")}/frame), ` +
+  `${sum("order_errors")} order errors (worst ${worst("order_errors")}/frame)`);
+console.log(`  per frame [holes, order errors]: ${t.frames.map((f) => `${f.frame}:${f.holes},${f.order_errors}`).join(" ")}`);
 console.log(`package test: @trisort/player installed from its tarball plays ${r.frames} frames on ${r.backend} ` +
   `(frame 0: ${r.over1_native} px over 1/255 from native); TrisortFormatError: ${r.truncated.message}`);
 JS
