@@ -173,21 +173,19 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         bail!("nothing to verify against: give --recording REC (graph rules) and/or --scene SCENE (images), or --environment studio|FILE.hdr (the stored light)");
     }
     // The stored light against the one named (None: not asked).
-    let environment = match &a.environment {
-        None => None,
-        Some(spec) => {
+    let environment = (a.environment.as_ref())
+        .map(|spec| -> Result<_> {
             let expected = trisort_bake::Light::parse(spec).load()?;
-            Some(baked.environment.difference(&expected))
-        }
-    };
-    let clip = match &a.clip {
-        None => None,
-        Some(name) => Some(
+            Ok(baked.environment.difference(&expected))
+        })
+        .transpose()?;
+    let clip = (a.clip.as_ref())
+        .map(|name| {
             baked
                 .clip(name)
-                .map_err(|e| anyhow::anyhow!("--clip {name}: {e}"))?,
-        ),
-    };
+                .map_err(|e| anyhow::anyhow!("--clip {name}: {e}"))
+        })
+        .transpose()?;
     let recs = read_recordings(&a.recording)?;
     let played = match a.mode {
         Mode::Depth => trisort_verify::PlayedIn::Depth,
@@ -267,20 +265,10 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         v["image_check"] = json!(check);
         // Block-compressed textures: what the image check drew them with, and their colour
         // error against the scene's RGBA8 (null: the file stores RGBA8).
-        v["textures"] = textures
-            .as_ref()
-            .map_or(serde_json::Value::Null, |t| t.to_json());
+        v["textures"] = json!(textures.as_ref().map(|t| t.to_json()));
         v["graph_check"] = json!(graph.as_ref().map(|g| g.checked));
         v["verified"] = json!(!unverified);
-        v["environment"] = json!({
-            "name": baked.environment.name,
-            "checked": match (&a.environment, graph.is_some()) {
-                (Some(_), _) => "given",
-                (None, true) if baked.environment.name == "studio" => "studio",
-                _ => "no",
-            },
-            "difference": environment.clone().flatten(),
-        });
+        v["environment"] = environment_json(&a, &baked, &environment, graph.is_some());
         if unverified {
             // Measured, not judged: no frame passed or failed.
             v["images_ok"] = Value::Null;
@@ -296,15 +284,7 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
         );
         print_environment(&a, &baked, environment.as_ref(), graph.is_some());
         if let Some(t) = &textures {
-            let worst = t.worst_psnr_db().map_or("unchanged".into(), |p| {
-                format!("worst PSNR {p:.1} dB against the scene's RGBA8")
-            });
-            println!(
-                "textures: {} stored as {} blocks, drawn decoded by both sides; alpha that \
-                 decides visibility equal to the scene's; colour {worst}",
-                t.compressed(),
-                t.format.name()
-            );
+            print_textures(t);
         }
         if let Some(dir) = &a.report {
             println!("report: {}", dir.join("index.html").display());
@@ -494,6 +474,38 @@ fn settings_rows(baked: &Baked) -> Vec<(String, String)> {
     rows.push(("scene hash (stored)".into(), hex(&baked.scene_hash)));
     rows.push(("path hash (stored)".into(), hex(&baked.path_hash)));
     rows
+}
+
+/// `--json`'s `environment`: the stored light's name, what it was checked against and the
+/// difference found (`environment`: `None` when no light was named).
+fn environment_json(
+    a: &VerifyArgs,
+    baked: &Baked,
+    environment: &Option<Option<String>>,
+    graph: bool,
+) -> Value {
+    json!({
+        "name": baked.environment.name,
+        "checked": match (&a.environment, graph) {
+            (Some(_), _) => "given",
+            (None, true) if baked.environment.name == "studio" => "studio",
+            _ => "no",
+        },
+        "difference": environment.clone().flatten(),
+    })
+}
+
+/// The text report's line on a file's block-compressed textures.
+fn print_textures(t: &trisort_bake::textures::TextureReport) {
+    let worst = t.worst_psnr_db().map_or("unchanged".into(), |p| {
+        format!("worst PSNR {p:.1} dB against the scene's RGBA8")
+    });
+    println!(
+        "textures: {} stored as {} blocks, drawn decoded by both sides; alpha that decides \
+         visibility equal to the scene's; colour {worst}",
+        t.compressed(),
+        t.format.name()
+    );
 }
 
 /// The image check of `verify --scene SPEC`: the scene as recorded (split where the
