@@ -20,7 +20,7 @@
 
 use rayon::prelude::*;
 use trisort_format::gpu_layout::tiled;
-use trisort_format::{AlphaMode, BlockFormat, Geometry, Texture, TextureBlocks};
+use trisort_format::{BlockFormat, Geometry, Texture, TextureBlocks};
 
 /// Why `--textures astc` is refused by a trisort built without the `astc` feature.
 pub const ASTC_MISSING: &str = "this trisort was built without ASTC encoding: install it with \
@@ -195,28 +195,12 @@ impl TextureReport {
     }
 }
 
-/// The textures whose level-0 alpha decides visibility: base colour of a MASK or BLEND
-/// material (every material, so every variant's too).
-pub fn alpha_textures(geometry: &Geometry) -> Vec<bool> {
-    let mut reads = vec![false; geometry.textures.len()];
-    for m in &geometry.materials {
-        if m.alpha_mode != AlphaMode::Opaque {
-            if let Some(t) = m.base_color_texture {
-                if let Some(r) = reads.get_mut(t as usize) {
-                    *r = true;
-                }
-            }
-        }
-    }
-    reads
-}
-
 /// Compresses `geometry`'s textures to `format` where that keeps visibility exact (module
 /// docs), replacing each compressed texture's RGBA8 levels with its blocks decoded. `Rgba8`
 /// leaves everything as it is. Textures are encoded in parallel.
 pub fn compress(geometry: &mut Geometry, format: TextureFormat) -> TextureReport {
     let t0 = std::time::Instant::now();
-    let alpha = alpha_textures(geometry);
+    let alpha = geometry.alpha_decides_visibility();
     let textures: Vec<TextureOutcome> = (geometry.textures.par_iter_mut())
         .enumerate()
         .map(|(i, t)| compress_one(i as u32, t, format, alpha[i]))
@@ -231,7 +215,8 @@ pub fn compress(geometry: &mut Geometry, format: TextureFormat) -> TextureReport
 /// For `verify --scene`: gives `scene` (the textures as imported) the stored texels of every
 /// texture `baked` stores block-compressed, after checking them against the scene's own
 /// rather than taking the file's word: same size and colour space, and, where the scene's
-/// materials let alpha decide visibility ([`alpha_textures`] of the scene), the same level-0
+/// materials let alpha decide visibility ([`Geometry::alpha_decides_visibility`] of the
+/// scene), the same level-0
 /// alpha texel for texel. The colour error is measured, not excused: the report's PSNR and
 /// largest difference per texture. `None` when the file stores no blocks.
 pub fn adopt_stored(
@@ -253,7 +238,7 @@ pub fn adopt_stored(
         BlockFormat::Astc4x4 => TextureFormat::Astc,
         BlockFormat::Bc7 => TextureFormat::Bc7,
     };
-    let alpha = alpha_textures(scene);
+    let alpha = scene.alpha_decides_visibility();
     let mut textures = Vec::new();
     for (i, (s, b)) in scene.textures.iter_mut().zip(&baked.textures).enumerate() {
         let Some(blocks) = &b.blocks else { continue };
@@ -511,6 +496,7 @@ pub fn difference(before: &[u8], after: &[u8]) -> (Option<f64>, u8) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use trisort_format::AlphaMode;
 
     /// A `size`² texture: a smooth colour ramp, and alpha `alpha(x, y)`.
     fn ramp(size: u32, alpha: impl Fn(u32, u32) -> u8) -> Texture {

@@ -483,6 +483,23 @@ impl Geometry {
         Ok(())
     }
 
+    /// Per texture: whether its level-0 alpha decides visibility, as the recorder reads it
+    /// (the base colour of a MASK or BLEND material, any of them, so any variant's too: cut
+    /// and transparent fragments are discarded). What `--textures` must keep exact and what
+    /// `verify` checks of a block-compressed texture.
+    pub fn alpha_decides_visibility(&self) -> Vec<bool> {
+        let mut reads = vec![false; self.textures.len()];
+        for m in &self.materials {
+            if m.alpha_mode == AlphaMode::Opaque {
+                continue;
+            }
+            if let Some(r) = m.base_color_texture.and_then(|t| reads.get_mut(t as usize)) {
+                *r = true;
+            }
+        }
+        reads
+    }
+
     /// Decodes every block-compressed texture whose RGBA8 levels are empty (as a file stores
     /// it) into [`Texture::rgba8`] and [`Texture::mips`], after checking its blocks
     /// ([`crate::blocks::TextureBlocks::check`]). What reading a file does before

@@ -173,12 +173,7 @@ fn texture_difference(recorded: &Geometry, baked: &[trisort_format::Texture]) ->
             recorded.textures.len()
         ));
     }
-    let alpha_decides = |t: usize| {
-        recorded.materials.iter().any(|m| {
-            m.alpha_mode != trisort_format::AlphaMode::Opaque
-                && m.base_color_texture == Some(t as u32)
-        })
-    };
+    let alpha_decides = recorded.alpha_decides_visibility();
     let k = (recorded.textures.iter().zip(baked).enumerate()).position(|(k, (r, b))| {
         if b.blocks.is_none() || r.blocks.is_some() {
             return r != b;
@@ -187,7 +182,7 @@ fn texture_difference(recorded: &Geometry, baked: &[trisort_format::Texture]) ->
             t.rgba8.chunks_exact(4).map(|p| p[3]).collect()
         };
         (&r.name, r.width, r.height, r.srgb) != (&b.name, b.width, b.height, b.srgb)
-            || (alpha_decides(k) && alpha(r) != alpha(b))
+            || (alpha_decides[k] && alpha(r) != alpha(b))
     })?;
     Some(format!("textures {k} differs"))
 }
