@@ -5,88 +5,15 @@
 //! conversion of BC7 texels differs from its RGBA8 one in the last bit). ETC2, which lavapipe
 //! lacks, is uploaded decoded there and draws as RGBA8 texels do; Mesa's GL (llvmpipe) samples
 //! it natively, exactly as decoded.
-use trisort_format::{Baked, BlockFormat, Texture, TextureBlocks};
+use trisort_format::{Baked, BlockFormat};
 use trisort_gpu::scene_gpu::ArrayUpload;
 use trisort_gpu::Gpu;
 use trisort_player::headless::{HeadlessConfig, HeadlessRenderer};
 use trisort_player::Mode;
+use trisort_testkit::blocks::{texture_of_blocks, Bits};
 use trisort_testkit::gpu;
 
 use crate::shading::{slot, textured};
-
-/// A pseudo-random generator for test blocks (xorshift).
-struct Bits(u64);
-
-impl Bits {
-    fn byte(&mut self) -> u8 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 24) as u8
-    }
-}
-
-/// A block of `format` valid for every decoder: random BC7 of every mode (the mode's bit set
-/// in the first byte), random ETC2 (RGBA8: its EAC multiplier not 0); where `uniform`, one
-/// colour over the block (BC7 mode 6 with every index 0; ETC2 individual mode with equal
-/// halves and every index 0), which is how a level smaller than a block is stored, tiled.
-fn block(bits: &mut Bits, format: BlockFormat, uniform: bool) -> Vec<u8> {
-    let mut b: Vec<u8> = (0..format.block_bytes()).map(|_| bits.byte()).collect();
-    let colour = b.len() - 8;
-    match (format, uniform) {
-        (BlockFormat::Bc7, false) => {
-            let mode = b[1] % 8;
-            b[0] = (b[0] & !((2u16 << mode) - 1) as u8) | (1 << mode);
-        }
-        (BlockFormat::Bc7, true) => {
-            // Mode 6: 7 mode bits, 56 endpoint bits, 2 p-bits, then 63 index bits.
-            b[0] = (b[0] & 0x80) | 0x40;
-            b[8] &= 0x01;
-            b[9..].fill(0);
-        }
-        (_, true) => {
-            for c in &mut b[colour..colour + 3] {
-                *c = (*c & 0xf0) | (*c >> 4);
-            }
-            let table = b[colour + 3] >> 5;
-            b[colour + 3] = table << 5 | table << 2;
-            b[colour + 4..].fill(0);
-            if colour == 8 {
-                b[2..colour].fill(0);
-            }
-        }
-        _ => {}
-    }
-    if format == BlockFormat::Etc2Rgba8 {
-        b[1] |= 0x10;
-    }
-    b
-}
-
-/// A `size`² texture stored as random `format` blocks (levels under 4 texels uniform), its
-/// RGBA8 levels decoded from them as reading a file decodes them.
-fn texture_of_blocks(bits: &mut Bits, format: BlockFormat, size: u32, srgb: bool) -> Texture {
-    let levels: Vec<Vec<u8>> = (0..=Texture::mip_count(size, size) as u32)
-        .map(|k| {
-            let (w, h) = Texture::level_size(size, size, k);
-            (0..w.div_ceil(4) * h.div_ceil(4))
-                .flat_map(|_| block(bits, format, w < 4 || h < 4))
-                .collect()
-        })
-        .collect();
-    let blocks = TextureBlocks { format, levels };
-    blocks.check(size, size).unwrap();
-    let mut decoded = (0..blocks.levels.len()).map(|k| blocks.decode_level(size, size, k));
-    Texture {
-        name: format!("{format} {size}"),
-        width: size,
-        height: size,
-        rgba8: decoded.next().unwrap(),
-        srgb,
-        mips: decoded.collect(),
-        blocks: Some(blocks),
-    }
-}
 
 /// [`textured`] with every map of the grey quad and the base colour of the red one (now
 /// visible, its texture's alpha blended over the rest) stored as random `format` blocks of
@@ -99,7 +26,7 @@ fn blocky(format: BlockFormat, seed: u64) -> Baked {
     let g = &mut b.geometry;
     g.textures = [(128, true), (16, true), (8, true), (64, false), (4, false)]
         .into_iter()
-        .map(|(size, srgb)| texture_of_blocks(&mut bits, format, size, srgb))
+        .map(|(size, srgb)| texture_of_blocks(&mut bits, format, (size, size), srgb))
         .collect();
     let grey = &mut g.materials[2];
     grey.base_color_texture = Some(0);
@@ -307,8 +234,9 @@ fn native_etc2_and_bc7_on_gl_draw_the_pixels_of_their_decoded_texels() {
     // to linear a step of 8 bits apart from RGBA8 ones now and then, as lavapipe does.
     let mut bits = Bits(0x0123_4567_89ab_cdef);
     let mut etc2 = blocky(BlockFormat::Etc2Rgb8, 0x5851_f42d_4c95_7f2d);
-    etc2.geometry.textures[1] = texture_of_blocks(&mut bits, BlockFormat::Etc2Rgba8, 16, true);
-    etc2.geometry.textures[4] = texture_of_blocks(&mut bits, BlockFormat::Etc2Rgba8, 4, false);
+    etc2.geometry.textures[1] =
+        texture_of_blocks(&mut bits, BlockFormat::Etc2Rgba8, (16, 16), true);
+    etc2.geometry.textures[4] = texture_of_blocks(&mut bits, BlockFormat::Etc2Rgba8, (4, 4), false);
     let bc7 = blocky(BlockFormat::Bc7, 0x2545_f491_4f6c_dd1d);
     for (baked, format) in [(etc2, BlockFormat::Etc2Rgba8), (bc7, BlockFormat::Bc7)] {
         let feature = trisort_gpu::scene_gpu::budget::compression_feature(format);

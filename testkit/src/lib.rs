@@ -17,6 +17,7 @@
 //! `trisort-gpu`'s do without it.
 #![deny(missing_docs)]
 
+pub mod blocks;
 pub mod fixtures;
 
 use std::path::{Path, PathBuf};
