@@ -35,24 +35,19 @@ pub(super) fn upload_textures(
     allocated: &mut GpuBytes,
 ) -> Textures {
     let plan = &budget.arrays;
-    let srgb = upload_array(
-        device,
-        queue,
-        geometry,
-        &plan.srgb,
-        &budget.uploads[0],
-        budget.layers[0],
-    );
-    let linear = upload_array(
-        device,
-        queue,
-        geometry,
-        &plan.linear,
-        &budget.uploads[1],
-        budget.layers[1],
-    );
-    allocated.count_texture_layers(&srgb.0, &budget.layer_kinds[0]);
-    allocated.count_texture_layers(&linear.0, &budget.layer_kinds[1]);
+    let [srgb, linear] = [&plan.srgb, &plan.linear].map(|array| {
+        let k = array.linear as usize;
+        let uploaded = upload_array(
+            device,
+            queue,
+            geometry,
+            array,
+            &budget.uploads[k],
+            budget.layers[k],
+        );
+        allocated.count_texture_layers(&uploaded.0, &budget.layer_kinds[k]);
+        uploaded
+    });
     Textures {
         srgb: srgb.1,
         linear: linear.1,
