@@ -33,7 +33,9 @@ pub use device::{
 #[cfg(not(target_arch = "wasm32"))]
 pub use readback::map_read_all;
 pub use readback::{f16_to_f32, halves, linear_to_srgb, poll_ready, quantize_rgba16f};
-pub use target::{clear_colour, FrameTarget, TargetConfig, BACKGROUND, COLOR_FORMAT, DEPTH_FORMAT};
+pub use target::{
+    clear_colour, FrameTarget, StagingLayout, TargetConfig, BACKGROUND, COLOR_FORMAT, DEPTH_FORMAT,
+};
 pub use timer::GpuTimer;
 pub mod scene_gpu;
 pub use scene_gpu::{Bindings, Lighting, Shading, ToneMap};

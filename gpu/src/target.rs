@@ -228,10 +228,23 @@ impl FrameTarget {
             .staging
             .as_ref()
             .expect("FrameTarget created without readback");
+        self.copy_to_buffer(enc, staging);
+    }
+
+    /// The bytes a buffer needs to hold the resolved frame ([`FrameTarget::copy_to_buffer`]):
+    /// rows padded to wgpu's copy alignment.
+    pub fn staging_size(&self) -> u64 {
+        self.row_bytes as u64 * self.size.1 as u64
+    }
+
+    /// Records the copy of the resolved frame into `buffer` (`COPY_DST`, at least
+    /// [`FrameTarget::staging_size`] bytes): for a caller that maps it itself, e.g. the web
+    /// player, which cannot wait for a mapping.
+    pub fn copy_to_buffer(&self, enc: &mut wgpu::CommandEncoder, buffer: &wgpu::Buffer) {
         enc.copy_texture_to_buffer(
             self.resolved.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
-                buffer: staging,
+                buffer,
                 layout: wgpu::TexelCopyBufferLayout {
                     offset: 0,
                     bytes_per_row: Some(self.row_bytes),
@@ -246,10 +259,7 @@ impl FrameTarget {
     /// alpha 255, quantized once like every frame trisort compares: in `saturate` mode the
     /// background goes under the accumulated colour first.
     pub fn rgba8(&self, padded: &[u8], mode: Mode) -> Vec<u8> {
-        quantize_rgba16f(
-            &halves(&self.unpad(padded)),
-            (mode == Mode::Saturate).then_some(BACKGROUND),
-        )
+        self.layout().rgba8(padded, mode)
     }
 
     #[cfg(not(target_arch = "wasm32"))]
@@ -294,11 +304,48 @@ impl FrameTarget {
 
     /// The staging buffer's mapped bytes as tightly packed rows (drops the row padding).
     pub fn unpad(&self, padded: &[u8]) -> Vec<u8> {
-        let row = (self.size.0 * self.bytes_per_pixel) as usize;
-        let mut out = Vec::with_capacity(row * self.size.1 as usize);
-        for y in 0..self.size.1 as usize {
+        self.layout().unpad(padded)
+    }
+
+    /// How the resolved frame lies in a staging buffer, apart from the target: what a caller
+    /// that converts the bytes after the target is out of reach keeps.
+    pub fn layout(&self) -> StagingLayout {
+        StagingLayout {
+            row: self.size.0 * self.bytes_per_pixel,
+            row_bytes: self.row_bytes,
+            rows: self.size.1,
+        }
+    }
+}
+
+/// The rows of a [`FrameTarget`]'s frame in a staging buffer ([`FrameTarget::layout`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StagingLayout {
+    /// Bytes of one row of texels.
+    pub row: u32,
+    /// Bytes from one row to the next in the buffer (`row` padded to the copy alignment).
+    pub row_bytes: u32,
+    /// Rows.
+    pub rows: u32,
+}
+
+impl StagingLayout {
+    /// The buffer's bytes as tightly packed rows (drops the row padding).
+    pub fn unpad(&self, padded: &[u8]) -> Vec<u8> {
+        let row = self.row as usize;
+        let mut out = Vec::with_capacity(row * self.rows as usize);
+        for y in 0..self.rows as usize {
             out.extend_from_slice(&padded[y * self.row_bytes as usize..][..row]);
         }
         out
+    }
+
+    /// An `Rgba16Float` frame's padded bytes as 8-bit sRGB RGBA with alpha 255
+    /// ([`FrameTarget::rgba8`]).
+    pub fn rgba8(&self, padded: &[u8], mode: Mode) -> Vec<u8> {
+        quantize_rgba16f(
+            &halves(&self.unpad(padded)),
+            (mode == Mode::Saturate).then_some(BACKGROUND),
+        )
     }
 }

@@ -100,13 +100,17 @@ impl OnScreen {
         surface_view: &wgpu::TextureView,
         frame: u32,
     ) -> Result<(), PlayerError> {
-        {
-            // In saturate mode the background goes under the accumulated colour in the blit.
-            let mut pass = self.frame.begin_pass(enc, clear_colour(self.mode), None);
-            self.player.draw(&mut pass, frame)?;
-        }
+        self.draw(enc, frame)?;
         blit.encode(enc, surface_view, &self.blit_group);
         Ok(())
+    }
+
+    /// Records frame `frame` into the off-screen target.
+    fn draw(&self, enc: &mut wgpu::CommandEncoder, frame: u32) -> Result<(), PlayerError> {
+        // In saturate mode the background goes under the accumulated colour at the end (the
+        // blit, or the readback's conversion).
+        let mut pass = self.frame.begin_pass(enc, clear_colour(self.mode), None);
+        self.player.draw(&mut pass, frame)
     }
 
     /// Draws frame `frame` into `surface`'s texture through a view in `view_format` (the format
@@ -131,6 +135,31 @@ impl OnScreen {
         self.encode(&mut enc, blit, &view, frame)?;
         gpu.queue.submit([enc.finish()]);
         Ok(())
+    }
+
+    /// Records frame `frame` into the off-screen target and the copy of the resolved frame
+    /// into `buffer` (`COPY_DST`, [`FrameTarget::staging_size`] bytes of [`OnScreen::target`]):
+    /// the frame as the headless player reads it back, for a caller that maps `buffer` itself
+    /// (the web player's `read_frame`, which cannot block on a mapping).
+    pub fn encode_readback(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        buffer: &wgpu::Buffer,
+        frame: u32,
+    ) -> Result<(), PlayerError> {
+        self.draw(enc, frame)?;
+        self.frame.copy_to_buffer(enc, buffer);
+        Ok(())
+    }
+
+    /// The off-screen frame target.
+    pub fn target(&self) -> &FrameTarget {
+        &self.frame
+    }
+
+    /// The mode it draws in.
+    pub fn mode(&self) -> Mode {
+        self.mode
     }
 
     /// The size of the off-screen frame.

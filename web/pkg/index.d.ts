@@ -91,6 +91,15 @@ export class TrisortPlayer {
   static open(options: OpenOptions): Promise<TrisortPlayer>;
   /** Draws `frame` (0-based) and presents it; returns the milliseconds spent encoding it. */
   render(frame: number): number;
+  /**
+   * Draws `frame` off-screen and reads it back through a mapped buffer (the canvas is
+   * untouched): `width × height` RGBA texels, rows top to bottom, 8-bit sRGB with alpha 255,
+   * converted as the native player converts its PNG frames. Works on WebGPU, whose canvases
+   * cannot be read back in every browser, and on WebGL2. Await one read before the next.
+   * @throws {TrisortOptionError} a read while the previous one has not settled
+   * @throws {TrisortDeviceError} the device failed to draw or map the frame
+   */
+  readFrame(frame: number): Promise<Uint8Array>;
   readonly frameCount: number;
   readonly width: number;
   readonly height: number;

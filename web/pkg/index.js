@@ -140,6 +140,19 @@ export class TrisortPlayer {
     return performance.now() - t0;
   }
 
+  /**
+   * Frame `frame` drawn off-screen and read back through a mapped buffer: width × height RGBA
+   * texels, rows top to bottom, 8-bit sRGB, alpha 255 (the native player's PNG pixels). The
+   * canvas is untouched. One read at a time; see index.d.ts.
+   */
+  async readFrame(frame) {
+    try {
+      return await this.#raw.read_frame(frame);
+    } catch (e) {
+      throw wrap(e);
+    }
+  }
+
   /** Frames in the file. */
   get frameCount() { return this.#raw.frame_count(); }
   /** The canvas size, the recorded size. */

@@ -1,6 +1,8 @@
 //! The wasm side: [`WebPlayer`], exported to the page with wasm-bindgen.
 
+use std::cell::Cell;
 use std::path::Path;
+use std::rc::Rc;
 
 use trisort_format::{Baked, DeviceLimits, Mode};
 use trisort_gpu::present::{configure_surface, Blit};
@@ -22,6 +24,9 @@ fn start() {
 /// drawing into its off-screen frame, copied to the canvas each [`WebPlayer::render`].
 #[wasm_bindgen]
 pub struct WebPlayer {
+    /// Kept while the player lives: Chromium aborts a WebGPU buffer mapping ("a valid external
+    /// Instance reference no longer exists") once the instance that made the device is gone.
+    _instance: wgpu::Instance,
     gpu: Gpu,
     surface: wgpu::Surface<'static>,
     surface_config: wgpu::SurfaceConfiguration,
@@ -35,6 +40,26 @@ pub struct WebPlayer {
     robust: trisort_format::Robust,
     warnings: Vec<String>,
     uncaptured: UncapturedError,
+    /// The buffer [`WebPlayer::read_frame`] maps, made on its first call.
+    readback: Option<wgpu::Buffer>,
+    /// Whether a [`WebPlayer::read_frame`] is waiting for its mapping.
+    reading: Rc<Cell<bool>>,
+}
+
+/// Resolves on the browser's next timer tick (`setTimeout(…, 1)`; at once where there is no
+/// `setTimeout`).
+async fn timer_tick() {
+    let tick = js_sys::Promise::new(&mut |resolve, _| {
+        let global = js_sys::global();
+        let set_timeout = js_sys::Reflect::get(&global, &JsValue::from_str("setTimeout"))
+            .ok()
+            .and_then(|f| f.dyn_into::<js_sys::Function>().ok());
+        match set_timeout {
+            Some(f) => drop(f.call2(&global, &resolve, &JsValue::from(1))),
+            None => drop(resolve.call0(&JsValue::NULL)),
+        }
+    });
+    let _ = wasm_bindgen_futures::JsFuture::from(tick).await;
 }
 
 /// A JavaScript `Error` with `message` and a `kind` property naming `kind` ([`ErrorKind`]):
@@ -132,6 +157,7 @@ impl WebPlayer {
         let fps = baked.fps;
         let robust = baked.settings.robust;
         Ok(WebPlayer {
+            _instance: instance,
             gpu,
             surface,
             surface_config: setup.config,
@@ -144,6 +170,8 @@ impl WebPlayer {
             robust,
             warnings,
             uncaptured,
+            readback: None,
+            reading: Rc::new(Cell::new(false)),
         })
     }
 
@@ -180,6 +208,105 @@ impl WebPlayer {
         }
         self.gpu.queue.present(texture);
         Ok(())
+    }
+
+    /// Draws frame `frame` off-screen and resolves to its pixels, read back through a mapped
+    /// buffer: a `Uint8Array` of `width × height` RGBA texels, rows top to bottom, 8-bit sRGB
+    /// with alpha 255, converted from the frame as the native player converts it for its PNGs
+    /// (`trisort play`). The canvas is untouched. WebGPU gives no way to read a canvas back
+    /// that works everywhere (a headless browser's reads come back blank); this works on
+    /// both backends. One read at a time: a second call before the first settles is refused.
+    pub fn read_frame(&mut self, frame: u32) -> Result<js_sys::Promise, JsValue> {
+        if self.reading.get() {
+            return Err(option_error(
+                "read_frame: the previous read_frame has not settled yet (await it first)",
+            ));
+        }
+        let target = self.on_screen.target();
+        let (layout, size, mode) = (
+            target.layout(),
+            target.staging_size(),
+            self.on_screen.mode(),
+        );
+        let buffer = self
+            .readback
+            .get_or_insert_with(|| {
+                self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("trisort web readback"),
+                    size,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            })
+            .clone();
+        let mut enc = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("trisort web readback"),
+            });
+        self.on_screen
+            .encode_readback(&mut enc, &buffer, frame)
+            .map_err(device_error)?;
+        self.gpu.queue.submit([enc.finish()]);
+        if let Some(e) = self.uncaptured.take() {
+            return Err(device_error(format!("wgpu: {e}")));
+        }
+        self.reading.set(true);
+        let reading = self.reading.clone();
+        // WebGPU reports a bad copy later, on the device; a failed mapping names it.
+        let uncaptured = self.uncaptured.clone();
+        // The mapping settles a JavaScript promise: WebGPU's mapAsync resolves after control
+        // returns to the browser; WebGL2's (emulated) mapping settles on the poll below.
+        let settled = Rc::new(Cell::new(false));
+        let mapped = js_sys::Promise::new(&mut |resolve, reject| {
+            let settled = settled.clone();
+            buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+                settled.set(true);
+                match r {
+                    Ok(()) => drop(resolve.call0(&JsValue::NULL)),
+                    Err(e) => drop(reject.call1(
+                        &JsValue::NULL,
+                        &device_error(format!("read_frame: mapping the frame failed: {e}")),
+                    )),
+                }
+            });
+        });
+        let device = self.gpu.device.clone();
+        Ok(wasm_bindgen_futures::future_to_promise(async move {
+            // WebGL2 maps when a poll finds the GPU done (it cannot block), so poll between
+            // timer ticks until the mapping settles, for at most about a minute.
+            for _ in 0..60_000 {
+                let _ = device.poll(wgpu::PollType::Poll);
+                if settled.get() {
+                    break;
+                }
+                timer_tick().await;
+            }
+            if !settled.get() {
+                reading.set(false);
+                return Err(device_error(
+                    "read_frame: the frame's mapping did not settle within a minute",
+                ));
+            }
+            let done = wasm_bindgen_futures::JsFuture::from(mapped)
+                .await
+                .map_err(|e| match uncaptured.take() {
+                    Some(first) => device_error(format!("read_frame: wgpu: {first}")),
+                    None => e,
+                });
+            let pixels = done.and_then(|_| {
+                let bytes = buffer
+                    .slice(..)
+                    .get_mapped_range()
+                    .map_err(|e| device_error(format!("read_frame: {e}")))?
+                    .to_vec();
+                buffer.unmap();
+                Ok(layout.rgba8(&bytes, mode))
+            });
+            reading.set(false);
+            Ok(js_sys::Uint8Array::from(&pixels?[..]).into())
+        }))
     }
 
     /// Frames in the file.

@@ -18,8 +18,8 @@ const tonemap = params.get("tonemap") || "neutral";
 const $ = (id) => document.getElementById(id);
 const canvas = $("canvas");
 
-const state = { player: null, twin: null, frame: 0, playing: false, last: 0, ms: 0 };
-window.trisort = { state, ready: null, renderFrame, open, selfCheck, pixels, compare, setClip, step };
+const state = { player: null, twin: null, frame: 0, playing: false, last: 0, ms: 0, checks: Promise.resolve() };
+window.trisort = { state, ready: null, renderFrame, open, selfCheck, pixels, readFrame, compare, setClip, step };
 
 // The RGBA pixels of a canvas or image (a canvas copied in the same task as its draw, while
 // its drawing buffer holds the frame), and the 2D canvas holding the copy.
@@ -27,6 +27,18 @@ function pixels(source) {
   const ctx = new OffscreenCanvas(source.width, source.height).getContext("2d", { colorSpace: "srgb" });
   ctx.drawImage(source, 0, 0);
   return { data: ctx.getImageData(0, 0, source.width, source.height).data, canvas: ctx.canvas };
+}
+
+// Frame `frame` of `player` read back through a mapped buffer (WebPlayer.read_frame: the frame
+// as the native player converts it; a WebGPU canvas cannot be read back in every browser), and
+// a 2D canvas holding it.
+async function readFrame(frame, player = state.player) {
+  const [w, h] = [player.width(), player.height()];
+  const data = await player.read_frame(frame);
+  const image = new ImageData(new Uint8ClampedArray(data.buffer, data.byteOffset, data.length), w, h);
+  const ctx = new OffscreenCanvas(w, h).getContext("2d", { colorSpace: "srgb" });
+  ctx.putImageData(image, 0, 0);
+  return { data: image.data, canvas: ctx.canvas };
 }
 
 // Two same-sized RGBA arrays compared on colour: pixels differing at all, pixels differing by
@@ -44,16 +56,31 @@ function compare(a, b) {
 }
 
 // Frame `frame` as played and as the z-buffer twin draws it: the holes (pixels that differ)
-// and their largest channel difference.
+// and their largest channel difference. WebGL2 canvases are copied in the task that drew them;
+// on WebGPU both frames are read back through mapped buffers.
+// Checks run one after another (a WebGPU check waits for its reads).
 function selfCheck(frame) {
+  const run = state.checks.then(() => checkFrame(frame));
+  state.checks = run.catch(() => {});
+  return run;
+}
+
+async function checkFrame(frame) {
   if (!state.twin) throw new Error("open the page with ?selfcheck=1");
   const outer = !state.checking;
   state.checking = true;
   try {
+    const mapped = state.player.backend() === "WebGPU";
     const ms = renderFrame(frame);
-    const played = pixels($("canvas")).data;
-    state.twin.render(frame);
-    const { differing: holes, max } = compare(played, pixels($("twin")).data);
+    const played = mapped ? (await readFrame(frame)).data : pixels($("canvas")).data;
+    let twin;
+    if (mapped) {
+      twin = (await readFrame(frame, state.twin)).data;
+    } else {
+      state.twin.render(frame);
+      twin = pixels($("twin")).data;
+    }
+    const { differing: holes, max } = compare(played, twin);
     if (outer) $("figures").textContent = `${state.player.figures(frame, ms)} · ${holes} holes (self-check)`;
     return { frame, holes, max_channel_diff: max };
   } finally {
@@ -76,7 +103,7 @@ function renderFrame(frame) {
   $("scrub").value = String(frame);
   $("figures").textContent = p.figures(frame, state.ms);
   // With ?selfcheck=1 every frame shown is also checked (selfCheck writes the figures).
-  if (state.twin && !state.checking) selfCheck(frame);
+  if (state.twin && !state.checking) selfCheck(frame).catch(showError);
   return state.ms;
 }
 
