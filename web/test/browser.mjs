@@ -60,10 +60,16 @@ const browser = await chromium.launch({
   executablePath: a.chromium,
   headless: true,
   args: [
-    "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-    "--ignore-gpu-blocklist", "--enable-unsafe-webgpu", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
-    "--force-color-profile=srgb",
+    "--no-sandbox", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist", "--enable-unsafe-webgpu",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--no-first-run", "--disable-quic", "--force-color-profile=srgb",
+    // WebGL2 on ANGLE's SwiftShader GL. WebGPU (Dawn on SwiftShader's Vulkan) loses its device
+    // ("A valid external Instance reference no longer exists") the first time a frame goes to
+    // its canvas unless the GPU process runs Vulkan itself, without a Vulkan surface (tried on
+    // Chromium 156: with ANGLE's GL, --disable-gpu-compositing, --in-process-gpu, Vulkan alone).
+    ...(a.backend === "webgpu"
+      ? ["--enable-features=Vulkan", "--use-vulkan=swiftshader", "--use-angle=vulkan", "--disable-vulkan-surface"]
+      : ["--use-angle=swiftshader"]),
   ],
 });
 let failed = null;
@@ -107,7 +113,10 @@ try {
       const name = `frame-${String(frame).padStart(5, "0")}.png`;
       const t = window.trisort;
       const ms = t.renderFrame(frame);
-      const ours = t.pixels(document.getElementById("canvas"));
+      // WebGPU: read back through a mapped buffer (its canvas reads back blank here).
+      const ours = t.state.player.backend() === "WebGPU"
+        ? await t.readFrame(frame)
+        : t.pixels(document.getElementById("canvas"));
       const resp = await fetch(`/native/${name}`);
       if (!resp.ok) throw new Error(`native frame ${name}: HTTP ${resp.status}`);
       const bmp = await createImageBitmap(await resp.blob(), {

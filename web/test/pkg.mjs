@@ -6,11 +6,12 @@
 //
 // With --three, the same browser then opens three.html (three-app.mjs: `TrisortMesh` from
 // @trisort/player/three in three.js scenes, every frame of the file in the id-colour mode
-// checked against the z-buffer and against plain WebGL2) and adds what it found as "three".
+// checked against the z-buffer and against plain WebGL2) and adds what it found as "three":
+// --three-file (default --file) at --three-samples (default 0: one sample at the pixel centre).
 //
 //   node web/test/pkg.mjs --consumer web/test/pkg-consumer --dist web/dist --native DIR
 //        [--file demo.baked] [--bad-file truncated.baked] [--frame 0] [--backend webgl2]
-//        [--three yes]
+//        [--three yes [--three-file demo-1x.baked] [--three-samples 0]]
 import { createServer } from "node:http";
 import { readFile } from "node:fs/promises";
 import { extname, join, normalize } from "node:path";
@@ -69,11 +70,11 @@ try {
   });
   if (a.three) {
     const t0 = Date.now();
-    await page.goto(`http://127.0.0.1:${server.address().port}/three.html`);
+    await page.goto(`http://127.0.0.1:${server.address().port}/three.html?samples=${a["three-samples"] ?? 0}`);
     await page.waitForFunction(() => window.threeLoaded || null).catch((e) => {
       throw new Error(`the page did not load three.js and @trisort/player/three: ${e.message}\n${logs.join("\n")}`);
     });
-    result.three = await page.evaluate((o) => window.runThreeTest(o), { file: `/dist/${a.file}` });
+    result.three = await page.evaluate((o) => window.runThreeTest(o), { file: `/dist/${a["three-file"] ?? a.file}` });
     result.three.seconds = (Date.now() - t0) / 1000;
   }
   result.console_errors = logs.filter((l) => l.startsWith("error") || l.startsWith("pageerror"));

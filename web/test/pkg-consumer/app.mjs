@@ -50,11 +50,29 @@ window.runPackageTest = async ({ file, badFile, backend, native, frame }) => {
     if (d > 1) over1++;
     if (ours[i] + ours[i + 1] + ours[i + 2] > 0) lit++;
   }
+  // The same frame read back through a mapped buffer (readFrame): the native player's
+  // conversion of the off-screen frame, here compared with the canvas; a second read before the
+  // first settles is refused.
+  const reading = player.readFrame(frame);
+  const busy = await failure(() => player.readFrame(frame));
+  const read = await reading;
+  let readDiffers = 0, readOver1Native = 0;
+  for (let i = 0; i < read.length; i += 4) {
+    let d = 0, n = 0;
+    for (let c = 0; c < 3; c++) {
+      d = Math.max(d, Math.abs(read[i + c] - ours[i + c]));
+      n = Math.max(n, Math.abs(read[i + c] - theirs[i + c]));
+    }
+    if (d > 0) readDiffers++;
+    if (n > 1) readOver1Native++;
+  }
   const bad = await fetchBytes(badFile);
   const result = {
     backend: player.backend, frames: player.frameCount, width: player.width, height: player.height,
     clips: player.clips(), stats: player.frameStats(frame), ms, pixels: ours.length / 4,
     lit, over1_native: over1,
+    read_frame: { bytes: read.length, is_uint8array: read instanceof Uint8Array, differs_from_canvas: readDiffers,
+      over1_native: readOver1Native, busy },
     truncated: await failure(() => TrisortPlayer.open({ canvas: document.createElement("canvas"), data: bad, name: badFile, backend })),
     bad_option: await failure(() => TrisortPlayer.open({ canvas, data, backend: "vulkan" })),
     no_canvas: await failure(() => TrisortPlayer.open({ data })),

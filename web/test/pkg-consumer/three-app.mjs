@@ -1,10 +1,12 @@
 // The three.js integration as an app uses it (web/test/pkg.mjs drives it): `TrisortMesh`s in
 // three.js scenes drawn by the page's own WebGLRenderer, every frame of the demo bake, in the
 // flat id-colour mode (each triangle's id + 1 as RGB, 0 the background), checked
-//   1. against itself with the depth test: the sorted draw (blend: back to front, no depth
-//      test) against the z-buffer of every triangle of the file (depth mode, the file's
-//      z-buffer twin). A pixel covered in one and not the other, or showing a triangle the
-//      frame does not draw, is a hole; another triangle of the frame is an order error;
+//   1. against itself with the depth test, as the native self-check: the frame's window drawn
+//      depth-tested (depth mode) against its z-buffer twin (the window, then every triangle of
+//      the file, depth-tested): a pixel that differs is a hole (a triangle the frame leaves out
+//      is nearest there). The sorted draw (blend: back to front, no depth test) against the
+//      depth-tested draw: pixels that differ are order errors, or this rasterizer's depth
+//      test disagreeing with the order recorded on another;
 //   2. against plain WebGL2 in the page drawing the same id colours with the player's own
 //      draw ranges (the native player's commands, `frame_ranges`), one drawElements per range
 //      in order: the order three.js draws must match pixel for pixel.

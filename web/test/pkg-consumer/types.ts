@@ -11,13 +11,14 @@ export async function play(canvas: HTMLCanvasElement, data: Uint8Array): Promise
   try {
     const player = await TrisortPlayer.open(options);
     const ms: number = player.render(0);
+    const pixels: Uint8Array = await player.readFrame(0);
     const clips: Clip[] = player.clips();
     player.setClip(clips[0].name);
     const next: number = player.step(clips[0].first, -1);
     player.setVariant(null);
     const fps: number | undefined = player.fps;
     const rawWidth: number = player.raw.width();
-    const total = player.frameStats(next).triangles + ms + rawWidth + player.frameCount + (fps ?? 0);
+    const total = player.frameStats(next).triangles + ms + rawWidth + pixels.length + player.frameCount + (fps ?? 0);
     player.free();
     return total;
   } catch (e) {
