@@ -28,8 +28,9 @@ const MAX_SIDE: u32 = 16_384;
 /// or what is wrong with it.
 ///
 /// The header is checked first (identifier, a 2D image of at most [`MAX_SIDE`] texels a
-/// side, one layer, one face, at least one level) so that the transcoder never sizes work
-/// from a corrupt one; the transcoder checks every offset and length in the rest.
+/// side, one layer, one face, at most 32 levels, a `levelCount` of 0 read as 1) so that the
+/// transcoder never sizes work from a corrupt one; the transcoder checks every offset and
+/// length in the rest.
 pub(super) fn decode(bytes: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
     if !bytes.starts_with(&IDENTIFIER) {
         return Err("is not a KTX2 file (it does not start with the KTX2 identifier)".into());
@@ -59,7 +60,8 @@ pub(super) fn decode(bytes: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
     if levels > 32 {
         return Err(format!("KTX2 image claims {levels} mip levels"));
     }
-    let transcoder = Transcoder::new(bytes)
+    let bytes = one_level_at_least(bytes, levels);
+    let transcoder = Transcoder::new(&bytes)
         .map_err(|e| format!("is not a Basis Universal KTX2 file the transcoder reads: {e:?}"))?;
     let texels = transcoder
         .transcode(0, TargetFormat::Rgba32, DecodeFlags::NONE)
@@ -71,6 +73,19 @@ pub(super) fn decode(bytes: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
         ));
     }
     Ok((width, height, texels))
+}
+
+/// `bytes` as the transcoder reads them: a `levelCount` of 0 (KTX2 § 3.7: "generate the mip
+/// levels at load"; the file stores level 0 alone, with one level index entry) is read as 1,
+/// which the transcoder otherwise refuses as invalid data. trisort generates the chain from
+/// level 0 in any case.
+fn one_level_at_least(bytes: &[u8], levels: u32) -> std::borrow::Cow<'_, [u8]> {
+    if levels != 0 {
+        return std::borrow::Cow::Borrowed(bytes);
+    }
+    let mut one = bytes.to_vec();
+    one[40..44].copy_from_slice(&1u32.to_le_bytes());
+    std::borrow::Cow::Owned(one)
 }
 
 #[cfg(test)]
@@ -96,5 +111,22 @@ mod tests {
         set(&mut header, 36, 1);
         set(&mut header, 40, 1);
         assert!(decode(&header).unwrap_err().contains("transcoder"));
+        set(&mut header, 40, 33);
+        assert!(decode(&header).unwrap_err().contains("33 mip levels"));
+    }
+
+    #[test]
+    fn a_level_count_of_zero_is_read_as_one() {
+        let mut header = IDENTIFIER.to_vec();
+        header.resize(80, 7);
+        header[40..44].copy_from_slice(&0u32.to_le_bytes());
+        let read = one_level_at_least(&header, 0);
+        assert_eq!(read[40..44], 1u32.to_le_bytes());
+        assert_eq!(read[..40], header[..40]);
+        assert_eq!(read[44..], header[44..]);
+        assert!(matches!(
+            one_level_at_least(&header, 3),
+            std::borrow::Cow::Borrowed(_)
+        ));
     }
 }
