@@ -225,6 +225,51 @@ fn window_plays_frames_under_xvfb() {
     }
 }
 
+/// A file with BC7 textures: the window uploads its texture arrays as headless `play` does,
+/// as blocks where the device samples them (lavapipe does) and decoded to RGBA8 with
+/// `--decode-textures`, which shows what a device without the feature draws.
+#[test]
+fn window_uploads_textures_as_play_does_and_decodes_them_when_asked() {
+    if tools_missing(&["xvfb-run"]) {
+        eprintln!("skipping the texture upload window test: xvfb-run is not on PATH");
+        return;
+    }
+    let Some(dir) = gpu_tempdir() else {
+        return;
+    };
+    let d = dir.path();
+    let bake = "bake demo:400 --path orbit:frames=2 --size 48x32 --textures bc7 -o t.baked";
+    run(d, &args(bake), true);
+    for extra in [&[][..], &["--decode-textures"][..]] {
+        let mut headless = vec!["play", "t.baked", "--out-dir", "frames"];
+        headless.extend_from_slice(extra);
+        let played = run_json(d, &headless);
+        let mut window = vec![
+            "play",
+            "t.baked",
+            "--window",
+            "--window-frames",
+            "2",
+            "--json",
+        ];
+        window.extend_from_slice(extra);
+        let (code, stdout, stderr) = under_xvfb(d, &window, Duration::from_secs(120));
+        assert_eq!(code, Some(0), "{window:?}\n{stdout}\n--- stderr\n{stderr}");
+        let v: serde_json::Value = serde_json::from_str(&stdout)
+            .unwrap_or_else(|e| panic!("bad JSON ({e}): {stdout}\n--- stderr\n{stderr}"));
+        assert_eq!(
+            v["texture_upload"], played["texture_upload"],
+            "{extra:?}: {v}"
+        );
+        if !extra.is_empty() {
+            assert_eq!(
+                v["texture_upload"]["srgb"], "rgba8 (decoded from bc7)",
+                "{v}"
+            );
+        }
+    }
+}
+
 /// Without `--fps` the viewer plays at the path's rate, stored in the baked file.
 #[test]
 fn window_plays_at_the_baked_fps() {

@@ -24,6 +24,9 @@ pub struct OnScreenSettings {
     pub shading: trisort_gpu::Shading,
     /// Tone map ([`crate::PlayerConfig::tone_map`]).
     pub tone_map: trisort_gpu::ToneMap,
+    /// Upload block-compressed textures decoded ([`crate::PlayerConfig::decode_textures`]):
+    /// what a device without the format's compression feature shows.
+    pub decode_textures: bool,
 }
 
 impl OnScreenSettings {
@@ -35,6 +38,7 @@ impl OnScreenSettings {
             glass_opacity: None,
             shading: trisort_gpu::Shading::Pbr,
             tone_map: trisort_gpu::ToneMap::Neutral,
+            decode_textures: false,
         }
     }
 }
@@ -78,6 +82,7 @@ impl OnScreen {
             draw_path: DrawPath::for_device(&gpu.adapter, &gpu.device),
             shading: settings.shading,
             tone_map: settings.tone_map,
+            decode_textures: settings.decode_textures,
             ..PlayerConfig::for_adapter(baked, &gpu.adapter, COLOR_FORMAT)
         };
         let player = Player::new(&gpu.device, &gpu.queue, baked, config)?;

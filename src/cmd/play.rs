@@ -90,8 +90,8 @@ pub struct PlayArgs {
     strict_profile: bool,
     /// Upload block-compressed textures (a file baked with `--textures etc2|astc|bc7`) as
     /// their decoded RGBA8 texels even where the device samples the blocks: what a device
-    /// without the compression feature draws, and allocates, for comparison. `--json`'s
-    /// `texture_upload` says how each texture array was uploaded.
+    /// without the compression feature draws, and allocates, for comparison (headless or
+    /// `--window`). `--json`'s `texture_upload` says how each texture array was uploaded.
     #[arg(long)]
     decode_textures: bool,
     #[command(flatten)]
@@ -285,9 +285,6 @@ fn run_window(a: &PlayArgs) -> Result<ExitCode> {
             "--subpixel-offset and --self-check apply to headless playback, not --window"
         );
     }
-    if a.decode_textures {
-        anyhow::bail!("--decode-textures applies to headless playback, not --window");
-    }
     super::window::run(super::window::WindowArgs {
         baked: &a.baked,
         frames: a.frames,
@@ -302,6 +299,7 @@ fn run_window(a: &PlayArgs) -> Result<ExitCode> {
         exit_after: a.window_frames,
         json: a.json,
         strict_profile: a.strict_profile,
+        decode_textures: a.decode_textures,
     })
 }
 

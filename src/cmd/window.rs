@@ -48,6 +48,8 @@ pub struct WindowArgs<'a> {
     /// Refuse a device outside the bake's raster profile (`play --strict-profile`); without
     /// it, warn.
     pub strict_profile: bool,
+    /// Upload block-compressed textures decoded (`play --decode-textures`).
+    pub decode_textures: bool,
 }
 
 /// The viewer's lines go to stderr; its device is checked against the bake's raster profile
@@ -97,6 +99,7 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
         variant: a.variant,
         clip: a.clip,
         exit_after: a.exit_after,
+        decode_textures: a.decode_textures,
     };
     let session = Session::open(a.baked, options).map_err(cli_error)?;
     // --frames counts from the first frame of the clip started at (of the file without one).
@@ -121,6 +124,10 @@ pub fn run(a: WindowArgs<'_>) -> Result<ExitCode> {
             "clip": played.clip,
             "presented_frames": played.presented,
             "last_frame": played.last_frame,
+            "texture_upload": {
+                "srgb": played.texture_upload[0],
+                "linear": played.texture_upload[1],
+            },
         }));
     } else {
         println!(

@@ -68,6 +68,7 @@ pub(crate) fn run(
             glass_opacity: options.glass_opacity,
             shading: options.shading,
             tone_map: options.tone_map,
+            decode_textures: options.decode_textures,
         },
         period: Duration::from_secs_f64(1.0 / fps),
         fps,
@@ -110,6 +111,11 @@ pub(crate) fn run(
         variant: viewer.variant,
         fps: viewer.fps,
         presented: viewer.presented,
+        texture_upload: viewer.gfx.as_ref().map_or_else(Default::default, |g| {
+            (g.targets.player().texture_uploads())
+                .each_ref()
+                .map(|u| u.name())
+        }),
     })
 }
 

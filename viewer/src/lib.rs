@@ -69,6 +69,9 @@ pub struct ViewerOptions {
     pub clip: Option<String>,
     /// For tests and automation: quit after presenting this many frames.
     pub exit_after: Option<u64>,
+    /// Upload block-compressed textures decoded, as a device without their compression
+    /// feature does (`play --decode-textures`).
+    pub decode_textures: bool,
 }
 
 /// What the caller of [`Session::play`] provides: the check of the window's device, and where
@@ -104,6 +107,9 @@ pub struct Played {
     /// The frame shown last: counted from the first frame of [`Played::clip`], or the file's
     /// frame where no clip was selected.
     pub last_frame: u32,
+    /// How the sRGB and the linear material texture arrays were uploaded, as `play --json`
+    /// names them (`ArrayUpload::name` of trisort-gpu; empty if the window never opened).
+    pub texture_upload: [String; 2],
 }
 
 /// A baked file opened for the viewer, with its options checked; not yet a window.
