@@ -27,11 +27,11 @@
  *
  * Conventions, thread safety and lifetimes are the C API's (the top of trisort.h): a handle
  * may be read from several threads at once; an Error reads the calling thread's last error
- * right after the call that failed. Wrapped: the functions of ABI 4, and format_version()
- * and version_string() when the included trisort.h is of ABI 5 or later, Baked::clips() and
- * Baked::find_clip() when it is of ABI 6 or later. Not wrapped: the
- * `trisort_gpu_*` functions of ABI 5 (call them with Baked::get()) and writing ORDER files
- * (trisort_export_order(), libtrisort_export).
+ * right after the call that failed. Wrapped: the functions of ABI 4; format_version(),
+ * version_string() and the `trisort_gpu_*` functions (Baked::gpu_frame_uniform() and the
+ * rest, with the enums Shading, ToneMap and TextureArray) when the included trisort.h is of
+ * ABI 5 or later; Baked::clips() and Baked::find_clip() when it is of ABI 6 or later. Not
+ * wrapped: writing ORDER files (trisort_export_order(), libtrisort_export).
  *
  * @code
  * #include <trisort.hpp>
@@ -105,6 +105,32 @@ static_assert(static_cast<std::uint32_t>(DepthRange::ZeroToOne) ==
 static_assert(static_cast<std::uint32_t>(DepthRange::MinusOneToOne) ==
                   static_cast<std::uint32_t>(TRISORT_DEPTH_RANGE_MINUS_ONE_TO_ONE),
               "DepthRange follows trisort.h");
+
+#if TRISORT_ABI_VERSION >= 5
+/** A surface model, for Baked::gpu_lighting_uniform(): trisort.h's `TRISORT_SHADING_*`. */
+enum class Shading : std::uint32_t {
+    /** One light plus ambient, no tone map (what the exported GLSL ES shaders' basic path draws). */
+    Basic = TRISORT_SHADING_BASIC,
+    /** glTF metallic-roughness lit by the file's environment, tone mapped (the default). */
+    Pbr = TRISORT_SHADING_PBR,
+};
+
+/** A tone map of the `Pbr` model: trisort.h's `TRISORT_TONE_MAP_*`. */
+enum class ToneMap : std::uint32_t {
+    /** Khronos PBR Neutral (the default). */
+    Neutral = TRISORT_TONE_MAP_NEUTRAL,
+    /** ACES (Narkowicz's fit). */
+    Aces = TRISORT_TONE_MAP_ACES,
+};
+
+/** One of the two material texture arrays: trisort.h's `TRISORT_TEXTURE_ARRAY_*`. */
+enum class TextureArray : std::uint32_t {
+    /** Base colour and emissive textures, sRGB. */
+    Srgb = TRISORT_TEXTURE_ARRAY_SRGB,
+    /** Metallic-roughness, normal, occlusion and clearcoat textures, linear. */
+    Linear = TRISORT_TEXTURE_ARRAY_LINEAR,
+};
+#endif
 
 /**
  * A short English name of a status ("io", "out of range"...), for messages; "unknown status"
@@ -744,6 +770,87 @@ public:
                 return trisort_variant_materials(h_.get(), name.c_str(), o, c, l);
             });
     }
+
+#if TRISORT_ABI_VERSION >= 5
+    // What the player uploads, for a host drawing with `trisort export-shaders`' shaders
+    // (trisort.h's trisort_gpu_*; `max_texture_size` is the device's largest 2D texture,
+    // 0 for no limit).
+
+    /**
+     * Frame `frame`'s `Frame` uniform for an image of `width` × `height` (0, 0: the recorded
+     * size): TRISORT_GPU_FRAME_UNIFORM_SIZE bytes, std140.
+     */
+    result<std::vector<std::uint8_t>> gpu_frame_uniform(std::uint32_t frame,
+                                                        std::uint32_t width = 0,
+                                                        std::uint32_t height = 0) const {
+        return detail::copy<std::uint8_t>([&](std::uint8_t *o, std::size_t c, std::size_t *l) {
+            return trisort_gpu_frame_uniform(h_.get(), frame, width, height, o, c, l);
+        });
+    }
+
+    /** The `Lighting` uniform: TRISORT_GPU_LIGHTING_UNIFORM_SIZE bytes, std140. */
+    result<std::vector<std::uint8_t>> gpu_lighting_uniform(Shading shading = Shading::Pbr,
+                                                           ToneMap tone_map = ToneMap::Neutral,
+                                                           std::uint32_t max_texture_size = 0) const {
+        return detail::copy<std::uint8_t>([&](std::uint8_t *o, std::size_t c, std::size_t *l) {
+            return trisort_gpu_lighting_uniform(h_.get(), static_cast<std::uint32_t>(shading),
+                                                static_cast<std::uint32_t>(tone_map),
+                                                max_texture_size, o, c, l);
+        });
+    }
+
+    /**
+     * The material data texture's texels: RGBA32F, TRISORT_GPU_DATA_WIDTH texels a row
+     * (upload as TRISORT_GPU_DATA_WIDTH × size() / 4 / TRISORT_GPU_DATA_WIDTH).
+     */
+    result<std::vector<float>> gpu_material_texels(std::uint32_t max_texture_size = 0) const {
+        return detail::copy<float>([&](float *o, std::size_t c, std::size_t *l) {
+            return trisort_gpu_material_texels(h_.get(), max_texture_size, o, c, l);
+        });
+    }
+
+    /** The node data texture's texels: every frame's node matrices, RGBA32F, as above. */
+    result<std::vector<float>> gpu_node_texels() const {
+        return detail::copy<float>([&](float *o, std::size_t c, std::size_t *l) {
+            return trisort_gpu_node_texels(h_.get(), o, c, l);
+        });
+    }
+
+    /** The size of material texture array `array` as the player uploads it. */
+    result<TrisortGpuTexture> gpu_texture_array(TextureArray array,
+                                                std::uint32_t max_texture_size = 0) const {
+        return detail::store<TrisortGpuTexture>([&](TrisortGpuTexture *out) {
+            return trisort_gpu_texture_array(h_.get(), static_cast<std::uint32_t>(array),
+                                             max_texture_size, out);
+        });
+    }
+
+    /** Level `level` of layer `layer` of texture array `array`: RGBA8, rows top to bottom. */
+    result<std::vector<std::uint8_t>> gpu_texture_array_level(TextureArray array,
+                                                              std::uint32_t layer,
+                                                              std::uint32_t level,
+                                                              std::uint32_t max_texture_size = 0) const {
+        return detail::copy<std::uint8_t>([&](std::uint8_t *o, std::size_t c, std::size_t *l) {
+            return trisort_gpu_texture_array_level(h_.get(), static_cast<std::uint32_t>(array),
+                                                   layer, level, max_texture_size, o, c, l);
+        });
+    }
+
+    /** The size of the prefiltered environment as the player uploads it (`layers` 1). */
+    result<TrisortGpuTexture> gpu_environment(std::uint32_t max_texture_size = 0) const {
+        return detail::store<TrisortGpuTexture>([&](TrisortGpuTexture *out) {
+            return trisort_gpu_environment(h_.get(), max_texture_size, out);
+        });
+    }
+
+    /** Level `level` of that environment: RGBA binary16 bits (GL_RGBA16F, GL_HALF_FLOAT). */
+    result<std::vector<std::uint16_t>> gpu_environment_level(std::uint32_t level,
+                                                             std::uint32_t max_texture_size = 0) const {
+        return detail::copy<std::uint16_t>([&](std::uint16_t *o, std::size_t c, std::size_t *l) {
+            return trisort_gpu_environment_level(h_.get(), level, max_texture_size, o, c, l);
+        });
+    }
+#endif
 
 #if TRISORT_ABI_VERSION >= 6
     /** The file's clips (at least one), in file order: together they cover its frames. */

@@ -148,6 +148,7 @@ fn expected_report(path: &Path, frame: u32) -> Vec<(&'static str, String)> {
     };
     let mut fps = 0.0;
     assert_eq!(unsafe { trisort_fps(h, &mut fps) }, TrisortStatus::Ok);
+    let gpu = gpu_lines(h, frame);
     let report = vec![
         ("frames", info.frame_count.to_string()),
         (
@@ -181,11 +182,77 @@ fn expected_report(path: &Path, frame: u32) -> Vec<(&'static str, String)> {
         ("projection zero to one", projection(0)),
         ("projection minus one to one", projection(1)),
         ("node matrices", info.node_count.to_string()),
+        ("gpu frame uniform", gpu[0].clone()),
+        ("gpu lighting uniform", gpu[1].clone()),
+        ("gpu texels", gpu[2].clone()),
+        ("gpu srgb array", gpu[3].clone()),
+        ("gpu environment", gpu[4].clone()),
         ("clips", clips_line(h)),
         ("last clip found", "1".into()),
     ];
     unsafe { trisort_close(h) };
     report
+}
+
+/// Values copied out by a two-call `trisort_gpu_*` function.
+fn copied<T: Default + Clone>(
+    f: &mut dyn FnMut(*mut T, usize, *mut usize) -> TrisortStatus,
+) -> Vec<T> {
+    let mut len = 0;
+    assert_eq!(f(null_mut(), 0, &mut len), TrisortStatus::Ok);
+    let mut v = vec![T::default(); len];
+    assert_eq!(f(v.as_mut_ptr(), len, &mut len), TrisortStatus::Ok);
+    v
+}
+
+/// The example's `gpu …` lines for frame `frame` of the file open as `h`, read through the
+/// C API (what the player uploads: uniforms, data textures, texture arrays, environment).
+fn gpu_lines(h: *const TrisortBaked, frame: u32) -> [String; 5] {
+    let sum = |v: &[u8]| v.iter().map(|&b| u64::from(b)).sum::<u64>();
+    let frame_uniform =
+        copied(&mut |o, c, l| unsafe { trisort_gpu_frame_uniform(h, frame, 0, 0, o, c, l) });
+    let lighting = copied(&mut |o, c, l| unsafe {
+        trisort_gpu_lighting_uniform(h, TRISORT_SHADING_PBR, TRISORT_TONE_MAP_NEUTRAL, 0, o, c, l)
+    });
+    let materials = copied(&mut |o, c, l| unsafe { trisort_gpu_material_texels(h, 0, o, c, l) });
+    let nodes = copied(&mut |o, c, l| unsafe { trisort_gpu_node_texels(h, o, c, l) });
+    let mut srgb = TrisortGpuTexture::default();
+    let s = unsafe { trisort_gpu_texture_array(h, TRISORT_TEXTURE_ARRAY_SRGB, 0, &mut srgb) };
+    assert_eq!(s, TrisortStatus::Ok);
+    let level0 = copied(&mut |o, c, l| unsafe {
+        trisort_gpu_texture_array_level(h, TRISORT_TEXTURE_ARRAY_SRGB, 0, 0, 0, o, c, l)
+    });
+    let mut env = TrisortGpuTexture::default();
+    assert_eq!(
+        unsafe { trisort_gpu_environment(h, 0, &mut env) },
+        TrisortStatus::Ok
+    );
+    let env0 = copied(&mut |o, c, l| unsafe { trisort_gpu_environment_level(h, 0, 0, o, c, l) });
+    [
+        format!("{} bytes, sum {}", frame_uniform.len(), sum(&frame_uniform)),
+        format!("{} bytes, sum {}", lighting.len(), sum(&lighting)),
+        format!(
+            "{} material floats, {} node floats",
+            materials.len(),
+            nodes.len()
+        ),
+        format!(
+            "{}x{}, {} layers, {} levels; level 0: {} bytes, sum {}",
+            srgb.width,
+            srgb.height,
+            srgb.layers,
+            srgb.levels,
+            level0.len(),
+            sum(&level0)
+        ),
+        format!(
+            "{}x{}, {} levels; level 0: {} halves",
+            env.width,
+            env.height,
+            env.levels,
+            env0.len()
+        ),
+    ]
 }
 
 /// The example's `clips` line for the file open as `h`, read through the C API: the count,

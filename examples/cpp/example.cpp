@@ -39,6 +39,15 @@ struct Report {
     trisort::Matrix projection_zero_to_one{};
     trisort::Matrix projection_minus_one_to_one{};
     std::size_t node_matrix_count = 0;
+    // What the player uploads (for a host drawing with `trisort export-shaders`' shaders).
+    std::vector<std::uint8_t> gpu_frame_uniform;     // frame `frame`, at the recorded size
+    std::vector<std::uint8_t> gpu_lighting_uniform;  // PBR, neutral tone map
+    std::size_t gpu_material_floats = 0;
+    std::size_t gpu_node_floats = 0;
+    TrisortGpuTexture gpu_srgb{};
+    std::vector<std::uint8_t> gpu_srgb_level0;  // layer 0
+    TrisortGpuTexture gpu_environment{};
+    std::size_t gpu_environment_level0 = 0;     // binary16 values
 #if TRISORT_ABI_VERSION >= 6
     std::vector<trisort::Clip> clips;
     std::uint32_t last_clip_found = 0;  // find_clip() of the last clip's name
@@ -98,6 +107,14 @@ Report collect(const std::string &path, std::uint32_t frame) {
     r.projection_minus_one_to_one =
         baked.frame_projection(frame, aspect, trisort::DepthRange::MinusOneToOne);
     r.node_matrix_count = baked.frame_node_matrices(frame, true).size();
+    r.gpu_frame_uniform = baked.gpu_frame_uniform(frame);
+    r.gpu_lighting_uniform = baked.gpu_lighting_uniform(trisort::Shading::Pbr);
+    r.gpu_material_floats = baked.gpu_material_texels().size();
+    r.gpu_node_floats = baked.gpu_node_texels().size();
+    r.gpu_srgb = baked.gpu_texture_array(trisort::TextureArray::Srgb);
+    r.gpu_srgb_level0 = baked.gpu_texture_array_level(trisort::TextureArray::Srgb, 0, 0);
+    r.gpu_environment = baked.gpu_environment();
+    r.gpu_environment_level0 = baked.gpu_environment_level(0).size();
 #if TRISORT_ABI_VERSION >= 6
     r.clips = baked.clips();
     r.last_clip_found = baked.find_clip(r.clips.back().name);
@@ -173,6 +190,22 @@ trisort::expected<Report> collect(const std::string &path, std::uint32_t frame) 
     r.projection_minus_one_to_one = *minus_one_to_one;
     EXAMPLE_TRY(nodes, baked.frame_node_matrices(frame, true));
     r.node_matrix_count = nodes->size();
+    EXAMPLE_TRY(frame_uniform, baked.gpu_frame_uniform(frame));
+    r.gpu_frame_uniform = *frame_uniform;
+    EXAMPLE_TRY(lighting, baked.gpu_lighting_uniform(trisort::Shading::Pbr));
+    r.gpu_lighting_uniform = *lighting;
+    EXAMPLE_TRY(material_texels, baked.gpu_material_texels());
+    r.gpu_material_floats = material_texels->size();
+    EXAMPLE_TRY(node_texels, baked.gpu_node_texels());
+    r.gpu_node_floats = node_texels->size();
+    EXAMPLE_TRY(srgb, baked.gpu_texture_array(trisort::TextureArray::Srgb));
+    r.gpu_srgb = *srgb;
+    EXAMPLE_TRY(srgb_level0, baked.gpu_texture_array_level(trisort::TextureArray::Srgb, 0, 0));
+    r.gpu_srgb_level0 = *srgb_level0;
+    EXAMPLE_TRY(gpu_environment, baked.gpu_environment());
+    r.gpu_environment = *gpu_environment;
+    EXAMPLE_TRY(environment_level0, baked.gpu_environment_level(0));
+    r.gpu_environment_level0 = environment_level0->size();
 #if TRISORT_ABI_VERSION >= 6
     EXAMPLE_TRY(clips, baked.clips());
     r.clips = std::move(*clips);
@@ -273,6 +306,25 @@ bool print(const std::string &path, const Report &r) {
     print_matrix("projection zero to one", r.projection_zero_to_one);
     print_matrix("projection minus one to one", r.projection_minus_one_to_one);
     std::cout << "node matrices: " << r.node_matrix_count << '\n';
+    const auto byte_sum = [](const std::vector<std::uint8_t> &v) {
+        std::uint64_t total = 0;
+        for (std::uint8_t b : v) {
+            total += b;
+        }
+        return total;
+    };
+    std::cout << "gpu frame uniform: " << r.gpu_frame_uniform.size() << " bytes, sum "
+              << byte_sum(r.gpu_frame_uniform) << '\n';
+    std::cout << "gpu lighting uniform: " << r.gpu_lighting_uniform.size() << " bytes, sum "
+              << byte_sum(r.gpu_lighting_uniform) << '\n';
+    std::cout << "gpu texels: " << r.gpu_material_floats << " material floats, "
+              << r.gpu_node_floats << " node floats\n";
+    std::cout << "gpu srgb array: " << r.gpu_srgb.width << 'x' << r.gpu_srgb.height << ", "
+              << r.gpu_srgb.layers << " layers, " << r.gpu_srgb.levels << " levels; level 0: "
+              << r.gpu_srgb_level0.size() << " bytes, sum " << byte_sum(r.gpu_srgb_level0) << '\n';
+    std::cout << "gpu environment: " << r.gpu_environment.width << 'x'
+              << r.gpu_environment.height << ", " << r.gpu_environment.levels
+              << " levels; level 0: " << r.gpu_environment_level0 << " halves\n";
 #if TRISORT_ABI_VERSION >= 6
     // A clip plays the file's frames first .. first + count - 1.
     std::cout << "clips: " << r.clips.size();
