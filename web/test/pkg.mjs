@@ -4,6 +4,9 @@
 // the options object, one frame drawn and compared with the native player's, the typed errors
 // provoked) and prints what it found as JSON. The caller gates.
 //
+// With --webgpu, a second Chromium with WebGPU kept (browser.mjs's flags) opens the page again
+// and plays frame 0 through `backend: "webgpu"`, read back with readFrame ("webgpu_run").
+//
 // With --three, the same browser then opens three.html (three-app.mjs: `TrisortMesh` from
 // @trisort/player/three in three.js scenes, every frame of the file in the id-colour mode
 // checked against the z-buffer and against plain WebGL2) and adds what it found as "three":
@@ -11,7 +14,7 @@
 //
 //   node web/test/pkg.mjs --consumer web/test/pkg-consumer --dist web/dist --native DIR
 //        [--file demo.baked] [--bad-file truncated.baked] [--frame 0] [--backend webgl2]
-//        [--three yes [--three-file demo-1x.baked] [--three-samples 0]]
+//        [--webgpu yes] [--three yes [--three-file demo-1x.baked] [--three-samples 0]]
 import { createServer } from "node:http";
 import { readFile } from "node:fs/promises";
 import { extname, join, normalize } from "node:path";
@@ -68,6 +71,30 @@ try {
     file: `/dist/${a.file}`, badFile: `/dist/${a["bad-file"]}`, backend: a.backend, frame,
     native: `/native/frame-${String(frame).padStart(5, "0")}.png`,
   });
+  // The package on WebGPU: Chromium again, with the flags that keep a WebGPU device in this
+  // headless browser (web/test/browser.mjs says why), the page opened afresh.
+  if (a.webgpu) {
+    const gpuBrowser = await chromium.launch({
+      executablePath: a.chromium, headless: true,
+      args: ["--no-sandbox", "--enable-unsafe-swiftshader", "--enable-unsafe-webgpu",
+        "--enable-features=Vulkan", "--use-vulkan=swiftshader", "--use-angle=vulkan",
+        "--disable-vulkan-surface", "--disable-background-networking", "--disable-component-update",
+        "--disable-sync", "--no-first-run", "--force-color-profile=srgb"],
+    });
+    try {
+      const gpuPage = await gpuBrowser.newPage({ viewport: { width: 600, height: 600 }, deviceScaleFactor: 1 });
+      gpuPage.setDefaultTimeout(120_000);
+      gpuPage.on("console", (m) => logs.push(`${m.type()}: ${m.text()}`));
+      gpuPage.on("pageerror", (e) => logs.push(`pageerror: ${e.message}`));
+      await gpuPage.goto(`http://127.0.0.1:${server.address().port}/`);
+      await gpuPage.waitForFunction(() => window.packageLoaded || null);
+      result.webgpu_run = await gpuPage.evaluate((o) => window.runWebGpuTest(o), {
+        file: `/dist/${a.file}`, frame, native: `/native/frame-${String(frame).padStart(5, "0")}.png`,
+      });
+    } finally {
+      await gpuBrowser.close();
+    }
+  }
   if (a.three) {
     const t0 = Date.now();
     await page.goto(`http://127.0.0.1:${server.address().port}/three.html?samples=${a["three-samples"] ?? 0}`);

@@ -69,7 +69,7 @@ printf '{ "name": "trisort-pkg-consumer", "private": true, "type": "module",\n  
 "$trisort" bake demo --path demo --size 256x256 --samples 1 --raster-profile browser \
   -o web/dist/demo-1x.baked >/dev/null 2>"$out/demo-1x-bake.log"
 node web/test/pkg.mjs --consumer "$consumer" --dist web/dist --native "$out/native" \
-  --bad-file truncated.baked --three yes --three-file demo-1x.baked > "$out/package.json"
+  --bad-file truncated.baked --webgpu yes --three yes --three-file demo-1x.baked > "$out/package.json"
 node - "$out/package.json" "${TRISORT_WEB_MAX_OVER1_NATIVE:-0.0125}" "$frames" <<'JS'
 const fs = require("fs");
 const r = JSON.parse(fs.readFileSync(process.argv[2], "utf8"));
@@ -96,6 +96,14 @@ if (!rf || rf.bytes !== 4 * r.pixels || !rf.is_uint8array) bad.push(`readFrame: 
 else {
   if (rf.over1_native > maxOver1 * r.pixels) bad.push(`readFrame differs from the native player in ${rf.over1_native} pixels by more than 1/255`);
   if (!is(rf.busy, "TrisortOptionError", "option")) bad.push(`a second readFrame while one is pending: ${JSON.stringify(rf.busy)}`);
+}
+// The package on WebGPU (a Chromium with WebGPU kept): frame 0 through readFrame, within the
+// same gate of the native frame.
+const wg = r.webgpu_run;
+if (!wg || wg.backend !== "WebGPU" || wg.bytes !== 4 * wg.pixels || wg.lit === 0) {
+  bad.push(`the package did not play on WebGPU: ${JSON.stringify(wg)}`);
+} else if (wg.over1_native > maxOver1 * wg.pixels) {
+  bad.push(`WebGPU frame 0 differs from the native player in ${wg.over1_native} pixels by more than 1/255`);
 }
 if (!r.format_is_class || !r.option_is_class) bad.push("the error classes do not extend TrisortError");
 if (r.console_errors.length) bad.push(`console errors: ${r.console_errors.join("; ")}`);
@@ -138,7 +146,8 @@ console.log(`three.js ${t.three}: TrisortMesh = plain WebGL2 of the player's ran
 console.log(`  per frame order errors: ${t.frames.map((f) => `${f.frame}:${f.order_errors}`).join(" ")}`);
 console.log(`package test: @trisort/player installed from its tarball plays ${r.frames} frames on ${r.backend} ` +
   `(frame 0: ${r.over1_native} px over 1/255 from native; readFrame ${rf.over1_native}, ` +
-  `${rf.differs_from_canvas} px differ from the canvas); TrisortFormatError: ${r.truncated.message}`);
+  `${rf.differs_from_canvas} px differ from the canvas; on WebGPU ${r.webgpu_run.over1_native}); ` +
+  `TrisortFormatError: ${r.truncated.message}`);
 JS
 # Exit 3 means "verified and some frame failed the recorded pattern's tolerance": expected on
 # another rasterizer; the gate below reads the figures instead.

@@ -87,4 +87,32 @@ window.runPackageTest = async ({ file, badFile, backend, native, frame }) => {
   player.free();
   return result;
 };
+// The package on WebGPU (pkg.mjs opens this page again in a Chromium started with WebGPU):
+// `backend: "webgpu"`, frame `frame` read back with readFrame (a WebGPU canvas is not read)
+// and compared with the native player's PNG.
+window.runWebGpuTest = async ({ file, native, frame }) => {
+  const data = await fetchBytes(file);
+  const player = await TrisortPlayer.open({
+    canvas: document.getElementById("canvas"), data, name: file, backend: "webgpu",
+  });
+  player.render(frame);
+  const read = await player.readFrame(frame);
+  const bmp = await createImageBitmap(await (await fetch(native)).blob(), {
+    colorSpaceConversion: "none", premultiplyAlpha: "none",
+  });
+  const theirs = pixels(bmp);
+  let over1 = 0, lit = 0;
+  for (let i = 0; i < read.length; i += 4) {
+    let d = 0;
+    for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(read[i + c] - theirs[i + c]));
+    if (d > 1) over1++;
+    if (read[i] + read[i + 1] + read[i + 2] > 0) lit++;
+  }
+  const result = {
+    backend: player.backend, adapter: player.adapter, bytes: read.length,
+    pixels: player.width * player.height, lit, over1_native: over1,
+  };
+  player.free();
+  return result;
+};
 window.packageLoaded = true;
