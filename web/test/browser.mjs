@@ -63,10 +63,11 @@ const browser = await chromium.launch({
     "--no-sandbox", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist", "--enable-unsafe-webgpu",
     "--disable-background-networking", "--disable-component-update", "--disable-sync",
     "--no-first-run", "--disable-quic", "--force-color-profile=srgb",
-    // WebGL2 on ANGLE's SwiftShader GL. WebGPU (Dawn on SwiftShader's Vulkan) loses its device
-    // ("A valid external Instance reference no longer exists") the first time a frame goes to
-    // its canvas unless the GPU process runs Vulkan itself, without a Vulkan surface (tried on
-    // Chromium 156: with ANGLE's GL, --disable-gpu-compositing, --in-process-gpu, Vulkan alone).
+    // WebGL2 on ANGLE over SwiftShader (`--use-angle=swiftshader`). WebGPU (Dawn on
+    // SwiftShader's Vulkan) loses its device ("A valid external Instance reference no longer
+    // exists") the first time a frame goes to its canvas unless the GPU process runs Vulkan
+    // itself, without a Vulkan surface (tried on Chromium 156: the WebGL2 flags,
+    // --disable-gpu-compositing, --in-process-gpu, Vulkan without the other two flags).
     ...(a.backend === "webgpu"
       ? ["--enable-features=Vulkan", "--use-vulkan=swiftshader", "--use-angle=vulkan", "--disable-vulkan-surface"]
       : ["--use-angle=swiftshader"]),
