@@ -70,13 +70,7 @@ fn play_samples_bc7_blocks_and_inspect_budgets_them_both_ways() {
             "frame {f}: native and decoded BC7 differ by {diff}/255"
         );
     }
-    // --decode-textures is for headless playback.
-    let out = run(
-        d,
-        &["play", "x.baked", "--window", "--decode-textures"],
-        false,
-    );
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--decode-textures"));
+    // `play --window --decode-textures`: tests/window_cli.rs (under Xvfb).
 }
 
 /// `bake --textures etc2|bc7`: the file stores blocks (smaller textures, `--json` `textures`
