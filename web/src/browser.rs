@@ -1,6 +1,6 @@
 //! The wasm side: [`WebPlayer`], exported to the page with wasm-bindgen.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::path::Path;
 use std::rc::Rc;
 
@@ -24,9 +24,6 @@ fn start() {
 /// drawing into its off-screen frame, copied to the canvas each [`WebPlayer::render`].
 #[wasm_bindgen]
 pub struct WebPlayer {
-    /// Kept while the player lives: Chromium aborts a WebGPU buffer mapping ("a valid external
-    /// Instance reference no longer exists") once the instance that made the device is gone.
-    _instance: wgpu::Instance,
     gpu: Gpu,
     surface: wgpu::Surface<'static>,
     surface_config: wgpu::SurfaceConfiguration,
@@ -45,6 +42,9 @@ pub struct WebPlayer {
     /// Whether a [`WebPlayer::read_frame`] is waiting for its mapping.
     reading: Rc<Cell<bool>>,
 }
+
+/// Longest a [`WebPlayer::read_frame`] waits for its mapping, in milliseconds.
+const READ_TIMEOUT_MS: f64 = 60_000.0;
 
 /// Resolves on the browser's next timer tick (`setTimeout(…, 1)`; at once where there is no
 /// `setTimeout`).
@@ -157,7 +157,6 @@ impl WebPlayer {
         let fps = baked.fps;
         let robust = baked.settings.robust;
         Ok(WebPlayer {
-            _instance: instance,
             gpu,
             surface,
             surface_config: setup.config,
@@ -213,9 +212,10 @@ impl WebPlayer {
     /// Draws frame `frame` off-screen and resolves to its pixels, read back through a mapped
     /// buffer: a `Uint8Array` of `width × height` RGBA texels, rows top to bottom, 8-bit sRGB
     /// with alpha 255, converted from the frame as the native player converts it for its PNGs
-    /// (`trisort play`). The canvas is untouched. WebGPU gives no way to read a canvas back
-    /// that works everywhere (a headless browser's reads come back blank); this works on
-    /// both backends. One read at a time: a second call before the first settles is refused.
+    /// (`trisort play`). The canvas is untouched, so this works where a canvas cannot be read
+    /// back (a WebGPU canvas after its frame was presented, or a headless browser that lost
+    /// the canvas's device), on both backends. One read at a time: a second call before the
+    /// first settles is refused.
     pub fn read_frame(&mut self, frame: u32) -> Result<js_sys::Promise, JsValue> {
         if self.reading.get() {
             return Err(option_error(
@@ -254,58 +254,45 @@ impl WebPlayer {
         }
         self.reading.set(true);
         let reading = self.reading.clone();
-        // WebGPU reports a bad copy later, on the device; a failed mapping names it.
         let uncaptured = self.uncaptured.clone();
-        // The mapping settles a JavaScript promise: WebGPU's mapAsync resolves after control
-        // returns to the browser; WebGL2's (emulated) mapping settles on the poll below.
-        let settled = Rc::new(Cell::new(false));
-        let mapped = js_sys::Promise::new(&mut |resolve, reject| {
-            let settled = settled.clone();
-            buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-                settled.set(true);
-                match r {
-                    Ok(()) => drop(resolve.call0(&JsValue::NULL)),
-                    Err(e) => drop(reject.call1(
-                        &JsValue::NULL,
-                        &device_error(format!("read_frame: mapping the frame failed: {e}")),
-                    )),
-                }
-            });
-        });
+        // The mapping's outcome, set by its callback: WebGPU's mapAsync settles after control
+        // returns to the browser, WebGL2's (emulated) one on a poll that finds the GPU done.
+        let outcome = Rc::new(RefCell::new(None));
+        let slot = outcome.clone();
+        buffer
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |r| *slot.borrow_mut() = Some(r));
         let device = self.gpu.device.clone();
         Ok(wasm_bindgen_futures::future_to_promise(async move {
-            // WebGL2 maps when a poll finds the GPU done (it cannot block), so poll between
-            // timer ticks until the mapping settles, for at most about a minute.
-            for _ in 0..60_000 {
+            // WebGL2 cannot block, so poll between timer ticks until the mapping settles.
+            let deadline = js_sys::Date::now() + READ_TIMEOUT_MS;
+            while outcome.borrow().is_none() && js_sys::Date::now() < deadline {
                 let _ = device.poll(wgpu::PollType::Poll);
-                if settled.get() {
-                    break;
+                if outcome.borrow().is_none() {
+                    timer_tick().await;
                 }
-                timer_tick().await;
             }
-            if !settled.get() {
-                reading.set(false);
-                return Err(device_error(
-                    "read_frame: the frame's mapping did not settle within a minute",
-                ));
-            }
-            let done = wasm_bindgen_futures::JsFuture::from(mapped)
-                .await
-                .map_err(|e| match uncaptured.take() {
-                    Some(first) => device_error(format!("read_frame: wgpu: {first}")),
-                    None => e,
-                });
-            let pixels = done.and_then(|_| {
-                let bytes = buffer
-                    .slice(..)
-                    .get_mapped_range()
-                    .map_err(|e| device_error(format!("read_frame: {e}")))?
-                    .to_vec();
-                buffer.unmap();
-                Ok(layout.rgba8(&bytes, mode))
-            });
+            let settled = outcome.borrow_mut().take();
             reading.set(false);
-            Ok(js_sys::Uint8Array::from(&pixels?[..]).into())
+            match settled {
+                None => Err(device_error(
+                    "read_frame: the frame's mapping did not settle within a minute",
+                )),
+                Some(Err(e)) => Err(device_error(match uncaptured.take() {
+                    // WebGPU reports a bad copy later, on the device: name it.
+                    Some(first) => format!("read_frame: wgpu: {first}"),
+                    None => format!("read_frame: mapping the frame failed: {e}"),
+                })),
+                Some(Ok(())) => {
+                    let bytes = buffer
+                        .slice(..)
+                        .get_mapped_range()
+                        .map_err(|e| device_error(format!("read_frame: {e}")))?
+                        .to_vec();
+                    buffer.unmap();
+                    Ok(js_sys::Uint8Array::from(&layout.rgba8(&bytes, mode)[..]).into())
+                }
+            }
         }))
     }
 
