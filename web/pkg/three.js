@@ -85,13 +85,13 @@ export class TrisortMesh extends THREE.Mesh {
     const bake = this.bake;
     const g = new THREE.BufferGeometry();
     const indices = bake.indices(this.backToFront);
-    const pos = bake.positions(), nrm = bake.normals(), uv = bake.uvs();
+    const pos = bake.positions();
     const node = Float32Array.from(bake.vertexNodes());
     const mat = Float32Array.from(bake.vertexMaterials());
     if (!this.idColors) {
       g.setAttribute("position", new THREE.BufferAttribute(pos, 3));
-      g.setAttribute("normal", new THREE.BufferAttribute(nrm, 3));
-      g.setAttribute("uv", new THREE.BufferAttribute(uv, 2));
+      g.setAttribute("normal", new THREE.BufferAttribute(bake.normals(), 3));
+      g.setAttribute("uv", new THREE.BufferAttribute(bake.uvs(), 2));
       g.setAttribute("trisortNode", new THREE.BufferAttribute(node, 1));
       g.setAttribute("trisortMaterial", new THREE.BufferAttribute(mat, 1));
       const small = bake.vertexCount <= 65536;
@@ -243,12 +243,14 @@ void main() {
     if (!(frame >= 0 && frame < bake.frameCount)) {
       throw new TrisortOptionError(`frame ${frame} is outside 0..${bake.frameCount - 1}`);
     }
+    // The frame shown already: its matrices are uploaded (render loops call this each tick).
+    if (frame === this.frame) return this;
     this.frame = frame;
     const nodes = this.uniforms.trisortNodes.value;
     nodes.image.data.set(bake.nodeViewMatrices(frame));
     nodes.needsUpdate = true;
     // wgpu's clip depth [0, 1] to WebGL's [-1, 1]: z' = 2z - w (x, y and w unchanged).
-    const p = Float32Array.from(bake.projection(frame));
+    const p = bake.projection(frame);  // a fresh Float32Array
     for (let c = 0; c < 4; c++) p[4 * c + 2] = Math.fround(2 * p[4 * c + 2] - p[4 * c + 3]);
     this.uniforms.trisortProjection.value.fromArray(p);
     const cam = this.camera;

@@ -18,6 +18,19 @@ function pixels(source) {
   return ctx.getImageData(0, 0, source.width, source.height).data;
 }
 
+// Two same-sized RGBA arrays: pixels differing at all, by more than 1/255, and lit in `a`.
+function compare(a, b) {
+  let differing = 0, over1 = 0, lit = 0;
+  for (let i = 0; i < a.length; i += 4) {
+    let d = 0;
+    for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(a[i + c] - b[i + c]));
+    if (d > 0) differing++;
+    if (d > 1) over1++;
+    if (a[i] + a[i + 1] + a[i + 2] > 0) lit++;
+  }
+  return { differing, over1, lit };
+}
+
 // How `promise` (or function) fails: its class, code and message; null when it does not.
 async function failure(f) {
   try {
@@ -43,29 +56,15 @@ window.runPackageTest = async ({ file, badFile, backend, native, frame }) => {
     colorSpaceConversion: "none", premultiplyAlpha: "none",
   });
   const theirs = pixels(bmp);
-  let over1 = 0, lit = 0;
-  for (let i = 0; i < ours.length; i += 4) {
-    let d = 0;
-    for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(ours[i + c] - theirs[i + c]));
-    if (d > 1) over1++;
-    if (ours[i] + ours[i + 1] + ours[i + 2] > 0) lit++;
-  }
+  const { over1, lit } = compare(ours, theirs);
   // The same frame read back through a mapped buffer (readFrame): the native player's
   // conversion of the off-screen frame, here compared with the canvas; a second read before the
   // first settles is refused.
   const reading = player.readFrame(frame);
   const busy = await failure(() => player.readFrame(frame));
   const read = await reading;
-  let readDiffers = 0, readOver1Native = 0;
-  for (let i = 0; i < read.length; i += 4) {
-    let d = 0, n = 0;
-    for (let c = 0; c < 3; c++) {
-      d = Math.max(d, Math.abs(read[i + c] - ours[i + c]));
-      n = Math.max(n, Math.abs(read[i + c] - theirs[i + c]));
-    }
-    if (d > 0) readDiffers++;
-    if (n > 1) readOver1Native++;
-  }
+  const readDiffers = compare(read, ours).differing;
+  const readOver1Native = compare(read, theirs).over1;
   const bad = await fetchBytes(badFile);
   const result = {
     backend: player.backend, frames: player.frameCount, width: player.width, height: player.height,
@@ -100,14 +99,7 @@ window.runWebGpuTest = async ({ file, native, frame }) => {
   const bmp = await createImageBitmap(await (await fetch(native)).blob(), {
     colorSpaceConversion: "none", premultiplyAlpha: "none",
   });
-  const theirs = pixels(bmp);
-  let over1 = 0, lit = 0;
-  for (let i = 0; i < read.length; i += 4) {
-    let d = 0;
-    for (let c = 0; c < 3; c++) d = Math.max(d, Math.abs(read[i + c] - theirs[i + c]));
-    if (d > 1) over1++;
-    if (read[i] + read[i + 1] + read[i + 2] > 0) lit++;
-  }
+  const { over1, lit } = compare(read, pixels(bmp));
   const result = {
     backend: player.backend, adapter: player.adapter, bytes: read.length,
     pixels: player.width * player.height, lit, over1_native: over1,
