@@ -22,10 +22,21 @@ use rayon::prelude::*;
 use trisort_format::gpu_layout::tiled;
 use trisort_format::{BlockFormat, Geometry, Texture, TextureBlocks};
 
+impl From<BlockFormat> for TextureFormat {
+    /// The `--textures` value that stores blocks of `format`.
+    fn from(format: BlockFormat) -> TextureFormat {
+        match format {
+            BlockFormat::Etc2Rgb8 | BlockFormat::Etc2Rgba8 => TextureFormat::Etc2,
+            BlockFormat::Astc4x4 => TextureFormat::Astc,
+            BlockFormat::Bc7 => TextureFormat::Bc7,
+        }
+    }
+}
+
 /// Why `--textures astc` is refused by a trisort built without the `astc` feature.
 pub const ASTC_MISSING: &str = "this trisort was built without ASTC encoding: install it with \
-     `cargo install --path . --features astc` (ARM's astcenc, C++, about two minutes more to \
-     build); etc2 and bc7 need nothing more";
+     `cargo install --path . --features astc` (ARM's astcenc, C++ compiled \
+     from source); etc2 and bc7 need nothing more";
 
 /// What `--textures` asks for.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -233,11 +244,7 @@ pub fn adopt_stored(
             baked.textures.len()
         ));
     }
-    let format = match first.format {
-        BlockFormat::Etc2Rgb8 | BlockFormat::Etc2Rgba8 => TextureFormat::Etc2,
-        BlockFormat::Astc4x4 => TextureFormat::Astc,
-        BlockFormat::Bc7 => TextureFormat::Bc7,
-    };
+    let format = TextureFormat::from(first.format);
     let alpha = scene.alpha_decides_visibility();
     let mut textures = Vec::new();
     for (i, (s, b)) in scene.textures.iter_mut().zip(&baked.textures).enumerate() {
@@ -310,17 +317,11 @@ fn compress_one(
     if format == TextureFormat::Rgba8 || t.blocks.is_some() {
         return outcome;
     }
-    let keep = |outcome: &mut TextureOutcome, why: String| {
-        outcome.kept_because = Some(why);
-    };
     if !(t.width.is_power_of_two() && t.height.is_power_of_two()) {
-        keep(
-            &mut outcome,
-            format!(
-                "{}×{} is not a power of two (a texture array tiles blocks only then)",
-                t.width, t.height
-            ),
-        );
+        outcome.kept_because = Some(format!(
+            "{}×{} is not a power of two (a texture array tiles blocks only then)",
+            t.width, t.height
+        ));
         return outcome;
     }
     let opaque = std::iter::once(&t.rgba8)
@@ -331,8 +332,7 @@ fn compress_one(
         TextureFormat::Etc2 if opaque => BlockFormat::Etc2Rgb8,
         TextureFormat::Etc2 => BlockFormat::Etc2Rgba8,
         TextureFormat::Astc if alpha_decides && !opaque => {
-            keep(
-                &mut outcome,
+            outcome.kept_because = Some(
                 "its alpha decides visibility and is not 255 everywhere; ASTC alpha may \
                  decode past 8 bits on a device"
                     .into(),
@@ -342,36 +342,38 @@ fn compress_one(
         TextureFormat::Astc => BlockFormat::Astc4x4,
         TextureFormat::Bc7 => BlockFormat::Bc7,
     };
-    let levels: Vec<Vec<u8>> = std::iter::once(&t.rgba8)
-        .chain(&t.mips)
-        .enumerate()
-        .map(|(k, level)| {
-            let (w, h) = Texture::level_size(t.width, t.height, k as u32);
-            encode_level(block, level, (w, h), opaque, t.srgb)
-        })
-        .collect();
-    let blocks = TextureBlocks {
+    // Level 0 first: its alpha decides whether the texture is compressed at all, and the
+    // mips are encoded only when it is.
+    let mut blocks = TextureBlocks {
         format: block,
-        levels,
+        levels: vec![encode_level(
+            block,
+            &t.rgba8,
+            (t.width, t.height),
+            opaque,
+            t.srgb,
+        )],
     };
-    let decoded: Vec<Vec<u8>> = (0..blocks.levels.len())
-        .map(|k| blocks.decode_level(t.width, t.height, k))
-        .collect();
+    let level0 = blocks.decode_level(t.width, t.height, 0);
     if alpha_decides {
-        let changed = (t.rgba8.chunks_exact(4).zip(decoded[0].chunks_exact(4)))
+        let changed = (t.rgba8.chunks_exact(4).zip(level0.chunks_exact(4)))
             .filter(|(a, b)| a[3] != b[3])
             .count();
         if changed > 0 {
-            keep(
-                &mut outcome,
-                format!(
-                    "its alpha decides visibility and {changed} level-0 texels' alpha \
-                     would change in {block}"
-                ),
-            );
+            outcome.kept_because = Some(format!(
+                "its alpha decides visibility and {changed} level-0 texels' alpha \
+                 would change in {block}"
+            ));
             return outcome;
         }
     }
+    for (k, level) in t.mips.iter().enumerate() {
+        let (w, h) = Texture::level_size(t.width, t.height, k as u32 + 1);
+        (blocks.levels).push(encode_level(block, level, (w, h), opaque, t.srgb));
+    }
+    let decoded: Vec<Vec<u8>> = std::iter::once(level0)
+        .chain((1..blocks.levels.len()).map(|k| blocks.decode_level(t.width, t.height, k)))
+        .collect();
     let (psnr, max) = difference(&t.rgba8, &decoded[0]);
     outcome.psnr_db = psnr;
     outcome.max_difference = max;
