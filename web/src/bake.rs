@@ -3,9 +3,10 @@
 //! mesh from them). Every array is a copy in the layout documented on its method; the order
 //! and the draw ranges are the native player's ([`trisort_player::commands`]).
 
+use std::cell::OnceCell;
 use std::path::Path;
 
-use trisort_format::{AlphaMode, Baked};
+use trisort_format::{AlphaMode, Baked, DrawIndexedIndirectArgs, FrameWindow};
 use trisort_player::commands::{frame_commands, index_buffer, Order};
 use wasm_bindgen::prelude::*;
 
@@ -19,7 +20,13 @@ const MATERIAL_FLOATS: usize = 16;
 #[wasm_bindgen]
 pub struct BakedData {
     baked: Baked,
+    /// The player's commands for every frame ([`frame_commands`]), front to back ([0]) and
+    /// back to front ([1]), made on the first [`BakedData::frame_ranges`] of that order.
+    commands: [OnceCell<Commands>; 2],
 }
+
+/// Every frame's draws and each frame's window over them.
+type Commands = (Vec<DrawIndexedIndirectArgs>, Vec<FrameWindow>);
 
 fn order(back_to_front: bool) -> Order {
     if back_to_front {
@@ -39,7 +46,10 @@ impl BakedData {
             let _ = js_sys::Reflect::set(&err, &"kind".into(), &ErrorKind::Format.name().into());
             JsValue::from(err)
         })?;
-        Ok(BakedData { baked })
+        Ok(BakedData {
+            baked,
+            commands: Default::default(),
+        })
     }
 
     /// Frames in the file.
@@ -161,7 +171,8 @@ impl BakedData {
         if frame >= self.frame_count() {
             return Vec::new();
         }
-        let (draws, windows) = frame_commands(&self.baked, order(back_to_front));
+        let (draws, windows) = self.commands[usize::from(back_to_front)]
+            .get_or_init(|| frame_commands(&self.baked, order(back_to_front)));
         let w = windows[frame as usize];
         draws[w.first as usize..(w.first + w.count) as usize]
             .iter()
