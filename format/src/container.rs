@@ -4,7 +4,7 @@
 //!
 //! | bytes | field |
 //! |---|---|
-//! | 8 | magic: `TRISREC\0` (Recording) or `TRISBAK\0` (Baked) |
+//! | 8 | magic: `TRISREC\0` (Recording), `TRISBAK\0` (Baked) or `TRISPRE\0` (Presorted) |
 //! | 4 | format version ([`FORMAT_VERSION`]) |
 //! | 8 | length of the compressed payload |
 //! | 8 | length of the decompressed payload |
@@ -53,6 +53,8 @@ pub enum FileKind {
     Recording,
     /// A `Baked` file (`trisort merge`, `trisort bake`).
     Baked,
+    /// A `Presorted` file (`trisort presort`).
+    Presorted,
 }
 
 impl FileKind {
@@ -61,6 +63,7 @@ impl FileKind {
         match self {
             FileKind::Recording => b"TRISREC\0",
             FileKind::Baked => b"TRISBAK\0",
+            FileKind::Presorted => b"TRISPRE\0",
         }
     }
 
@@ -69,12 +72,13 @@ impl FileKind {
         match self {
             FileKind::Recording => "recording",
             FileKind::Baked => "baked file",
+            FileKind::Presorted => "presorted file",
         }
     }
 
     /// Which kind of file `bytes` starts like, if any.
     pub fn sniff(bytes: &[u8]) -> Option<FileKind> {
-        [FileKind::Recording, FileKind::Baked]
+        [FileKind::Recording, FileKind::Baked, FileKind::Presorted]
             .into_iter()
             .find(|k| bytes.starts_with(k.magic()))
     }
@@ -172,6 +176,12 @@ pub trait Stored: DeserializeOwned {
 }
 
 impl Stored for crate::Recording {
+    fn after_decode(&mut self) -> Result<(), crate::StructureError> {
+        self.geometry.decode_blocks()
+    }
+}
+
+impl Stored for crate::Presorted {
     fn after_decode(&mut self) -> Result<(), crate::StructureError> {
         self.geometry.decode_blocks()
     }

@@ -310,6 +310,14 @@ impl Geometry {
         self.vertices[self.triangles[t as usize][0] as usize].material
     }
 
+    /// Whether triangle `t` needs a depth order: its material is `BLEND` or transmissive (the
+    /// default pipeline's transparent pass, the triangles `presort` sorts). The others are
+    /// drawn correctly in any order with the depth test.
+    pub fn needs_order(&self, t: u32) -> bool {
+        let m = &self.materials[self.triangle_material(t) as usize];
+        m.alpha_mode == AlphaMode::Blend || m.transmission > 0.0
+    }
+
     /// The node that moves triangle `t`.
     pub fn triangle_node(&self, t: u32) -> u32 {
         self.vertices[self.triangles[t as usize][0] as usize].node

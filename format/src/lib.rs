@@ -23,6 +23,7 @@ pub mod gpu_layout;
 pub mod legacy;
 pub mod options;
 pub mod order;
+pub mod presorted;
 pub mod recording;
 pub mod structure;
 
@@ -41,6 +42,9 @@ pub use geometry::{
 pub use options::{
     Bridge, Choice, Choosable, DeviceBackend, DeviceLimits, Layout, Mode, OptionValue,
     ParseOptionError, Seeding, Shading, Strategy, ToneMap,
+};
+pub use presorted::{
+    OutsideError, PlaneTest, Polyhedron, PresortStats, Presorted, PresortedCopy, Segment,
 };
 pub use recording::{
     DepthAt, DeviceInfo, Edge, FrameRecord, Phase, ProfileName, RasterProfile, RecordSettings,

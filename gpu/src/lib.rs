@@ -182,6 +182,16 @@ pub fn plain_shader() -> String {
     storage_shader("plain", &[], &[PLAIN], &[])
 }
 
+/// The depth-presorted renderer's fragment entry points (`fs_presorted_straight`,
+/// `fs_presorted_premultiplied`); compose with [`presorted_shader`].
+pub const PRESORTED: &str = include_str!("../../shaders/reference/presorted.wgsl");
+
+/// The complete presorted shader: [`COMMON`], the player's [`PLAYER`] entry points and
+/// [`PRESORTED`] (needs `Features::PRIMITIVE_INDEX`).
+pub fn presorted_shader() -> String {
+    storage_shader("presorted", &["primitive_index"], &[PLAYER, PRESORTED], &[])
+}
+
 /// The per-sample linked-list OIT renderer's entry points (`fs_oit_list`,
 /// `vs_oit_fullscreen`, `fs_oit_resolve`); compose with [`oit_shader`].
 pub const OIT: &str = include_str!("../../shaders/reference/oit.wgsl");

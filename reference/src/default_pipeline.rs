@@ -8,7 +8,7 @@
 //! resolved and quantized once like the player's frames. Its error against the exact
 //! reference is what sorting buys.
 
-use trisort_format::{AlphaMode, FrameState, Geometry};
+use trisort_format::{FrameState, Geometry};
 use trisort_gpu::scene_gpu::{Lighting, SceneGpu, ScenePipeline, View};
 use trisort_gpu::Gpu;
 use trisort_gpu::{clear_colour, halves, quantize_rgba16f, COLOR_FORMAT};
@@ -21,9 +21,7 @@ use crate::ReferenceError;
 /// Whether a scene triangle is drawn in the transparent pass: its material (that of its first
 /// vertex) is `BLEND` or transmissive.
 pub fn is_transparent(geometry: &Geometry, triangle: usize) -> bool {
-    let v = geometry.triangles[triangle][0] as usize;
-    let m = &geometry.materials[geometry.vertices[v].material as usize];
-    m.alpha_mode == AlphaMode::Blend || m.transmission > 0.0
+    geometry.needs_order(triangle as u32)
 }
 
 /// The default pipeline for one scene at one view.

@@ -26,6 +26,7 @@ pub mod frames;
 pub mod html;
 pub mod oit;
 pub mod peeling;
+pub mod presorted;
 pub mod report;
 mod target;
 pub mod verify;
@@ -36,6 +37,7 @@ pub use deploy::Srgb8Player;
 pub use exact::{ExactReference, ReferenceConfig, ReferenceFrame, UnorderedEdges};
 pub use oit::{OitConfig, OitFrame, OitRenderer};
 pub use peeling::{PeeledFrame, PeelingConfig, PeelingRenderer};
+pub use presorted::PresortedRenderer;
 pub use verify::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
 
 /// Errors of the reference renderers.

@@ -147,6 +147,7 @@ pub fn run(a: InspectArgs) -> Result<ExitCode> {
     match kind {
         Some(FileKind::Recording) => inspect_recording(&a, &path),
         Some(FileKind::Baked) => inspect_baked(&a, &path),
+        Some(FileKind::Presorted) => super::presort::inspect(&path, a.json),
         None => inspect_scene(&a),
     }
 }

@@ -8,6 +8,7 @@ mod export_shaders;
 mod inspect;
 pub mod merge;
 mod play;
+mod presort;
 pub mod record;
 mod upgrade;
 pub mod verify;
@@ -46,6 +47,10 @@ enum Command {
     Play(play::PlayArgs),
     /// Check a baked file: graph rules against its recording, images against the exact reference.
     Verify(verify::VerifyArgs),
+    /// Depth-presort a scene for free viewpoints (paper 000): per viewpoint partition, a list of
+    /// triangle copies with half-space tests, sorted for every camera outside a bounding
+    /// polyhedron.
+    Presort(presort::PresortArgs),
     /// Measure frame times and accuracy of the merged player against its rivals.
     Bench(bench::BenchArgs),
     /// Bake and play the built-in procedural car and print its figures.
@@ -171,6 +176,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Play(a) => play::run(a),
         Command::Verify(a) => verify::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Presort(a) => presort::run(a),
         Command::Demo(a) => demo::run(a),
         Command::ExportOrder(a) => export_order::run(a),
         Command::ExportShaders(a) => export_shaders::run(a),

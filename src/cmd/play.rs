@@ -35,6 +35,11 @@ pub struct PlayArgs {
     /// none: render and time only.
     #[arg(long)]
     out_dir: Option<PathBuf>,
+    /// Camera path of a presorted file (`trisort presort`), which plays along any path of
+    /// cameras outside its bounding polyhedron: a path spec as `bake --path` takes, or
+    /// `random:N[:SEED]` (N random cameras outside the polyhedron).
+    #[arg(long, value_name = "P")]
+    path: Option<String>,
     /// Playback size (default: the recorded size).
     #[arg(long, value_parser = parse_size)]
     size: Option<(u32, u32)>,
@@ -198,6 +203,33 @@ pub fn check_profile(
 }
 
 pub fn run(a: PlayArgs) -> Result<ExitCode> {
+    if super::presort::is_presorted(&a.baked) {
+        if a.window {
+            anyhow::bail!(
+                "{}: presorted files play headless (--path P --out-dir DIR); --window plays baked files",
+                a.baked.display()
+            );
+        }
+        let run = super::presort::PresortedRun {
+            file: &a.baked,
+            path: a.path.as_deref(),
+            size: a.size,
+            samples: a.samples,
+            mode: a.mode,
+            frames: a.frames,
+            glass_opacity: a.glass_opacity,
+            shading: a.shading.shading,
+            tone_map: a.shading.tonemap,
+            json: a.json,
+        };
+        return super::presort::play(&run, a.out_dir.as_deref());
+    }
+    if a.path.is_some() {
+        anyhow::bail!(
+            "{}: --path plays presorted files; a baked file plays the path it was baked for",
+            a.baked.display()
+        );
+    }
     if a.window {
         return run_window(&a);
     }

@@ -52,6 +52,10 @@ pub struct VerifyArgs {
     /// Scene (.glb/.gltf or `demo[:TRIANGLES]`): checks the images against the exact reference.
     #[arg(long)]
     scene: Option<String>,
+    /// Camera path of a presorted file (`trisort presort`): a path spec as `bake --path`
+    /// takes, or `random:N[:SEED]` (N random cameras outside its bounding polyhedron).
+    #[arg(long, value_name = "P")]
+    path: Option<String>,
     /// Compositing mode of the image check.
     #[arg(long, default_value = "blend")]
     mode: Mode,
@@ -168,6 +172,27 @@ fn elsewhere_player<'g>(
 }
 
 pub fn run(a: VerifyArgs) -> Result<ExitCode> {
+    if super::presort::is_presorted(&a.baked) {
+        let run = super::presort::PresortedRun {
+            file: &a.baked,
+            path: a.path.as_deref(),
+            size: a.size,
+            samples: a.samples,
+            mode: a.mode,
+            frames: a.frames,
+            glass_opacity: None,
+            shading: a.shading.shading,
+            tone_map: a.shading.tonemap,
+            json: a.json,
+        };
+        return super::presort::verify(&run, a.scene.as_deref());
+    }
+    if a.path.is_some() {
+        bail!(
+            "{}: --path verifies presorted files; a baked file is checked along its own path",
+            a.baked.display()
+        );
+    }
     let baked: Baked = trisort_player::open_baked(&a.baked)?;
     if a.recording.is_empty() && a.scene.is_none() && a.environment.is_none() {
         bail!("nothing to verify against: give --recording REC (graph rules) and/or --scene SCENE (images), or --environment studio|FILE.hdr (the stored light)");

@@ -1,0 +1,372 @@
+//! The depth-presorted renderer (paper 000): plays a [`Presorted`] file from any camera outside
+//! its polyhedron, for `play`, `verify` and `bench`.
+//!
+//! Per frame, the CPU picks the camera's partition (trivial) and the GPU selects the copies
+//! whose half-space tests the camera passes, in the fragment stage (`fs_presorted_*` in
+//! `shaders/reference/presorted.wgsl`, the variant paper 000 favours for models of more than
+//! a few thousand triangles). Passes, into the player's `Rgba16Float` MSAA target with a
+//! depth buffer, resolved and quantized once like the player's frames:
+//!
+//! - `blend`: the opaque triangles (ascending ids, depth test and writes), then the partition's
+//!   segment in one draw, back to front (depth test, no writes), straight-alpha `over`.
+//! - `depth`: the segment front to back, then the opaque triangles, both with depth test and
+//!   writes: each sample shows its nearest fragment over the background.
+//! - `saturate`: the opaque triangles' depth alone, then the segment front to back (depth test,
+//!   no writes), then the opaque colours (`LessEqual`), premultiplied and composited under.
+
+use trisort_format::{FrameState, Mode, Presorted};
+use trisort_gpu::pipeline::{storage_entry, uniform_entry};
+use trisort_gpu::scene_gpu::{Lighting, SceneGpu, ScenePipeline, View};
+use trisort_gpu::Gpu;
+use trisort_gpu::{clear_colour, halves, quantize_rgba16f, BACKGROUND, COLOR_FORMAT};
+use trisort_player::blend_state;
+use wgpu::util::DeviceExt;
+
+use crate::target::{lit_scene, Target, DEPTH_FORMAT};
+use crate::ReferenceError;
+
+/// The camera of every frame checked against a presorted file: outside the polyhedron, within
+/// its reach, no node moved from its rest pose (the lists are for the static scene). Returns
+/// each frame's partition, or an error naming the first frame that cannot be drawn.
+pub fn partitions_of(
+    file: &Presorted,
+    frames: &[FrameState],
+) -> Result<Vec<usize>, ReferenceError> {
+    frames
+        .iter()
+        .enumerate()
+        .map(|(f, s)| {
+            if let Some(p) = s.poses.first() {
+                return Err(ReferenceError::Invalid(format!(
+                    "frame {f}: the path moves node {} from its rest pose; a presorted file \
+                     holds the scene at rest",
+                    p.node
+                )));
+            }
+            let eye = s.camera.eye();
+            file.polyhedron.partition_of(eye.to_array()).map_err(|e| {
+                ReferenceError::Invalid(format!(
+                    "frame {f}: {e} (camera at {:.3}, {:.3}, {:.3}; presorted files play from \
+                     outside their bounding polyhedron, within {:.3} of its centre per axis)",
+                    eye.x, eye.y, eye.z, file.polyhedron.reach
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Renders a presorted file's frames.
+pub struct PresortedRenderer<'g> {
+    gpu: &'g Gpu,
+    mode: Mode,
+    scene: SceneGpu,
+    /// Per frame: partition and camera relative to the centre.
+    frames: Vec<(usize, [f32; 3])>,
+    /// Per partition: (first copy, copies) in this renderer's drawing order.
+    segments: Vec<(u32, u32)>,
+    opaque: (wgpu::Buffer, u32),
+    sorted: wgpu::Buffer,
+    params: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    /// (pipeline, what it draws: false opaque, true the segment), in order.
+    passes: Vec<(wgpu::RenderPipeline, bool)>,
+    target: Target,
+}
+
+impl<'g> PresortedRenderer<'g> {
+    /// Uploads `file` for the camera path `frames` at `view` in `mode`, lit as `lighting` says.
+    /// Errors naming the frame where a camera is inside the polyhedron or beyond its reach, or
+    /// a frame moves a node; or where the device lacks `PRIMITIVE_INDEX`.
+    pub fn new(
+        gpu: &'g Gpu,
+        file: &Presorted,
+        frames: &[FrameState],
+        view: View,
+        lighting: Lighting<'_>,
+        mode: Mode,
+    ) -> Result<PresortedRenderer<'g>, ReferenceError> {
+        if !gpu
+            .device
+            .features()
+            .contains(wgpu::Features::PRIMITIVE_INDEX)
+        {
+            return Err(ReferenceError::Unsupported(format!(
+                "{}: the presorted renderer selects copies by primitive index",
+                gpu.describe()
+            )));
+        }
+        let partitions = partitions_of(file, frames)?;
+        let c = file.polyhedron.centre;
+        let frame_eyes = partitions
+            .iter()
+            .zip(frames)
+            .map(|(&k, s)| {
+                let e = s.camera.eye();
+                (
+                    k,
+                    [
+                        (e.x - c[0]) as f32,
+                        (e.y - c[1]) as f32,
+                        (e.z - c[2]) as f32,
+                    ],
+                )
+            })
+            .collect();
+        let device = &gpu.device;
+        let target = Target::new(
+            gpu,
+            (view.width, view.height),
+            view.samples,
+            COLOR_FORMAT,
+            true,
+        )?;
+        let shading = lighting.shading;
+        let scene = lit_scene(gpu, &file.geometry, frames, view, lighting);
+        // The copies in drawing order: back to front in blend, front to back otherwise.
+        let reverse = mode != Mode::Blend;
+        let mut order: Vec<u32> = Vec::with_capacity(file.copies.len());
+        let mut segments = Vec::with_capacity(file.segments.len());
+        for s in &file.segments {
+            segments.push((order.len() as u32, s.count));
+            let run = s.first..s.first + s.count;
+            if reverse {
+                order.extend(run.rev());
+            } else {
+                order.extend(run);
+            }
+        }
+        let mut index: Vec<u32> = Vec::with_capacity(order.len() * 3 + 3);
+        let mut copy_tests: Vec<[u32; 2]> = Vec::with_capacity(order.len() + 1);
+        for &k in &order {
+            let copy = &file.copies[k as usize];
+            index.extend_from_slice(&file.geometry.triangles[copy.triangle as usize]);
+            copy_tests.push([copy.first_test, copy.tests]);
+        }
+        // No empty buffers.
+        index.extend_from_slice(&[0, 0, 0]);
+        copy_tests.push([0, 0]);
+        let mut tests: Vec<u32> = file.tests.iter().map(|t| t.packed()).collect();
+        tests.push(0);
+        let mut planes = file.planes.clone();
+        planes.push([0.0; 4]);
+        let buffer = |label: &str, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let storage = wgpu::BufferUsages::STORAGE;
+        let sorted = buffer(
+            "presorted copies",
+            bytemuck::cast_slice(&index),
+            wgpu::BufferUsages::INDEX,
+        );
+        let copy_tests = buffer(
+            "presorted copy tests",
+            bytemuck::cast_slice(&copy_tests),
+            storage,
+        );
+        let tests = buffer("presorted tests", bytemuck::cast_slice(&tests), storage);
+        let planes = buffer("presorted planes", bytemuck::cast_slice(&planes), storage);
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("presorted params"),
+            size: 32,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("presorted"),
+            entries: &[
+                uniform_entry(0, fragment, false, Some(32)),
+                storage_entry(1, fragment, true),
+                storage_entry(2, fragment, true),
+                storage_entry(3, fragment, true),
+            ],
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("presorted"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: copy_tests.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: tests.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: planes.as_entire_binding(),
+                },
+            ],
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("presorted"),
+            source: wgpu::ShaderSource::Wgsl(trisort_gpu::presorted_shader().into()),
+        });
+        let (player_fs, presorted_fs) = match mode {
+            Mode::Saturate => ("fs_player_premultiplied", "fs_presorted_premultiplied"),
+            Mode::Blend | Mode::Depth => ("fs_player_straight", "fs_presorted_straight"),
+        };
+        use wgpu::CompareFunction::{Less, LessEqual};
+        let pipeline =
+            |label: &str, fs: &str, depth: (wgpu::CompareFunction, bool), colour: bool| {
+                ScenePipeline {
+                    label,
+                    layouts: &[&scene.layout, &layout],
+                    module: &module,
+                    vertex: "vs_player",
+                    fragment: fs,
+                    target: wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: Some(blend_state(mode)),
+                        write_mask: if colour {
+                            wgpu::ColorWrites::ALL
+                        } else {
+                            wgpu::ColorWrites::empty()
+                        },
+                    },
+                    depth: Some((DEPTH_FORMAT, depth.0, depth.1)),
+                    samples: view.samples,
+                }
+                .build_shaded(device, shading)
+            };
+        let passes = match mode {
+            Mode::Blend => vec![
+                (
+                    pipeline("presorted opaque", player_fs, (Less, true), true),
+                    false,
+                ),
+                (
+                    pipeline("presorted list", presorted_fs, (Less, false), true),
+                    true,
+                ),
+            ],
+            Mode::Depth => vec![
+                (
+                    pipeline("presorted list", presorted_fs, (Less, true), true),
+                    true,
+                ),
+                (
+                    pipeline("presorted opaque", player_fs, (Less, true), true),
+                    false,
+                ),
+            ],
+            Mode::Saturate => vec![
+                (
+                    pipeline("presorted opaque depth", player_fs, (Less, true), false),
+                    false,
+                ),
+                (
+                    pipeline("presorted list", presorted_fs, (Less, false), true),
+                    true,
+                ),
+                (
+                    pipeline("presorted opaque", player_fs, (LessEqual, false), true),
+                    false,
+                ),
+            ],
+        };
+        let mut opaque: Vec<u32> = file
+            .opaque
+            .iter()
+            .flat_map(|&t| file.geometry.triangles[t as usize])
+            .collect();
+        let opaque_count = opaque.len() as u32;
+        opaque.extend_from_slice(&[0, 0, 0]);
+        let opaque = (
+            buffer(
+                "presorted opaque",
+                bytemuck::cast_slice(&opaque),
+                wgpu::BufferUsages::INDEX,
+            ),
+            opaque_count,
+        );
+        Ok(PresortedRenderer {
+            gpu,
+            mode,
+            scene,
+            frames: frame_eyes,
+            segments,
+            opaque,
+            sorted,
+            params,
+            bind_group,
+            passes,
+            target,
+        })
+    }
+
+    /// Frame `frame`'s partition.
+    pub fn partition(&self, frame: u32) -> Option<usize> {
+        self.frames.get(frame as usize).map(|f| f.0)
+    }
+
+    /// Triangles submitted for frame `frame` (the opaque ones and the partition's copies; the
+    /// copies that fail their tests are discarded per fragment).
+    pub fn triangles(&self, frame: u32) -> u32 {
+        let k = self.frames[frame as usize].0;
+        self.opaque.1 / 3 + self.segments[k].1
+    }
+
+    /// Writes frame `frame`'s camera and segment; call before recording the frame's passes
+    /// (their uniform is shared by every frame).
+    pub fn prepare(&self, frame: u32) -> Result<(), ReferenceError> {
+        let &(k, eye) = self
+            .frames
+            .get(frame as usize)
+            .ok_or_else(|| ReferenceError::Invalid(format!("frame {frame} is beyond the path")))?;
+        let mut bytes = [0u8; 32];
+        bytes[..12].copy_from_slice(bytemuck::cast_slice(&eye));
+        bytes[16..20].copy_from_slice(&self.segments[k].0.to_le_bytes());
+        self.gpu.queue.write_buffer(&self.params, 0, &bytes);
+        Ok(())
+    }
+
+    /// Records frame `frame` into `pass` (attachments as the view: `Rgba16Float` colour and
+    /// `Depth32Float` depth at its sample count); [`PresortedRenderer::prepare`] first.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, frame: u32) {
+        let (k, _) = self.frames[frame as usize];
+        let (first, count) = self.segments[k];
+        pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
+        pass.set_bind_group(1, &self.bind_group, &[]);
+        pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
+        for (pipeline, list) in &self.passes {
+            pass.set_pipeline(pipeline);
+            if *list {
+                if count == 0 {
+                    continue;
+                }
+                pass.set_index_buffer(self.sorted.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(first * 3..(first + count) * 3, 0, 0..1);
+            } else {
+                if self.opaque.1 == 0 {
+                    continue;
+                }
+                pass.set_index_buffer(self.opaque.0.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..self.opaque.1, 0, 0..1);
+            }
+        }
+    }
+
+    /// Renders frame `frame` over the player's background as 8-bit sRGB RGBA (quantized once,
+    /// like the player's frames).
+    pub fn render(&self, frame: u32) -> Result<Vec<u8>, ReferenceError> {
+        self.prepare(frame)?;
+        let bytes = self
+            .target
+            .render(self.gpu, clear_colour(self.mode), |pass| {
+                self.draw(pass, frame);
+                Ok(())
+            })?;
+        let under = (self.mode == Mode::Saturate).then_some(BACKGROUND);
+        Ok(quantize_rgba16f(&halves(&bytes), under))
+    }
+}

@@ -1,0 +1,544 @@
+//! `trisort presort SCENE -o FILE` (paper 000's preprocessing), and playing and verifying the
+//! presorted file it writes along any camera path (`play FILE --path P`, `verify FILE --path
+//! P`; `random:N[:SEED]` is N random cameras outside the file's polyhedron).
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use glam::{DMat4, DVec3};
+use serde_json::json;
+use trisort_bake::{working_scene, Light};
+use trisort_format::{Camera, FileKind, FrameState, Mode, Presorted, RecordSettings};
+use trisort_gpu::scene_gpu::View;
+use trisort_gpu::{Gpu, Lighting, Shading, ToneMap};
+use trisort_presort::{presort, PresortOptions};
+use trisort_reference::{compare, ExactReference, PresortedRenderer, ReferenceConfig};
+use trisort_scene::Scene;
+
+use crate::common::{load_scene, print_json, progress_bar};
+
+/// Arguments of `presort`.
+#[derive(Args, Debug)]
+pub struct PresortArgs {
+    /// Scene (.glb/.gltf or `demo[:TRIANGLES]`).
+    scene: String,
+    /// Output presorted file.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Faces of the bounding polyhedron, one viewpoint partition (and list) each: 4
+    /// (tetrahedron), 6 (cube), 8 (octahedron), or 10 to 256 (directions spread over the
+    /// sphere). More partitions: shorter lists per frame, more copies in the file.
+    #[arg(long, default_value_t = 6)]
+    partitions: u32,
+    /// How far cameras may go from the scene's centre, per axis, in scene radii (the
+    /// viewpoint regions are bounded there; farther cameras are refused).
+    #[arg(long, default_value_t = 100.0)]
+    reach: f64,
+    /// The light players shade with: `studio` or an equirectangular .hdr file.
+    #[arg(long, default_value = "studio")]
+    environment: String,
+    /// Opacity transmissive glass is drawn at.
+    #[arg(long, default_value_t = RecordSettings::DEFAULT_GLASS_OPACITY)]
+    glass_opacity: f32,
+    /// Do not split triangles that pass through each other first (no order exists for them).
+    #[arg(long)]
+    keep_intersections: bool,
+    /// Print the figures as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// A camera at the scene's rest pose, for the split (which only reads the poses).
+fn rest_frame() -> FrameState {
+    FrameState {
+        camera: Camera {
+            view: DMat4::IDENTITY.to_cols_array(),
+            yfov: 1.0,
+            znear: 0.1,
+            zfar: None,
+        },
+        poses: Vec::new(),
+    }
+}
+
+/// `presort`.
+pub fn run(a: PresortArgs) -> Result<ExitCode> {
+    let t0 = Instant::now();
+    let environment = Light::parse(&a.environment).load()?;
+    let mut scene = load_scene(&a.scene)?;
+    let scene_hash = scene.hash();
+    let settings = RecordSettings {
+        split_intersections: !a.keep_intersections,
+        ..RecordSettings::default()
+    };
+    let split = working_scene(
+        &mut scene,
+        &a.scene,
+        &[rest_frame()],
+        "its rest pose",
+        &settings,
+    )?;
+    if let Some(r) = &split {
+        if r.triangles_added > 0 {
+            eprintln!(
+                "trisort: split {} pairs of triangles that pass through each other (+{} triangles)",
+                r.pairs_split + r.pairs_split_across_groups,
+                r.triangles_added
+            );
+        }
+    }
+    let bar = progress_bar(a.partitions as u64, "partitions");
+    let options = PresortOptions {
+        partitions: a.partitions,
+        reach: a.reach,
+        ..PresortOptions::default()
+    };
+    let lists = presort(&scene.geometry, options, &|done, _| {
+        bar.set_position(done as u64)
+    })
+    .with_context(|| format!("presorting {}", a.scene))?;
+    bar.finish_and_clear();
+    let mut file = lists.into_presorted(scene.geometry, environment, a.glass_opacity, scene_hash);
+    file.stats.seconds = t0.elapsed().as_secs_f64();
+    trisort_format::write_file_atomic(FileKind::Presorted, &a.output, &file)?;
+    let s = &file.stats;
+    let ratio = s.list_triangles as f64 / (s.sorted_triangles.max(1) as f64);
+    if a.json {
+        print_json(&json!({
+            "triangles": s.triangles,
+            "list_triangles": s.list_triangles,
+            "partitions": file.segments.len(),
+            "seconds": s.seconds,
+            "sorted_triangles": s.sorted_triangles,
+            "list_ratio": ratio,
+            "per_partition_mean": s.list_triangles as f64 / file.segments.len() as f64,
+            "duplicated": s.duplicated,
+            "moved": s.moved,
+            "regions": s.regions,
+            "linear_programs": s.linear_programs,
+            "planes": file.planes.len(),
+            "output": a.output,
+        }));
+    } else {
+        println!(
+            "presorted {}: {} triangles, {} need an order; {} partitions, {} copies in all \
+             ({ratio:.2}× the sorted triangles, {:.0} a partition; {} duplicated, {} moved, \
+             {} planes) in {:.2} s → {}",
+            a.scene,
+            s.triangles,
+            s.sorted_triangles,
+            file.segments.len(),
+            s.list_triangles,
+            s.list_triangles as f64 / file.segments.len() as f64,
+            s.duplicated,
+            s.moved,
+            file.planes.len(),
+            s.seconds,
+            a.output.display()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Whether `path` is a presorted file (by its magic).
+pub fn is_presorted(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok()
+        && FileKind::sniff(&head) == Some(FileKind::Presorted)
+}
+
+/// Reads and checks a presorted file.
+pub fn read(path: &Path) -> Result<Presorted> {
+    let file: Presorted = trisort_format::read_file(FileKind::Presorted, path)?;
+    file.check_structure()
+        .map_err(|e| anyhow::anyhow!("{}: malformed presorted file: {e}", path.display()))?;
+    Ok(file)
+}
+
+/// `N` random cameras outside `file`'s polyhedron (1.2 to 4 times its largest face distance
+/// from the centre, in random directions), each looking at the centre with the scene in view;
+/// deterministic for a seed.
+pub fn random_views(file: &Presorted, n: u32, seed: u64) -> Vec<FrameState> {
+    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let centre = DVec3::from(file.polyhedron.centre);
+    let size = file
+        .polyhedron
+        .faces
+        .iter()
+        .map(|f| f[3])
+        .fold(0.0, f64::max);
+    let mut out = Vec::with_capacity(n as usize);
+    while out.len() < n as usize {
+        let d = DVec3::new(next() * 2.0 - 1.0, next() * 2.0 - 1.0, next() * 2.0 - 1.0);
+        if !(d.length() > 0.1 && d.length() <= 1.0) {
+            continue;
+        }
+        let distance = size * (1.2 + 2.8 * next());
+        let eye = centre + d.normalize() * distance;
+        if file.polyhedron.partition_of(eye.to_array()).is_err() {
+            continue;
+        }
+        let dir = (centre - eye).normalize();
+        let up = if dir.y.abs() > 0.95 {
+            DVec3::Z
+        } else {
+            DVec3::Y
+        };
+        out.push(FrameState {
+            camera: Camera {
+                view: DMat4::look_at_rh(eye, centre, up).to_cols_array(),
+                yfov: 2.0 * (size / distance).min(0.95).asin(),
+                znear: distance * 0.01,
+                zfar: None,
+            },
+            poses: Vec::new(),
+        });
+    }
+    out
+}
+
+/// The frames of `--path spec` over `file`: `random:N[:SEED]`, or any path spec the other
+/// commands take (over the file's own scene).
+pub fn frames_of(file: &Presorted, spec: &str, fps: f64) -> Result<Vec<FrameState>> {
+    if let Some(rest) = spec.strip_prefix("random:") {
+        let (n, seed) = rest.split_once(':').unwrap_or((rest, "1"));
+        let n: u32 = n
+            .parse()
+            .ok()
+            .filter(|&n| n > 0)
+            .with_context(|| format!("--path {spec}: N must be a positive count"))?;
+        let seed: u64 = seed
+            .parse()
+            .with_context(|| format!("--path {spec}: SEED must be a number"))?;
+        return Ok(random_views(file, n, seed));
+    }
+    let scene = Scene {
+        name: "presorted scene".into(),
+        geometry: file.geometry.clone(),
+        ..Scene::default()
+    };
+    let timeline = trisort_bake::load_path(spec, &scene, fps)?;
+    Ok(timeline.frames)
+}
+
+/// How a presorted file is played or verified.
+pub struct PresortedRun<'a> {
+    /// The file.
+    pub file: &'a Path,
+    /// `--path`.
+    pub path: Option<&'a str>,
+    /// Image size.
+    pub size: Option<(u32, u32)>,
+    /// MSAA samples.
+    pub samples: Option<u32>,
+    /// Mode.
+    pub mode: Mode,
+    /// Frames, half-open.
+    pub frames: Option<crate::common::FrameRange>,
+    /// Glass opacity override.
+    pub glass_opacity: Option<f32>,
+    /// Shading.
+    pub shading: Shading,
+    /// Tone map.
+    pub tone_map: ToneMap,
+    /// JSON output.
+    pub json: bool,
+}
+
+struct Loaded {
+    file: Presorted,
+    frames: Vec<FrameState>,
+    range: std::ops::Range<u32>,
+    view: View,
+}
+
+fn load(r: &PresortedRun<'_>) -> Result<Loaded> {
+    let file = read(r.file)?;
+    let Some(spec) = r.path else {
+        bail!(
+            "{}: a presorted file plays along any camera path: give one with --path (e.g. \
+             --path orbit or --path random:64)",
+            r.file.display()
+        );
+    };
+    let frames = frames_of(&file, spec, 30.0)?;
+    let n = frames.len() as u32;
+    let range = match r.frames {
+        Some(f) => f.resolve(n)?,
+        None => 0..n,
+    };
+    let (w, h) = r.size.unwrap_or(RecordSettings::DEFAULT_SIZE);
+    let view = View {
+        width: w,
+        height: h,
+        samples: r.samples.unwrap_or(RecordSettings::DEFAULT_SAMPLES),
+        glass_opacity: r.glass_opacity.unwrap_or(file.glass_opacity),
+    };
+    // Every frame of the path must be playable, not just the ones drawn: say which is not.
+    trisort_reference::presorted::partitions_of(&file, &frames)
+        .map_err(|e| anyhow::anyhow!("{}: --path {spec}: {e}", r.file.display()))?;
+    Ok(Loaded {
+        file,
+        frames,
+        range,
+        view,
+    })
+}
+
+fn renderer<'g>(gpu: &'g Gpu, l: &Loaded, r: &PresortedRun<'_>) -> Result<PresortedRenderer<'g>> {
+    Ok(PresortedRenderer::new(
+        gpu,
+        &l.file,
+        &l.frames,
+        l.view,
+        Lighting {
+            shading: r.shading,
+            tone_map: r.tone_map,
+            environment: &l.file.environment,
+        },
+        r.mode,
+    )?)
+}
+
+/// `play FILE --path P` on a presorted file: PNG frames (with `out_dir`) and per-frame figures.
+pub fn play(r: &PresortedRun<'_>, out_dir: Option<&Path>) -> Result<ExitCode> {
+    let l = load(r)?;
+    let gpu = crate::common::open_gpu()?;
+    let renderer = renderer(&gpu, &l, r)?;
+    if let Some(d) = out_dir {
+        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
+    }
+    let bar = progress_bar(l.range.len() as u64, "frames");
+    let mut frames = Vec::new();
+    for f in l.range.clone() {
+        let t = Instant::now();
+        let rgba = renderer.render(f)?;
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        if let Some(d) = out_dir {
+            trisort_reference::frames::write_png(
+                &d.join(format!("frame-{f:05}.png")),
+                l.view.width,
+                l.view.height,
+                &rgba,
+            )?;
+        }
+        frames.push(json!({
+            "frame": f,
+            "partition": renderer.partition(f),
+            "triangles": renderer.triangles(f),
+            "wall_ms": ms,
+        }));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    if r.json {
+        print_json(&json!({
+            "file": r.file,
+            "kind": "presorted",
+            "device": gpu.describe(),
+            "size": [l.view.width, l.view.height],
+            "samples": l.view.samples,
+            "mode": r.mode.to_string(),
+            "frames": frames,
+        }));
+    } else {
+        println!(
+            "played {} frames of {} on {} at {}x{}, {}x{}",
+            frames.len(),
+            r.file.display(),
+            gpu.describe(),
+            l.view.width,
+            l.view.height,
+            l.view.samples,
+            out_dir.map_or(String::new(), |d| format!(" → {}", d.display()))
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `verify FILE --path P` on a presorted file: every frame against the exact reference of the
+/// scene (`scene`, split as `presort` splits it; the file's own scene without it). At the
+/// pattern both render, `depth` must be bit-exact and `blend`/`saturate` within 1/255 on every
+/// pixel (no pixel is excused).
+pub fn verify(r: &PresortedRun<'_>, scene: Option<&str>) -> Result<ExitCode> {
+    let l = load(r)?;
+    let geometry = match scene {
+        Some(spec) => {
+            let mut s = load_scene(spec)?;
+            if s.hash() != l.file.scene_hash {
+                bail!(
+                    "{}: made from another scene than {spec} (scene hashes differ)",
+                    r.file.display()
+                );
+            }
+            let settings = RecordSettings::default();
+            working_scene(&mut s, spec, &[rest_frame()], "its rest pose", &settings)?;
+            s.geometry
+        }
+        None => l.file.geometry.clone(),
+    };
+    let gpu = crate::common::open_gpu()?;
+    let renderer = renderer(&gpu, &l, r)?;
+    let lighting = Lighting {
+        shading: r.shading,
+        tone_map: r.tone_map,
+        environment: &l.file.environment,
+    };
+    let reference = ExactReference::new(
+        &gpu,
+        &geometry,
+        &l.frames,
+        lighting,
+        ReferenceConfig {
+            size: (l.view.width, l.view.height),
+            samples: l.view.samples,
+            mode: r.mode,
+            glass_opacity: l.view.glass_opacity,
+            max_layers: 4096,
+        },
+    )?;
+    let bar = progress_bar(l.range.len() as u64, "verify");
+    let mut ok = true;
+    let mut frames = Vec::new();
+    for f in l.range.clone() {
+        let test = renderer.render(f)?;
+        let truth = reference.render(f, None)?;
+        let c = compare(&test, &truth.rgba8, l.view.width, l.view.height, &[]);
+        let pass = if r.mode == Mode::Depth {
+            c.pixels_differing == 0
+        } else {
+            c.max_channel_diff <= 1
+        };
+        ok &= pass && !truth.truncated;
+        frames.push(json!({
+            "frame": f,
+            "ok": pass,
+            "partition": renderer.partition(f),
+            "triangles": renderer.triangles(f),
+            "pixels_differing": c.pixels_differing,
+            "max_channel_diff": c.max_channel_diff,
+            "psnr": c.psnr,
+            "flip_mean": c.flip_mean,
+            "truncated": truth.truncated,
+        }));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let failed = frames.iter().filter(|f| f["ok"] == false).count();
+    if r.json {
+        print_json(&json!({
+            "ok": ok,
+            "kind": "presorted",
+            "device": gpu.describe(),
+            "mode": r.mode.to_string(),
+            "size": [l.view.width, l.view.height],
+            "samples": l.view.samples,
+            "reference_scene": scene.unwrap_or("the file's own"),
+            "frames": frames,
+        }));
+    } else {
+        println!(
+            "{}: {} of {} frames {} in {} mode at {}x{}, {}x against the exact reference of {} \
+             (every pixel within {})",
+            r.file.display(),
+            frames.len() - failed,
+            frames.len(),
+            if ok { "exact" } else { "checked" },
+            r.mode,
+            l.view.width,
+            l.view.height,
+            l.view.samples,
+            scene.unwrap_or("the file's own scene"),
+            if r.mode == Mode::Depth {
+                "0 (bit-exact)"
+            } else {
+                "1/255"
+            }
+        );
+        for f in frames.iter().filter(|f| f["ok"] == false) {
+            println!(
+                "  frame {}: {} pixels differ, largest {}/255",
+                f["frame"], f["pixels_differing"], f["max_channel_diff"]
+            );
+        }
+    }
+    Ok(if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(super::verify::VERIFY_FAILED)
+    })
+}
+
+/// `inspect FILE` of a presorted file: its figures and each partition's list.
+pub fn inspect(path: &Path, as_json: bool) -> Result<ExitCode> {
+    let file = read(path)?;
+    let s = &file.stats;
+    let partitions: Vec<serde_json::Value> = file
+        .segments
+        .iter()
+        .zip(&file.polyhedron.faces)
+        .map(|(seg, f)| {
+            let copies = &file.copies[seg.first as usize..(seg.first + seg.count) as usize];
+            json!({
+                "copies": seg.count,
+                "tested": copies.iter().filter(|c| c.tests > 0).count(),
+                "normal": [f[0], f[1], f[2]],
+            })
+        })
+        .collect();
+    let v = json!({
+        "kind": "presorted",
+        "tool_version": file.tool_version,
+        "triangles": s.triangles,
+        "sorted_triangles": s.sorted_triangles,
+        "list_triangles": s.list_triangles,
+        "partitions": file.segments.len(),
+        "duplicated": s.duplicated,
+        "moved": s.moved,
+        "planes": file.planes.len(),
+        "seconds": s.seconds,
+        "centre": file.polyhedron.centre,
+        "reach": file.polyhedron.reach,
+        "per_partition": partitions,
+    });
+    if as_json {
+        print_json(&v);
+    } else {
+        println!(
+            "{}: presorted file (paper 000), {} triangles ({} opaque drawn with the depth test, \
+             {} sorted), {} partitions, {} copies ({} duplicated), {} planes; cameras outside \
+             the polyhedron within {:.3} of ({:.3}, {:.3}, {:.3})",
+            path.display(),
+            s.triangles,
+            file.opaque.len(),
+            s.sorted_triangles,
+            file.segments.len(),
+            s.list_triangles,
+            s.duplicated,
+            file.planes.len(),
+            file.polyhedron.reach,
+            file.polyhedron.centre[0],
+            file.polyhedron.centre[1],
+            file.polyhedron.centre[2]
+        );
+        for (k, p) in partitions.iter().enumerate() {
+            println!(
+                "  partition {k}: {} copies, {} with tests",
+                p["copies"], p["tested"]
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
