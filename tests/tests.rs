@@ -22,6 +22,7 @@ mod format_upgrade;
 mod gpu_budget;
 mod long_paths;
 mod merge_car;
+mod presort_cli;
 mod record_cli;
 mod self_check_cli;
 mod shard_cli;

@@ -4,7 +4,9 @@
 use trisort_format::{FrameState, Geometry};
 use trisort_gpu::{Gpu, Lighting};
 use trisort_player::Mode;
-use trisort_reference::{OitConfig, OitRenderer, PeelingConfig, PeelingRenderer};
+use trisort_reference::{
+    OitConfig, OitRenderer, PeelingConfig, PeelingRenderer, PresortedRenderer,
+};
 
 use crate::methods::{BenchView, Method, Stream};
 use crate::BenchError;
@@ -168,7 +170,7 @@ impl Method for PeelingMethod<'_> {
     }
 }
 
-/// Builds the `oit` or `peeling` method of a group (`None` for the other kinds).
+/// Builds the `oit`, `peeling` or `presorted` method of a group (`None` for the other kinds).
 pub(crate) fn build<'g>(
     kind: crate::table::MethodKind,
     gpu: &'g Gpu,
@@ -199,6 +201,185 @@ pub(crate) fn build<'g>(
                 input.baked.settings.max_layers.max(1),
             )?))
         }
+        MethodKind::Presorted => {
+            progress("presorting (paper 000, 6 partitions)");
+            Some(Box::new(PresortedMethod::new(
+                gpu,
+                input.geometry,
+                input.frame_states,
+                &input.baked.environment,
+                input.view,
+                input.mode,
+            )?))
+        }
         _ => None,
     })
+}
+
+/// The `presorted` method (paper 000): the scene presorted for free viewpoints
+/// ([`trisort_presort`], 6 partitions), drawn by [`PresortedRenderer`]: the opaque triangles
+/// with the depth test, then the camera's partition's list in one draw with the fragment-stage
+/// half-space test. It needs no bake, only cameras outside the scene's bounding polyhedron.
+pub struct PresortedMethod<'g> {
+    gpu: &'g Gpu,
+    mode: Mode,
+    file: trisort_format::Presorted,
+    renderer: PresortedRenderer<'g>,
+    target: trisort_gpu::FrameTarget,
+}
+
+impl<'g> PresortedMethod<'g> {
+    /// Presorts `geometry` (6 partitions) and uploads it for `frames`; errors where a camera
+    /// is inside the polyhedron or the presort finds no order.
+    pub fn new(
+        gpu: &'g Gpu,
+        geometry: &Geometry,
+        frames: &[FrameState],
+        environment: &trisort_format::Environment,
+        view: BenchView,
+        mode: Mode,
+    ) -> Result<PresortedMethod<'g>, BenchError> {
+        // A path this method cannot draw (a camera inside the polyhedron, a moving node) or a
+        // scene it cannot order leaves it out of the table, saying why.
+        let unsupported = |why: String| {
+            BenchError::Reference(trisort_reference::ReferenceError::Unsupported(why))
+        };
+        let file = presorted_once(geometry, environment, view.glass_opacity)
+            .map_err(|e| unsupported(format!("presorting: {e}")))?;
+        trisort_reference::presorted::partitions_of(&file, frames)
+            .map_err(|e| unsupported(e.to_string()))?;
+        let renderer = PresortedRenderer::new(
+            gpu,
+            &file,
+            frames,
+            view.view(),
+            Lighting::pbr(environment),
+            mode,
+        )?;
+        let target = trisort_gpu::FrameTarget::new(
+            &gpu.adapter,
+            &gpu.device,
+            trisort_gpu::TargetConfig {
+                depth: true,
+                ..trisort_gpu::TargetConfig::readback(view.size, view.samples, mode)
+            },
+        )?;
+        Ok(PresortedMethod {
+            gpu,
+            mode,
+            file,
+            renderer,
+            target,
+        })
+    }
+}
+
+impl Method for PresortedMethod<'_> {
+    fn name(&self) -> &str {
+        "presorted"
+    }
+    fn mode(&self) -> Mode {
+        self.mode
+    }
+    fn gpu(&self) -> &Gpu {
+        self.gpu
+    }
+    fn variant(&self) -> String {
+        let s = &self.file.stats;
+        format!(
+            "paper 000, {} partitions, {} copies for {} sorted triangles, fragment-stage test",
+            self.file.segments.len(),
+            s.list_triangles,
+            s.sorted_triangles
+        )
+    }
+    fn triangles(&self, frame: u32) -> u64 {
+        self.renderer.triangles(frame) as u64
+    }
+    fn draws(&self, _frame: u32) -> u32 {
+        self.renderer.draws()
+    }
+    fn stat_slots(&self, _frame: u32) -> u32 {
+        1
+    }
+    fn encode(&self, enc: &mut wgpu::CommandEncoder, frame: u32, stats: Option<&wgpu::QuerySet>) {
+        let mut pass = self
+            .target
+            .begin_pass(enc, trisort_gpu::clear_colour(self.mode), None);
+        if let Some(set) = stats {
+            pass.begin_pipeline_statistics_query(set, 0);
+        }
+        self.renderer.draw(&mut pass, frame);
+        if stats.is_some() {
+            pass.end_pipeline_statistics_query();
+        }
+    }
+    fn image(&self, frame: u32) -> Result<Vec<u8>, BenchError> {
+        Ok(self
+            .target
+            .read_rgba8(self.gpu, self.mode, |enc| self.encode(enc, frame, None))?)
+    }
+    fn streams(&self, frame: u32) -> Vec<Stream> {
+        let g = &self.file.geometry;
+        let opaque: Vec<u32> = self
+            .file
+            .opaque
+            .iter()
+            .flat_map(|&t| g.triangles[t as usize])
+            .collect();
+        let list: Vec<u32> = self
+            .renderer
+            .partition(frame)
+            .map(|k| {
+                let s = self.file.segments[k];
+                self.file.copies[s.first as usize..(s.first + s.count) as usize]
+                    .iter()
+                    .flat_map(|c| g.triangles[c.triangle as usize])
+                    .collect()
+            })
+            .unwrap_or_default();
+        vec![
+            Stream {
+                indices: opaque,
+                depth: Some(true),
+                repeat: 1,
+                per_sample: false,
+            },
+            Stream {
+                indices: list,
+                depth: Some(false),
+                repeat: 1,
+                per_sample: false,
+            },
+        ]
+    }
+}
+
+/// The presort of `geometry`, made once per process: a bench's groups (sample counts, modes)
+/// share one scene, and presorting it takes seconds.
+fn presorted_once(
+    geometry: &Geometry,
+    environment: &trisort_format::Environment,
+    glass_opacity: f32,
+) -> Result<trisort_format::Presorted, trisort_presort::PresortError> {
+    use std::sync::{Mutex, OnceLock};
+    type Memo = Mutex<Vec<(trisort_format::Hash, trisort_format::Presorted)>>;
+    static MEMO: OnceLock<Memo> = OnceLock::new();
+    let mut bytes: Vec<u8> = bytemuck::cast_slice(&geometry.vertices).to_vec();
+    bytes.extend_from_slice(bytemuck::cast_slice(&geometry.triangles));
+    bytes.extend_from_slice(&glass_opacity.to_le_bytes());
+    let key = trisort_format::hash_bytes(&bytes);
+    let memo = MEMO.get_or_init(|| Mutex::new(Vec::new()));
+    if let Some((_, f)) = memo.lock().unwrap().iter().find(|(k, _)| *k == key) {
+        return Ok(f.clone());
+    }
+    let lists = trisort_presort::presort(geometry, Default::default(), &|_, _| {})?;
+    let file = lists.into_presorted(
+        geometry.clone(),
+        environment.clone(),
+        glass_opacity,
+        [0; 32],
+    );
+    memo.lock().unwrap().push((key, file.clone()));
+    Ok(file)
 }

@@ -30,16 +30,19 @@ pub enum MethodKind {
     Oit,
     /// Exact GPU depth peeling.
     Peeling,
+    /// Depth-presorted lists for free viewpoints (paper 000).
+    Presorted,
 }
 
 impl MethodKind {
     /// All methods, in table order.
-    pub const ALL: [MethodKind; 5] = [
+    pub const ALL: [MethodKind; 6] = [
         MethodKind::Default,
         MethodKind::Source,
         MethodKind::Merged,
         MethodKind::Oit,
         MethodKind::Peeling,
+        MethodKind::Presorted,
     ];
 
     /// The name used on the command line and in JSON.
@@ -50,6 +53,7 @@ impl MethodKind {
             MethodKind::Merged => "merged",
             MethodKind::Oit => "oit",
             MethodKind::Peeling => "peeling",
+            MethodKind::Presorted => "presorted",
         }
     }
 
@@ -61,7 +65,7 @@ impl MethodKind {
     /// Whether the method renders `mode` (OIT: blend only; default and peeling: no saturate).
     pub fn supports(self, mode: Mode) -> bool {
         match self {
-            MethodKind::Source | MethodKind::Merged => true,
+            MethodKind::Source | MethodKind::Merged | MethodKind::Presorted => true,
             MethodKind::Oit => mode == Mode::Blend,
             MethodKind::Default | MethodKind::Peeling => mode != Mode::Saturate,
         }
@@ -313,7 +317,7 @@ fn build_methods<'a>(
                     )?));
                 }
             }
-            MethodKind::Oit | MethodKind::Peeling => {
+            MethodKind::Oit | MethodKind::Peeling | MethodKind::Presorted => {
                 match crate::rivals::build(kind, gpu, input, progress) {
                     Ok(Some(m)) => methods.push(m),
                     Ok(None) => {}

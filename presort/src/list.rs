@@ -21,10 +21,11 @@
 //! copy whose region has no volume is dropped (no viewpoint draws it).
 
 use std::collections::HashMap;
+use std::rc::Rc;
 
 use glam::DVec3;
 
-use crate::geom::{occlusion, region, Plane, Tri};
+use crate::geom::{occlusion, region, Plane, Tri, INTERIOR};
 use crate::lp::separate;
 use crate::partition::Partition;
 
@@ -116,7 +117,7 @@ struct Builder<'a, P: Planes> {
     partition: &'a Partition,
     planes: &'a mut P,
     /// Ō(x→y) by copy uids: its vertices when it has volume.
-    cache: HashMap<(u32, u32), Option<Vec<DVec3>>>,
+    cache: HashMap<(u32, u32), Option<Rc<[DVec3]>>>,
     next_uid: u32,
     stats: ListStats,
 }
@@ -141,7 +142,7 @@ impl<P: Planes> Builder<'_, P> {
     }
 
     /// Ō(x→y)'s vertices when `x` occludes `y` somewhere both are drawn.
-    fn occludes(&mut self, x: &ListCopy, y: &ListCopy) -> Option<Vec<DVec3>> {
+    fn occludes(&mut self, x: &ListCopy, y: &ListCopy) -> Option<Rc<[DVec3]>> {
         if let Some(v) = self.cache.get(&(x.uid, y.uid)) {
             return v.clone();
         }
@@ -149,14 +150,25 @@ impl<P: Planes> Builder<'_, P> {
             &self.instances[x.instance as usize].tri,
             &self.instances[y.instance as usize].tri,
         );
-        let v = occlusion(tx, ty).and_then(|o| {
-            self.stats.regions += 1;
-            let mut planes = x.region.clone();
-            planes.extend(o);
-            // y's region beyond what x's already has: its front side and its cuts.
-            planes.extend_from_slice(&y.region[self.partition.planes.len()..]);
-            region(&planes)
-        });
+        // Cheap rejections first, not cached (they cost less than a lookup's memory): the
+        // triangles' sides of each other's planes, then a plane of O(x→y) with the whole
+        // partition outside it.
+        let o = occlusion(tx, ty)?;
+        let outside = |p: &Plane| {
+            self.partition
+                .vertices
+                .iter()
+                .all(|v| p.eval(*v) < -INTERIOR)
+        };
+        if o.iter().any(outside) {
+            return None;
+        }
+        self.stats.regions += 1;
+        let mut planes = x.region.clone();
+        planes.extend(o);
+        // y's region beyond what x's already has: its front side and its cuts.
+        planes.extend_from_slice(&y.region[self.partition.planes.len()..]);
+        let v: Option<Rc<[DVec3]>> = region(&planes).map(Rc::from);
         self.cache.insert((x.uid, y.uid), v.clone());
         v
     }
@@ -194,10 +206,9 @@ pub fn build_list<P: Planes>(
     while p < list.len() {
         steps += 1;
         let x = list[p].clone();
-        let mut backs: Vec<(usize, Vec<DVec3>)> = Vec::new();
+        let mut backs: Vec<(usize, Rc<[DVec3]>)> = Vec::new();
         for q in p + 1..list.len() {
-            let y = list[q].clone();
-            if let Some(v) = b.occludes(&x, &y) {
+            if let Some(v) = b.occludes(&x, &list[q]) {
                 backs.push((q, v));
             }
         }
@@ -215,10 +226,9 @@ pub fn build_list<P: Planes>(
                 steps,
             });
         }
-        let mut fronts: Vec<Vec<DVec3>> = Vec::new();
+        let mut fronts: Vec<Rc<[DVec3]>> = Vec::new();
         for q in p + 1..=last {
-            let f = list[q].clone();
-            if let Some(v) = b.occludes(&f, &x) {
+            if let Some(v) = b.occludes(&list[q], &x) {
                 fronts.push(v);
             }
         }

@@ -66,7 +66,8 @@ pub struct PresortedRenderer<'g> {
     segments: Vec<(u32, u32)>,
     opaque: (wgpu::Buffer, u32),
     sorted: wgpu::Buffer,
-    params: wgpu::Buffer,
+    /// Bytes between frames' uniform slots.
+    stride: u32,
     bind_group: wgpu::BindGroup,
     /// (pipeline, what it draws: false opaque, true the segment), in order.
     passes: Vec<(wgpu::RenderPipeline, bool)>,
@@ -97,7 +98,7 @@ impl<'g> PresortedRenderer<'g> {
         }
         let partitions = partitions_of(file, frames)?;
         let c = file.polyhedron.centre;
-        let frame_eyes = partitions
+        let frame_eyes: Vec<(usize, [f32; 3])> = partitions
             .iter()
             .zip(frames)
             .map(|(&k, s)| {
@@ -169,17 +170,21 @@ impl<'g> PresortedRenderer<'g> {
         );
         let tests = buffer("presorted tests", bytemuck::cast_slice(&tests), storage);
         let planes = buffer("presorted planes", bytemuck::cast_slice(&planes), storage);
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("presorted params"),
-            size: 32,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        // Every frame's camera and segment, one uniform slot each (a dynamic offset picks the
+        // frame, so frames can be encoded back to back without a write between them).
+        let stride = device.limits().min_uniform_buffer_offset_alignment.max(32) as usize;
+        let mut slots = vec![0u8; stride * frames.len().max(1)];
+        for (f, (k, eye)) in frame_eyes.iter().enumerate() {
+            let at = f * stride;
+            slots[at..at + 12].copy_from_slice(bytemuck::cast_slice(eye));
+            slots[at + 16..at + 20].copy_from_slice(&segments[*k].0.to_le_bytes());
+        }
+        let params = buffer("presorted params", &slots, wgpu::BufferUsages::UNIFORM);
         let fragment = wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("presorted"),
             entries: &[
-                uniform_entry(0, fragment, false, Some(32)),
+                uniform_entry(0, fragment, true, Some(32)),
                 storage_entry(1, fragment, true),
                 storage_entry(2, fragment, true),
                 storage_entry(3, fragment, true),
@@ -191,7 +196,11 @@ impl<'g> PresortedRenderer<'g> {
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
-                    resource: params.as_entire_binding(),
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &params,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(32),
+                    }),
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
@@ -297,7 +306,7 @@ impl<'g> PresortedRenderer<'g> {
             segments,
             opaque,
             sorted,
-            params,
+            stride: stride as u32,
             bind_group,
             passes,
             target,
@@ -312,31 +321,25 @@ impl<'g> PresortedRenderer<'g> {
     /// Triangles submitted for frame `frame` (the opaque ones and the partition's copies; the
     /// copies that fail their tests are discarded per fragment).
     pub fn triangles(&self, frame: u32) -> u32 {
-        let k = self.frames[frame as usize].0;
+        // (Frames beyond the path count the opaque triangles alone.)
+        let Some(&(k, _)) = self.frames.get(frame as usize) else {
+            return self.opaque.1 / 3;
+        };
         self.opaque.1 / 3 + self.segments[k].1
     }
 
-    /// Writes frame `frame`'s camera and segment; call before recording the frame's passes
-    /// (their uniform is shared by every frame).
-    pub fn prepare(&self, frame: u32) -> Result<(), ReferenceError> {
-        let &(k, eye) = self
-            .frames
-            .get(frame as usize)
-            .ok_or_else(|| ReferenceError::Invalid(format!("frame {frame} is beyond the path")))?;
-        let mut bytes = [0u8; 32];
-        bytes[..12].copy_from_slice(bytemuck::cast_slice(&eye));
-        bytes[16..20].copy_from_slice(&self.segments[k].0.to_le_bytes());
-        self.gpu.queue.write_buffer(&self.params, 0, &bytes);
-        Ok(())
+    /// Draw calls of a frame (the opaque pass or passes, the list).
+    pub fn draws(&self) -> u32 {
+        self.passes.len() as u32
     }
 
     /// Records frame `frame` into `pass` (attachments as the view: `Rgba16Float` colour and
-    /// `Depth32Float` depth at its sample count); [`PresortedRenderer::prepare`] first.
+    /// `Depth32Float` depth at its sample count).
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, frame: u32) {
         let (k, _) = self.frames[frame as usize];
         let (first, count) = self.segments[k];
         pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
-        pass.set_bind_group(1, &self.bind_group, &[]);
+        pass.set_bind_group(1, &self.bind_group, &[frame * self.stride]);
         pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
         for (pipeline, list) in &self.passes {
             pass.set_pipeline(pipeline);
@@ -359,7 +362,11 @@ impl<'g> PresortedRenderer<'g> {
     /// Renders frame `frame` over the player's background as 8-bit sRGB RGBA (quantized once,
     /// like the player's frames).
     pub fn render(&self, frame: u32) -> Result<Vec<u8>, ReferenceError> {
-        self.prepare(frame)?;
+        if frame as usize >= self.frames.len() {
+            return Err(ReferenceError::Invalid(format!(
+                "frame {frame} is beyond the path"
+            )));
+        }
         let bytes = self
             .target
             .render(self.gpu, clear_colour(self.mode), |pass| {

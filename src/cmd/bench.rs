@@ -41,7 +41,9 @@ pub struct BenchArgs {
     /// Modes, comma-separated (blend, depth, saturate). The first is the headline.
     #[arg(long, default_value = "blend,depth,saturate", value_delimiter = ',')]
     mode: Vec<Mode>,
-    /// Methods, comma-separated: default, source, merged, oit, peeling.
+    /// Methods, comma-separated: default, source, merged, oit, peeling, presorted (paper 000;
+    /// not by default: it presorts the scene first, and needs every camera outside the
+    /// scene's bounding polyhedron).
     #[arg(long, default_value = "default,source,merged,oit,peeling", value_delimiter = ',', value_parser = parse_method)]
     methods: Vec<MethodKind>,
     /// Frames to measure, half-open `a..b` (default: all); the bake always covers the path.

@@ -40,8 +40,10 @@ pub struct PresortArgs {
     /// The light players shade with: `studio` or an equirectangular .hdr file.
     #[arg(long, default_value = "studio")]
     environment: String,
-    /// Opacity transmissive glass is drawn at.
-    #[arg(long, default_value_t = RecordSettings::DEFAULT_GLASS_OPACITY)]
+    /// Opacity transmissive glass is drawn at (stored; `play --glass-opacity` overrides it).
+    /// Visibly tinted by default, as `demo` draws it: at 0 (`bake`'s default, see-through)
+    /// glass shows nothing and its order nothing either.
+    #[arg(long, default_value_t = super::demo::DEMO_GLASS_OPACITY)]
     glass_opacity: f32,
     /// Do not split triangles that pass through each other first (no order exists for them).
     #[arg(long)]
@@ -162,8 +164,8 @@ pub fn read(path: &Path) -> Result<Presorted> {
 }
 
 /// `N` random cameras outside `file`'s polyhedron (1.2 to 4 times its largest face distance
-/// from the centre, in random directions), each looking at the centre with the scene in view;
-/// deterministic for a seed.
+/// from the centre, in random directions; camera k in partition k mod the partitions), each
+/// looking at the centre with the scene in view; deterministic for a seed.
 pub fn random_views(file: &Presorted, n: u32, seed: u64) -> Vec<FrameState> {
     let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
     let mut next = move || {
@@ -187,7 +189,10 @@ pub fn random_views(file: &Presorted, n: u32, seed: u64) -> Vec<FrameState> {
         }
         let distance = size * (1.2 + 2.8 * next());
         let eye = centre + d.normalize() * distance;
-        if file.polyhedron.partition_of(eye.to_array()).is_err() {
+        // Camera k in partition k mod faces, so that every list is drawn (on a flat scene
+        // most directions leave through the top or bottom face).
+        let wanted = out.len() % file.polyhedron.faces.len();
+        if file.polyhedron.partition_of(eye.to_array()) != Ok(wanted) {
             continue;
         }
         let dir = (centre - eye).normalize();
