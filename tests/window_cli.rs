@@ -422,3 +422,34 @@ fn window_shows_the_png_frames_pixels() {
         );
     }
 }
+
+/// `play --window` on a presorted file (paper 000): the free-viewpoint window turns the camera
+/// as a turntable until `--window-frames` frames were presented, every one drawn sorted from
+/// a camera outside the polyhedron.
+#[test]
+fn window_orbits_a_presorted_file() {
+    if tools_missing(&["xvfb-run"]) {
+        eprintln!("skipping the presorted window test: xvfb-run is not on PATH");
+        return;
+    }
+    let Some(dir) = gpu_tempdir() else {
+        return;
+    };
+    let d = dir.path();
+    run(d, &args("presort demo:2000 -o w.presorted"), true);
+    let window = args("play w.presorted --window --window-frames 40 --size 96x64 --json");
+    let (code, stdout, stderr) = under_xvfb(d, &window, Duration::from_secs(120));
+    assert_eq!(code, Some(0), "{stdout}\n--- stderr\n{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout)
+        .unwrap_or_else(|e| panic!("bad JSON ({e}): {stdout}\n--- stderr\n{stderr}"));
+    assert_eq!(v["kind"], "presorted");
+    assert_eq!(v["presented"], 40, "{v}");
+    assert!(!v["partitions"].as_array().unwrap().is_empty(), "{v}");
+    // The turntable turned the camera 1.5 degrees after each frame but the last, from 30.
+    let yaw = v["last_camera"]["yaw"].as_f64().unwrap();
+    assert!((yaw - (30.0 + 1.5 * 39.0)).abs() < 1e-6, "{v}");
+    assert!(
+        stderr.contains("drag to orbit"),
+        "the controls are told: {stderr}"
+    );
+}

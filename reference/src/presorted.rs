@@ -68,6 +68,10 @@ pub struct PresortedRenderer<'g> {
     sorted: wgpu::Buffer,
     /// Bytes between frames' uniform slots.
     stride: u32,
+    /// Every frame's camera and segment.
+    params: wgpu::Buffer,
+    /// The file's polyhedron (a free camera's partition).
+    polyhedron: trisort_format::Polyhedron,
     bind_group: wgpu::BindGroup,
     /// (pipeline, what it draws: false opaque, true the segment), in order.
     passes: Vec<(wgpu::RenderPipeline, bool)>,
@@ -179,7 +183,12 @@ impl<'g> PresortedRenderer<'g> {
             slots[at..at + 12].copy_from_slice(bytemuck::cast_slice(eye));
             slots[at + 16..at + 20].copy_from_slice(&segments[*k].0.to_le_bytes());
         }
-        let params = buffer("presorted params", &slots, wgpu::BufferUsages::UNIFORM);
+        let params = buffer(
+            "presorted params",
+            &slots,
+            // COPY_DST: a free camera rewrites its slot (`set_camera`).
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
         let fragment = wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("presorted"),
@@ -307,10 +316,60 @@ impl<'g> PresortedRenderer<'g> {
             opaque,
             sorted,
             stride: stride as u32,
+            params,
+            polyhedron: file.polyhedron.clone(),
             bind_group,
             passes,
             target,
         })
+    }
+
+    /// Moves frame slot `frame` to the camera of `state` (a free camera: the window's orbit),
+    /// `geometry` being the file's scene. Errors, leaving the slot as it was, where the camera
+    /// is inside the polyhedron or beyond its reach or `state` moves a node.
+    pub fn set_camera(
+        &mut self,
+        geometry: &trisort_format::Geometry,
+        frame: u32,
+        state: &FrameState,
+    ) -> Result<usize, ReferenceError> {
+        if frame as usize >= self.frames.len() {
+            return Err(ReferenceError::Invalid(format!(
+                "frame {frame} is beyond the path"
+            )));
+        }
+        if !state.poses.is_empty() {
+            return Err(ReferenceError::Invalid(
+                "a presorted file holds the scene at rest: no node may move".into(),
+            ));
+        }
+        let e = state.camera.eye();
+        let k = self
+            .polyhedron
+            .partition_of(e.to_array())
+            .map_err(|why| ReferenceError::Invalid(why.to_string()))?;
+        let c = self.polyhedron.centre;
+        let eye = [
+            (e.x - c[0]) as f32,
+            (e.y - c[1]) as f32,
+            (e.z - c[2]) as f32,
+        ];
+        if !self
+            .scene
+            .set_frame(&self.gpu.queue, geometry, frame, state)
+        {
+            return Err(ReferenceError::Unsupported(
+                "the scene's frames cannot be rewritten on this binding tier".into(),
+            ));
+        }
+        let mut bytes = [0u8; 32];
+        bytes[..12].copy_from_slice(bytemuck::cast_slice(&eye));
+        bytes[16..20].copy_from_slice(&self.segments[k].0.to_le_bytes());
+        self.gpu
+            .queue
+            .write_buffer(&self.params, frame as u64 * self.stride as u64, &bytes);
+        self.frames[frame as usize] = (k, eye);
+        Ok(k)
     }
 
     /// Frame `frame`'s partition.

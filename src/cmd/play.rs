@@ -205,10 +205,17 @@ pub fn check_profile(
 pub fn run(a: PlayArgs) -> Result<ExitCode> {
     if super::presort::is_presorted(&a.baked) {
         if a.window {
-            anyhow::bail!(
-                "{}: presorted files play headless (--path P --out-dir DIR); --window plays baked files",
-                a.baked.display()
-            );
+            return super::presort::orbit_window(super::presort::OrbitArgs {
+                file: &a.baked,
+                size: a.size,
+                samples: a.samples,
+                mode: a.mode,
+                glass_opacity: a.glass_opacity,
+                shading: a.shading.shading,
+                tone_map: a.shading.tonemap,
+                exit_after: a.window_frames,
+                json: a.json,
+            });
         }
         let run = super::presort::PresortedRun {
             file: &a.baked,

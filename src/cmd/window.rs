@@ -76,7 +76,7 @@ impl ViewerHost for Host<'_> {
 }
 
 /// The viewer's error in the CLI's words (the flags to use instead).
-fn cli_error(e: ViewerError) -> anyhow::Error {
+pub fn cli_error(e: ViewerError) -> anyhow::Error {
     match e {
         ViewerError::NoDisplay { detail: None } => anyhow!("{NO_DISPLAY}"),
         ViewerError::NoDisplay { detail: Some(d) } => anyhow!("{NO_DISPLAY} ({d})"),

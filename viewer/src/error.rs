@@ -64,6 +64,15 @@ pub enum ViewerError {
         #[source]
         source: Box<ViewerError>,
     },
+    /// The presorted renderer refused the file or a camera.
+    #[error("showing {}", file.display())]
+    Presorted {
+        /// The presorted file.
+        file: PathBuf,
+        /// What failed.
+        #[source]
+        source: trisort_reference::ReferenceError,
+    },
     /// wgpu could not create a surface for the window.
     #[error("creating a wgpu surface for the window")]
     Surface(#[source] wgpu::CreateSurfaceError),

@@ -37,11 +37,13 @@
 mod app;
 mod error;
 mod gfx;
+mod orbit;
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 pub use error::{BoxError, ViewerError};
+pub use orbit::{orbit, OrbitOptions, Orbited, ORBIT_CONTROLS};
 use trisort_format::{Baked, Mode};
 use trisort_gpu::{Gpu, Shading, ToneMap};
 

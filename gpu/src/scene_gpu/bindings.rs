@@ -10,8 +10,8 @@ use super::uniforms::{FrameData, FrameUniform, LightingUniform};
 
 /// The material table on the GPU: a storage buffer, or the texture tier's data texture.
 pub(crate) enum MaterialStore {
-    /// Storage tier: binding 2.
-    Buffer(wgpu::Buffer),
+    /// Storage tier: binding 2 (and binding 1's node matrices).
+    Buffer(wgpu::Buffer, wgpu::Buffer),
     /// Texture tier: the Rgba32Float texture of binding 2, [`DATA_WIDTH`] texels a row.
     Texture(wgpu::Texture),
 }
@@ -239,7 +239,8 @@ pub(super) fn storage_bind_group(
         "node matrices",
         budget.bytes.buffer(GpuKind::NodeMatrices),
         &data.node_bytes,
-        wgpu::BufferUsages::STORAGE,
+        // COPY_DST: a free camera rewrites a frame's matrices (`SceneGpu::set_frame`).
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
     );
     allocated.count_buffer(GpuKind::Materials, &materials);
     allocated.count_buffer(GpuKind::NodeMatrices, &node_buffer);
@@ -265,6 +266,6 @@ pub(super) fn storage_bind_group(
         layout,
         bind_group,
         data.node_stride,
-        MaterialStore::Buffer(materials),
+        MaterialStore::Buffer(materials, node_buffer),
     )
 }

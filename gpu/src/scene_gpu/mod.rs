@@ -368,7 +368,7 @@ impl SceneGpu {
         let table = material_table(materials, &self.texture_places);
         let bytes: &[u8] = bytemuck::cast_slice(&table);
         match &self.material_store {
-            MaterialStore::Buffer(buffer) => queue.write_buffer(buffer, 0, bytes),
+            MaterialStore::Buffer(buffer, _) => queue.write_buffer(buffer, 0, bytes),
             MaterialStore::Texture(texture) => {
                 crate::data_textures::write_data_texture(queue, texture, bytes)
             }
@@ -413,6 +413,37 @@ impl SceneGpu {
                 bytemuck::bytes_of(&u),
             );
         }
+    }
+
+    /// Replaces frame `f`'s camera and node poses with `state` (uniforms and camera-relative
+    /// node matrices of `geometry`, the scene uploaded): a free camera draws through one frame
+    /// slot. Storage tier only; `false` (nothing written) on the data-texture tier or for a
+    /// frame beyond those uploaded. Takes effect for commands submitted after it.
+    pub fn set_frame(
+        &mut self,
+        queue: &wgpu::Queue,
+        geometry: &Geometry,
+        f: u32,
+        state: &FrameState,
+    ) -> bool {
+        let MaterialStore::Buffer(_, nodes) = &self.material_store else {
+            return false;
+        };
+        let Some(slot) = self.uniforms.get_mut(f as usize) else {
+            return false;
+        };
+        *slot = (
+            frame_uniform(state, self.view),
+            projection(state, self.view),
+        );
+        queue.write_buffer(
+            &self.frame_buffer,
+            f as u64 * self.frame_stride,
+            bytemuck::bytes_of(&slot.0),
+        );
+        let m = trisort_format::gpu_layout::node_matrices(geometry, state);
+        queue.write_buffer(nodes, f as u64 * self.node_stride, bytemuck::cast_slice(&m));
+        true
     }
 
     /// Number of frames uploaded.
