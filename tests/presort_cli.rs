@@ -55,9 +55,7 @@ fn a_presorted_demo_car_verifies_exact_from_random_cameras_and_a_reversed_one_do
     );
     let depth = run_json(
         d,
-        &args(&format!(
-            "verify car.presorted --path random:4:8 --size 96x96 --samples 4 --mode depth"
-        )),
+        &args("verify car.presorted --path random:4:8 --size 96x96 --samples 4 --mode depth"),
     );
     assert_eq!(depth["ok"], true, "{depth}");
 

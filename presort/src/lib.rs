@@ -142,19 +142,7 @@ pub fn presort(
     if let Some(t) = world.iter().position(|t| t.iter().any(|v| !v.is_finite())) {
         return Err(PresortError::NotFinite(t as u32));
     }
-    let (lo, hi) = world.iter().flatten().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), v| (lo.min(*v), hi.max(*v)),
-    );
-    let centre = (lo + hi) * 0.5;
-    let radius = world
-        .iter()
-        .flatten()
-        .map(|v| v.distance(centre))
-        .fold(0.0, f64::max);
-    if !(radius > 0.0 && radius.is_finite()) {
-        return Err(PresortError::Empty);
-    }
+    let (centre, radius) = bounds(&world)?;
     let norm = |v: DVec3| (v - centre) / radius;
     // The polyhedron: each face just outside the scene's support in its direction.
     let faces: Vec<(DVec3, f64)> = partition::face_normals(options.partitions)
@@ -177,34 +165,7 @@ pub fn presort(
             opaque.push(t);
         }
     }
-    // Instances, and the planes of the double-sided ones' own tests (shared by all lists).
-    let mut own_planes: Vec<Plane> = Vec::new();
-    let mut instances: Vec<Instance> = Vec::new();
-    for &t in &sorted {
-        let tri = Tri::new(world[t as usize].map(norm), t);
-        let material = &geometry.materials[geometry.triangle_material(t) as usize];
-        match (material.double_sided, tri.plane) {
-            (true, Some(plane)) => {
-                own_planes.push(plane);
-                let index = (own_planes.len() - 1) as u32;
-                instances.push(Instance {
-                    tri,
-                    own: Some(Test {
-                        plane: index,
-                        flipped: false,
-                    }),
-                });
-                instances.push(Instance {
-                    tri: tri.reversed(),
-                    own: Some(Test {
-                        plane: index,
-                        flipped: true,
-                    }),
-                });
-            }
-            _ => instances.push(Instance { tri, own: None }),
-        }
-    }
+    let (own_planes, instances) = instances(geometry, &sorted, &world, norm);
     let done = AtomicUsize::new(0);
     let total = parts.len();
     progress(0, total);
@@ -320,4 +281,56 @@ impl Lists {
             stats: self.stats,
         }
     }
+}
+
+/// The centre of the scene's bounding box and the largest distance of a corner from it.
+fn bounds(world: &[[DVec3; 3]]) -> Result<(DVec3, f64), PresortError> {
+    let (lo, hi) = world.iter().flatten().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+    );
+    let centre = (lo + hi) * 0.5;
+    let radius = world
+        .iter()
+        .flatten()
+        .map(|v| v.distance(centre))
+        .fold(0.0, f64::max);
+    if !(radius > 0.0 && radius.is_finite()) {
+        return Err(PresortError::Empty);
+    }
+    Ok((centre, radius))
+}
+
+/// The instances of the `sorted` triangles (normalised by `norm`): the front of each, and the
+/// back of a double-sided one too, each double-sided instance tested against its triangle's
+/// plane (returned first: shared by every partition's list).
+fn instances(
+    geometry: &Geometry,
+    sorted: &[u32],
+    world: &[[DVec3; 3]],
+    norm: impl Fn(DVec3) -> DVec3,
+) -> (Vec<Plane>, Vec<Instance>) {
+    let mut own_planes: Vec<Plane> = Vec::new();
+    let mut instances: Vec<Instance> = Vec::new();
+    for &t in sorted {
+        let tri = Tri::new(world[t as usize].map(&norm), t);
+        let material = &geometry.materials[geometry.triangle_material(t) as usize];
+        match (material.double_sided, tri.plane) {
+            (true, Some(plane)) => {
+                own_planes.push(plane);
+                let index = (own_planes.len() - 1) as u32;
+                for (tri, flipped) in [(tri, false), (tri.reversed(), true)] {
+                    instances.push(Instance {
+                        tri,
+                        own: Some(Test {
+                            plane: index,
+                            flipped,
+                        }),
+                    });
+                }
+            }
+            _ => instances.push(Instance { tri, own: None }),
+        }
+    }
+    (own_planes, instances)
 }

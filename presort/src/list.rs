@@ -207,8 +207,8 @@ pub fn build_list<P: Planes>(
         steps += 1;
         let x = list[p].clone();
         let mut backs: Vec<(usize, Rc<[DVec3]>)> = Vec::new();
-        for q in p + 1..list.len() {
-            if let Some(v) = b.occludes(&x, &list[q]) {
+        for (q, y) in list.iter().enumerate().skip(p + 1) {
+            if let Some(v) = b.occludes(&x, y) {
                 backs.push((q, v));
             }
         }
@@ -227,8 +227,8 @@ pub fn build_list<P: Planes>(
             });
         }
         let mut fronts: Vec<Rc<[DVec3]>> = Vec::new();
-        for q in p + 1..=last {
-            if let Some(v) = b.occludes(&list[q], &x) {
+        for f in &list[p + 1..=last] {
+            if let Some(v) = b.occludes(f, &x) {
                 fronts.push(v);
             }
         }

@@ -25,7 +25,7 @@ pub fn separate(negative: &[DVec3], positive: &[DVec3]) -> Option<Plane> {
         for p in points {
             // sign · (n · p − d) ≥ s
             lp.add_constraint(
-                &[
+                [
                     (n[0], sign * p.x),
                     (n[1], sign * p.y),
                     (n[2], sign * p.z),

@@ -90,32 +90,12 @@ impl<'g> PresortedRenderer<'g> {
         lighting: Lighting<'_>,
         mode: Mode,
     ) -> Result<PresortedRenderer<'g>, ReferenceError> {
-        if !gpu
-            .device
-            .features()
-            .contains(wgpu::Features::PRIMITIVE_INDEX)
-        {
-            return Err(ReferenceError::Unsupported(format!(
-                "{}: the presorted renderer selects copies by primitive index",
-                gpu.describe()
-            )));
-        }
+        check_device(gpu)?;
         let partitions = partitions_of(file, frames)?;
-        let c = file.polyhedron.centre;
         let frame_eyes: Vec<(usize, [f32; 3])> = partitions
             .iter()
             .zip(frames)
-            .map(|(&k, s)| {
-                let e = s.camera.eye();
-                (
-                    k,
-                    [
-                        (e.x - c[0]) as f32,
-                        (e.y - c[1]) as f32,
-                        (e.z - c[2]) as f32,
-                    ],
-                )
-            })
+            .map(|(&k, s)| (k, relative_eye(file, s)))
             .collect();
         let device = &gpu.device;
         let target = Target::new(
@@ -127,33 +107,8 @@ impl<'g> PresortedRenderer<'g> {
         )?;
         let shading = lighting.shading;
         let scene = lit_scene(gpu, &file.geometry, frames, view, lighting);
-        // The copies in drawing order: back to front in blend, front to back otherwise.
-        let reverse = mode != Mode::Blend;
-        let mut order: Vec<u32> = Vec::with_capacity(file.copies.len());
-        let mut segments = Vec::with_capacity(file.segments.len());
-        for s in &file.segments {
-            segments.push((order.len() as u32, s.count));
-            let run = s.first..s.first + s.count;
-            if reverse {
-                order.extend(run.rev());
-            } else {
-                order.extend(run);
-            }
-        }
-        let mut index: Vec<u32> = Vec::with_capacity(order.len() * 3 + 3);
-        let mut copy_tests: Vec<[u32; 2]> = Vec::with_capacity(order.len() + 1);
-        for &k in &order {
-            let copy = &file.copies[k as usize];
-            index.extend_from_slice(&file.geometry.triangles[copy.triangle as usize]);
-            copy_tests.push([copy.first_test, copy.tests]);
-        }
-        // No empty buffers.
-        index.extend_from_slice(&[0, 0, 0]);
-        copy_tests.push([0, 0]);
-        let mut tests: Vec<u32> = file.tests.iter().map(|t| t.packed()).collect();
-        tests.push(0);
-        let mut planes = file.planes.clone();
-        planes.push([0.0; 4]);
+        // Back to front in blend, front to back otherwise.
+        let order = DrawingOrder::of(file, mode != Mode::Blend);
         let buffer = |label: &str, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -164,24 +119,19 @@ impl<'g> PresortedRenderer<'g> {
         let storage = wgpu::BufferUsages::STORAGE;
         let sorted = buffer(
             "presorted copies",
-            bytemuck::cast_slice(&index),
+            bytemuck::cast_slice(&order.index),
             wgpu::BufferUsages::INDEX,
         );
-        let copy_tests = buffer(
-            "presorted copy tests",
-            bytemuck::cast_slice(&copy_tests),
-            storage,
-        );
-        let tests = buffer("presorted tests", bytemuck::cast_slice(&tests), storage);
-        let planes = buffer("presorted planes", bytemuck::cast_slice(&planes), storage);
+        let mut tests: Vec<u32> = file.tests.iter().map(|t| t.packed()).collect();
+        tests.push(0);
+        let mut planes = file.planes.clone();
+        planes.push([0.0; 4]);
         // Every frame's camera and segment, one uniform slot each (a dynamic offset picks the
         // frame, so frames can be encoded back to back without a write between them).
         let stride = device.limits().min_uniform_buffer_offset_alignment.max(32) as usize;
         let mut slots = vec![0u8; stride * frames.len().max(1)];
         for (f, (k, eye)) in frame_eyes.iter().enumerate() {
-            let at = f * stride;
-            slots[at..at + 12].copy_from_slice(bytemuck::cast_slice(eye));
-            slots[at + 16..at + 20].copy_from_slice(&segments[*k].0.to_le_bytes());
+            slots[f * stride..f * stride + 32].copy_from_slice(&slot(*eye, order.segments[*k].0));
         }
         let params = buffer(
             "presorted params",
@@ -199,99 +149,35 @@ impl<'g> PresortedRenderer<'g> {
                 storage_entry(3, fragment, true),
             ],
         });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("presorted"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(32),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: copy_tests.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: tests.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: planes.as_entire_binding(),
-                },
+        let copy_tests = buffer(
+            "presorted copy tests",
+            bytemuck::cast_slice(&order.copy_tests),
+            storage,
+        );
+        let tests = buffer("presorted tests", bytemuck::cast_slice(&tests), storage);
+        let planes = buffer("presorted planes", bytemuck::cast_slice(&planes), storage);
+        let bind_group = trisort_gpu::pipeline::bind_group(
+            device,
+            "presorted",
+            &layout,
+            &[
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &params,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(32),
+                }),
+                copy_tests.as_entire_binding(),
+                tests.as_entire_binding(),
+                planes.as_entire_binding(),
             ],
-        });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("presorted"),
-            source: wgpu::ShaderSource::Wgsl(trisort_gpu::presorted_shader().into()),
-        });
-        let (player_fs, presorted_fs) = match mode {
-            Mode::Saturate => ("fs_player_premultiplied", "fs_presorted_premultiplied"),
-            Mode::Blend | Mode::Depth => ("fs_player_straight", "fs_presorted_straight"),
-        };
-        use wgpu::CompareFunction::{Less, LessEqual};
-        let pipeline =
-            |label: &str, fs: &str, depth: (wgpu::CompareFunction, bool), colour: bool| {
-                ScenePipeline {
-                    label,
-                    layouts: &[&scene.layout, &layout],
-                    module: &module,
-                    vertex: "vs_player",
-                    fragment: fs,
-                    target: wgpu::ColorTargetState {
-                        format: COLOR_FORMAT,
-                        blend: Some(blend_state(mode)),
-                        write_mask: if colour {
-                            wgpu::ColorWrites::ALL
-                        } else {
-                            wgpu::ColorWrites::empty()
-                        },
-                    },
-                    depth: Some((DEPTH_FORMAT, depth.0, depth.1)),
-                    samples: view.samples,
-                }
-                .build_shaded(device, shading)
-            };
-        let passes = match mode {
-            Mode::Blend => vec![
-                (
-                    pipeline("presorted opaque", player_fs, (Less, true), true),
-                    false,
-                ),
-                (
-                    pipeline("presorted list", presorted_fs, (Less, false), true),
-                    true,
-                ),
-            ],
-            Mode::Depth => vec![
-                (
-                    pipeline("presorted list", presorted_fs, (Less, true), true),
-                    true,
-                ),
-                (
-                    pipeline("presorted opaque", player_fs, (Less, true), true),
-                    false,
-                ),
-            ],
-            Mode::Saturate => vec![
-                (
-                    pipeline("presorted opaque depth", player_fs, (Less, true), false),
-                    false,
-                ),
-                (
-                    pipeline("presorted list", presorted_fs, (Less, false), true),
-                    true,
-                ),
-                (
-                    pipeline("presorted opaque", player_fs, (LessEqual, false), true),
-                    false,
-                ),
-            ],
-        };
+        );
+        let passes = passes(
+            device,
+            &[&scene.layout, &layout],
+            mode,
+            view.samples,
+            shading,
+        );
         let mut opaque: Vec<u32> = file
             .opaque
             .iter()
@@ -312,7 +198,7 @@ impl<'g> PresortedRenderer<'g> {
             mode,
             scene,
             frames: frame_eyes,
-            segments,
+            segments: order.segments,
             opaque,
             sorted,
             stride: stride as u32,
@@ -362,12 +248,11 @@ impl<'g> PresortedRenderer<'g> {
                 "the scene's frames cannot be rewritten on this binding tier".into(),
             ));
         }
-        let mut bytes = [0u8; 32];
-        bytes[..12].copy_from_slice(bytemuck::cast_slice(&eye));
-        bytes[16..20].copy_from_slice(&self.segments[k].0.to_le_bytes());
-        self.gpu
-            .queue
-            .write_buffer(&self.params, frame as u64 * self.stride as u64, &bytes);
+        self.gpu.queue.write_buffer(
+            &self.params,
+            frame as u64 * self.stride as u64,
+            &slot(eye, self.segments[k].0),
+        );
         self.frames[frame as usize] = (k, eye);
         Ok(k)
     }
@@ -435,4 +320,138 @@ impl<'g> PresortedRenderer<'g> {
         let under = (self.mode == Mode::Saturate).then_some(BACKGROUND);
         Ok(quantize_rgba16f(&halves(&bytes), under))
     }
+}
+
+/// The camera of `state` relative to the polyhedron's centre, as the shader tests it.
+fn relative_eye(file: &Presorted, state: &FrameState) -> [f32; 3] {
+    let e = state.camera.eye();
+    let c = file.polyhedron.centre;
+    [0, 1, 2].map(|a| (e[a] - c[a]) as f32)
+}
+
+/// One frame's uniform slot (`PresortParams`): the camera relative to the centre and the
+/// drawn segment's first copy.
+fn slot(eye: [f32; 3], first: u32) -> [u8; 32] {
+    let mut bytes = [0u8; 32];
+    bytes[..12].copy_from_slice(bytemuck::cast_slice(&eye));
+    bytes[16..20].copy_from_slice(&first.to_le_bytes());
+    bytes
+}
+
+/// The copies in the order a renderer draws them, segment by segment.
+struct DrawingOrder {
+    /// Vertex indices, three a copy (and one degenerate triangle: no empty buffers).
+    index: Vec<u32>,
+    /// Per copy: its first test and test count (and one entry more).
+    copy_tests: Vec<[u32; 2]>,
+    /// Per partition: (first copy, copies) in this order.
+    segments: Vec<(u32, u32)>,
+}
+
+impl DrawingOrder {
+    /// `file`'s copies, each segment back to front, or front to back when `reverse`.
+    fn of(file: &Presorted, reverse: bool) -> DrawingOrder {
+        let mut order: Vec<u32> = Vec::with_capacity(file.copies.len());
+        let mut segments = Vec::with_capacity(file.segments.len());
+        for s in &file.segments {
+            segments.push((order.len() as u32, s.count));
+            let run = s.first..s.first + s.count;
+            if reverse {
+                order.extend(run.rev());
+            } else {
+                order.extend(run);
+            }
+        }
+        let mut index: Vec<u32> = Vec::with_capacity(order.len() * 3 + 3);
+        let mut copy_tests: Vec<[u32; 2]> = Vec::with_capacity(order.len() + 1);
+        for &k in &order {
+            let copy = &file.copies[k as usize];
+            index.extend_from_slice(&file.geometry.triangles[copy.triangle as usize]);
+            copy_tests.push([copy.first_test, copy.tests]);
+        }
+        index.extend_from_slice(&[0, 0, 0]);
+        copy_tests.push([0, 0]);
+        DrawingOrder {
+            index,
+            copy_tests,
+            segments,
+        }
+    }
+}
+
+/// The passes of `mode`, each a pipeline and whether it draws the list (else the opaque
+/// triangles), in order (see the module documentation).
+fn passes(
+    device: &wgpu::Device,
+    layouts: &[&wgpu::BindGroupLayout],
+    mode: Mode,
+    samples: u32,
+    shading: trisort_gpu::Shading,
+) -> Vec<(wgpu::RenderPipeline, bool)> {
+    use wgpu::CompareFunction::{Less, LessEqual};
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("presorted"),
+        source: wgpu::ShaderSource::Wgsl(trisort_gpu::presorted_shader().into()),
+    });
+    let (player_fs, presorted_fs) = match mode {
+        Mode::Saturate => ("fs_player_premultiplied", "fs_presorted_premultiplied"),
+        Mode::Blend | Mode::Depth => ("fs_player_straight", "fs_presorted_straight"),
+    };
+    let pipeline = |list: bool, depth: (wgpu::CompareFunction, bool), colour: bool| {
+        let p = ScenePipeline {
+            label: if list {
+                "presorted list"
+            } else {
+                "presorted opaque"
+            },
+            layouts,
+            module: &module,
+            vertex: "vs_player",
+            fragment: if list { presorted_fs } else { player_fs },
+            target: wgpu::ColorTargetState {
+                format: COLOR_FORMAT,
+                blend: Some(blend_state(mode)),
+                write_mask: if colour {
+                    wgpu::ColorWrites::ALL
+                } else {
+                    wgpu::ColorWrites::empty()
+                },
+            },
+            depth: Some((DEPTH_FORMAT, depth.0, depth.1)),
+            samples,
+        }
+        .build_shaded(device, shading);
+        (p, list)
+    };
+    match mode {
+        Mode::Blend => vec![
+            pipeline(false, (Less, true), true),
+            pipeline(true, (Less, false), true),
+        ],
+        Mode::Depth => vec![
+            pipeline(true, (Less, true), true),
+            pipeline(false, (Less, true), true),
+        ],
+        // The opaque depth alone, the list under nothing, the opaque colours under the list.
+        Mode::Saturate => vec![
+            pipeline(false, (Less, true), false),
+            pipeline(true, (Less, false), true),
+            pipeline(false, (LessEqual, false), true),
+        ],
+    }
+}
+
+/// Errors where the device lacks `PRIMITIVE_INDEX` (the test finds a fragment's copy by it).
+fn check_device(gpu: &Gpu) -> Result<(), ReferenceError> {
+    if gpu
+        .device
+        .features()
+        .contains(wgpu::Features::PRIMITIVE_INDEX)
+    {
+        return Ok(());
+    }
+    Err(ReferenceError::Unsupported(format!(
+        "{}: the presorted renderer selects copies by primitive index",
+        gpu.describe()
+    )))
 }

@@ -171,7 +171,8 @@ fn elsewhere_player<'g>(
     Ok(player)
 }
 
-pub fn run(a: VerifyArgs) -> Result<ExitCode> {
+/// `verify` of a presorted file (`None`: the file is not one; `--path` is then refused).
+fn presorted(a: &VerifyArgs) -> Option<Result<ExitCode>> {
     if super::presort::is_presorted(&a.baked) {
         let run = super::presort::PresortedRun {
             file: &a.baked,
@@ -185,13 +186,19 @@ pub fn run(a: VerifyArgs) -> Result<ExitCode> {
             tone_map: a.shading.tonemap,
             json: a.json,
         };
-        return super::presort::verify(&run, a.scene.as_deref());
+        return Some(super::presort::verify(&run, a.scene.as_deref()));
     }
-    if a.path.is_some() {
-        bail!(
+    a.path.is_some().then(|| {
+        Err(anyhow::anyhow!(
             "{}: --path verifies presorted files; a baked file is checked along its own path",
             a.baked.display()
-        );
+        ))
+    })
+}
+
+pub fn run(a: VerifyArgs) -> Result<ExitCode> {
+    if let Some(checked) = presorted(&a) {
+        return checked;
     }
     let baked: Baked = trisort_player::open_baked(&a.baked)?;
     if a.recording.is_empty() && a.scene.is_none() && a.environment.is_none() {
