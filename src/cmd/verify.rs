@@ -56,6 +56,10 @@ pub struct VerifyArgs {
     /// takes, or `random:N[:SEED]` (N random cameras outside its bounding polyhedron).
     #[arg(long, value_name = "P")]
     path: Option<String>,
+    /// Opacity transmissive glass is drawn at, for a presorted file (default: the one it
+    /// stores); a baked file is checked at its recorded opacity.
+    #[arg(long, value_name = "ALPHA")]
+    glass_opacity: Option<f32>,
     /// Compositing mode of the image check.
     #[arg(long, default_value = "blend")]
     mode: Mode,
@@ -181,16 +185,17 @@ fn presorted(a: &VerifyArgs) -> Option<Result<ExitCode>> {
             samples: a.samples,
             mode: a.mode,
             frames: a.frames,
-            glass_opacity: None,
+            glass_opacity: a.glass_opacity,
             shading: a.shading.shading,
             tone_map: a.shading.tonemap,
             json: a.json,
         };
         return Some(super::presort::verify(&run, a.scene.as_deref()));
     }
-    a.path.is_some().then(|| {
+    (a.path.is_some() || a.glass_opacity.is_some()).then(|| {
         Err(anyhow::anyhow!(
-            "{}: --path verifies presorted files; a baked file is checked along its own path",
+            "{}: --path and --glass-opacity apply to presorted files; a baked file is checked \
+             along its own path at its recorded opacity",
             a.baked.display()
         ))
     })
