@@ -301,3 +301,38 @@ fn bench_sweep_robust_factor_plays_each_point_off_its_pattern() {
     }
     no_temp_files(&out);
 }
+
+/// `--methods …,presorted` (paper 000): the scene presorted once, played on the bench's frames,
+/// exact where the default pipeline is not (glass at 0.5 over glass); and left out, saying
+/// why, on a path whose camera is inside the scene's bounding polyhedron.
+#[test]
+fn bench_runs_the_presorted_method_and_leaves_it_out_inside_the_polyhedron() {
+    let Some(dir) = gpu_tempdir() else {
+        return;
+    };
+    let free = format!(
+        "bench demo:3000 --path {PATH} --size 64x64 --samples 4 --mode blend --glass-opacity 0.5 \
+         --methods default,merged,presorted --repeats 1 --no-unvalidated --out free"
+    );
+    let v = run_json(dir.path(), &args(&free));
+    let p = &v["methods"]["presorted"];
+    assert!(f(&p["ms_per_frame"]) > 0.0, "{v}");
+    let frames = v["frames"].as_array().expect("frames").len();
+    assert_eq!(
+        p["frames_exact"], frames,
+        "presorted is exact on every frame: {p}"
+    );
+    assert_eq!(p["max_channel_diff"], 0, "{p}");
+    assert!(f(&p["triangles_per_frame"]) >= f(&v["methods"]["default"]["triangles_per_frame"]));
+    let inside = "bench demo:3000 --path orbit:frames=1,distance=0.2 --size 48x48 --samples 4 \
+                  --mode blend --methods merged,presorted --repeats 1 --no-unvalidated --out inside";
+    let v = run_json(dir.path(), &args(inside));
+    let skipped = v["groups"][0]["skipped"].as_array().expect("skipped");
+    assert_eq!(skipped.len(), 1, "{v}");
+    assert_eq!(skipped[0]["method"], "presorted");
+    assert!(
+        skipped[0]["why"].as_str().unwrap().contains("inside"),
+        "{skipped:?}"
+    );
+    assert!(v["methods"]["presorted"].is_null());
+}
