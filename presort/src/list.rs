@@ -118,6 +118,8 @@ struct Builder<'a, P: Planes> {
     planes: &'a mut P,
     /// Ō(x→y) by copy uids: its vertices when it has volume.
     cache: HashMap<(u32, u32), Option<Rc<[DVec3]>>>,
+    /// Per instance: its extent along the partition's face normal (least, most).
+    spans: Vec<(f64, f64)>,
     next_uid: u32,
     stats: ListStats,
 }
@@ -145,6 +147,15 @@ impl<P: Planes> Builder<'_, P> {
     fn occludes(&mut self, x: &ListCopy, y: &ListCopy) -> Option<Rc<[DVec3]>> {
         if let Some(v) = self.cache.get(&(x.uid, y.uid)) {
             return v.clone();
+        }
+        // Along the face's normal n, x must reach beyond y: a camera v = q + t(p − q), t ≥ 1,
+        // p ∈ x, q ∈ y, has n·v ≤ n·p when n·(p − q) ≤ 0, and n·p is inside the face.
+        let (sx, sy) = (
+            self.spans[x.instance as usize],
+            self.spans[y.instance as usize],
+        );
+        if sx.1 <= sy.0 {
+            return None;
         }
         let (tx, ty) = (
             &self.instances[x.instance as usize].tri,
@@ -187,6 +198,18 @@ pub fn build_list<P: Planes>(
         partition,
         planes,
         cache: HashMap::new(),
+        spans: instances
+            .iter()
+            .map(|i| {
+                i.tri
+                    .v
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                        let d = partition.normal.dot(*v);
+                        (lo.min(d), hi.max(d))
+                    })
+            })
+            .collect(),
         next_uid: 0,
         stats: ListStats::default(),
     };

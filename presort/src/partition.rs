@@ -61,6 +61,9 @@ pub struct Partition {
     pub vertices: Vec<DVec3>,
     /// A viewpoint inside it (the preliminary order is a depth sort from there).
     pub viewpoint: DVec3,
+    /// Its face's outward normal: every camera of the partition is beyond the face along it,
+    /// and the scene is not.
+    pub normal: DVec3,
 }
 
 /// The partitions of the polyhedron with faces `faces` (unit normal, distance `h > 0` from the
@@ -105,6 +108,7 @@ pub fn partitions(faces: &[(DVec3, f64)], reach: f64) -> Option<Vec<Partition>> 
                 planes,
                 vertices,
                 viewpoint: centre * 3.0,
+                normal: nf,
             })
         })
         .collect()
