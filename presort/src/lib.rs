@@ -127,8 +127,9 @@ fn world_triangles(geometry: &Geometry) -> Vec<[DVec3; 3]> {
         .collect()
 }
 
-/// Presorts `geometry` (already split, static). `progress(done, total)` is called as
-/// partitions finish (from worker threads).
+/// Presorts `geometry` (already split, static). `progress(done, total)` is called as the
+/// partitions' scans move on (from worker threads): `total` is the sorted instances times the
+/// partitions, each partition counting at most its instances until it finishes.
 pub fn presort(
     geometry: &Geometry,
     options: PresortOptions,
@@ -167,7 +168,8 @@ pub fn presort(
     }
     let (own_planes, instances) = instances(geometry, &sorted, &world, norm);
     let done = AtomicUsize::new(0);
-    let total = parts.len();
+    let per_partition = instances.len();
+    let total = parts.len() * per_partition;
     progress(0, total);
     let built: Vec<Result<_, PresortError>> = parts
         .par_iter()
@@ -175,7 +177,14 @@ pub fn presort(
         .map(|(k, part)| {
             let mut planes: Vec<Plane> = own_planes.clone();
             let max_steps = options.max_steps_per_instance * (instances.len() as u64 + 16);
-            let r = build_list(&instances, part, &mut planes, max_steps).map_err(
+            let mut counted = 0usize;
+            let mut advanced = || {
+                if counted < per_partition {
+                    counted += 1;
+                    progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                }
+            };
+            let r = build_list(&instances, part, &mut planes, max_steps, &mut advanced).map_err(
                 |NoOrder { triangles, steps }| PresortError::NoOrder {
                     partition: k,
                     steps,
@@ -183,7 +192,8 @@ pub fn presort(
                     b: triangles.1,
                 },
             );
-            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            let rest = per_partition - counted;
+            progress(done.fetch_add(rest, Ordering::Relaxed) + rest, total);
             r.map(|(list, stats)| (list, stats, planes))
         })
         .collect();

@@ -186,12 +186,14 @@ impl<P: Planes> Builder<'_, P> {
 }
 
 /// The list of `partition` over `instances` (those drawn from it), new cutting planes added to
-/// `planes`. `max_steps` bounds the scan.
+/// `planes`. `max_steps` bounds the scan; `advanced` is called each time the scan moves on
+/// past a copy (for progress).
 pub fn build_list<P: Planes>(
     instances: &[Instance],
     partition: &Partition,
     planes: &mut P,
     max_steps: u64,
+    advanced: &mut dyn FnMut(),
 ) -> Result<(Vec<ListCopy>, ListStats), NoOrder> {
     let mut b = Builder {
         instances,
@@ -237,6 +239,7 @@ pub fn build_list<P: Planes>(
         }
         let Some(&(last, _)) = backs.last() else {
             p += 1;
+            advanced();
             continue;
         };
         if steps > max_steps {

@@ -92,14 +92,16 @@ pub fn run(a: PresortArgs) -> Result<ExitCode> {
             );
         }
     }
-    let bar = progress_bar(a.partitions as u64, "partitions");
+    // Copies placed, over all partitions' lists.
+    let bar = progress_bar(0, "placed");
     let options = PresortOptions {
         partitions: a.partitions,
         reach: a.reach,
         ..PresortOptions::default()
     };
-    let lists = presort(&scene.geometry, options, &|done, _| {
-        bar.set_position(done as u64)
+    let lists = presort(&scene.geometry, options, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
     })
     .with_context(|| format!("presorting {}", a.scene))?;
     bar.finish_and_clear();
