@@ -145,27 +145,10 @@ pub fn presort(
     }
     let (centre, radius) = bounds(&world)?;
     let norm = |v: DVec3| (v - centre) / radius;
-    // The polyhedron: each face just outside the scene's support in its direction.
-    let faces: Vec<(DVec3, f64)> = partition::face_normals(options.partitions)
-        .into_iter()
-        .map(|n| {
-            let h = world
-                .iter()
-                .flatten()
-                .map(|v| n.dot(norm(*v)))
-                .fold(f64::NEG_INFINITY, f64::max);
-            (n, h.max(0.0) + 0.01)
-        })
-        .collect();
+    let faces = faces(options.partitions, &world, norm);
     let parts = partition::partitions(&faces, options.reach).ok_or(PresortError::Empty)?;
-    let (mut opaque, mut sorted) = (Vec::new(), Vec::new());
-    for t in 0..geometry.triangles.len() as u32 {
-        if geometry.needs_order(t) {
-            sorted.push(t);
-        } else {
-            opaque.push(t);
-        }
-    }
+    let (sorted, opaque): (Vec<u32>, Vec<u32>) =
+        (0..geometry.triangles.len() as u32).partition(|&t| geometry.needs_order(t));
     let (own_planes, instances) = instances(geometry, &sorted, &world, norm);
     let done = AtomicUsize::new(0);
     let per_partition = instances.len();
@@ -343,4 +326,24 @@ fn instances(
         }
     }
     (own_planes, instances)
+}
+
+/// The polyhedron's faces (unit normal, distance), normalised: each face just outside the
+/// scene's support in its direction.
+fn faces(
+    partitions: u32,
+    world: &[[DVec3; 3]],
+    norm: impl Fn(DVec3) -> DVec3,
+) -> Vec<(DVec3, f64)> {
+    partition::face_normals(partitions)
+        .into_iter()
+        .map(|n| {
+            let h = world
+                .iter()
+                .flatten()
+                .map(|v| n.dot(norm(*v)))
+                .fold(f64::NEG_INFINITY, f64::max);
+            (n, h.max(0.0) + 0.01)
+        })
+        .collect()
 }

@@ -162,6 +162,34 @@ impl UnorderedEdges {
         Ok(edges)
     }
 
+    /// `pairs` (scene ids, either order) in each of `frames` frames, over a scene of
+    /// `scene_triangles` triangles, every one of them in G and none moved by the tie rule: for
+    /// a renderer that orders by geometry where the rasterizer's depths may not, e.g. two
+    /// triangles that meet at an edge or a corner, whose depths there differ by rounding
+    /// alone. The caller derives the pairs from the scene, not from the file it checks.
+    pub fn of_pairs(
+        scene_triangles: usize,
+        frames: usize,
+        pairs: &[(u32, u32)],
+    ) -> Result<UnorderedEdges, ReferenceError> {
+        let mut edges = UnorderedEdges::empty(scene_triangles);
+        let all: Vec<u32> = (0..scene_triangles as u32).collect();
+        edges.add_g(&all, "the scene")?;
+        if let Some(&(a, b)) = pairs
+            .iter()
+            .find(|(a, b)| a.max(b) >= &(scene_triangles as u32))
+        {
+            return Err(ReferenceError::Invalid(format!(
+                "pair ({a}, {b}) names a triangle beyond the scene's {scene_triangles}"
+            )));
+        }
+        for f in 0..frames {
+            edges.set_drawn(f, Vec::new());
+            edges.set_frame(f, pairs.iter().flat_map(|&(a, b)| [(a, b, 0), (b, a, 0)]));
+        }
+        Ok(edges)
+    }
+
     fn empty(scene_triangles: usize) -> UnorderedEdges {
         UnorderedEdges {
             in_g: vec![false; scene_triangles],

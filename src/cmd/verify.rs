@@ -190,7 +190,8 @@ fn presorted(a: &VerifyArgs) -> Option<Result<ExitCode>> {
             tone_map: a.shading.tonemap,
             json: a.json,
         };
-        return Some(super::presort::verify(&run, a.scene.as_deref()));
+        let diff_dir = a.diff_dir.as_deref().map(|d| (d, a.diff_all));
+        return Some(super::presort::verify(&run, a.scene.as_deref(), diff_dir));
     }
     (a.path.is_some() || a.glass_opacity.is_some()).then(|| {
         Err(anyhow::anyhow!(
