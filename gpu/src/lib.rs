@@ -328,6 +328,7 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("peeling 1x", peeling_shader(1)),
         ("peeling 4x", peeling_shader(4)),
         ("oit", oit_shader(32)),
+        ("presorted", presorted_shader()),
         ("coverage", coverage_shader()),
         ("conservative 1x", conservative_shader(1)),
         ("conservative 4x", conservative_shader(4)),
