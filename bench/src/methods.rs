@@ -95,13 +95,17 @@ impl BenchView {
     }
 }
 
-fn stats_begin(pass: &mut wgpu::RenderPass<'_>, stats: Option<&wgpu::QuerySet>, slot: u32) {
+pub(crate) fn stats_begin(
+    pass: &mut wgpu::RenderPass<'_>,
+    stats: Option<&wgpu::QuerySet>,
+    slot: u32,
+) {
     if let Some(set) = stats {
         pass.begin_pipeline_statistics_query(set, slot);
     }
 }
 
-fn stats_end(pass: &mut wgpu::RenderPass<'_>, stats: Option<&wgpu::QuerySet>) {
+pub(crate) fn stats_end(pass: &mut wgpu::RenderPass<'_>, stats: Option<&wgpu::QuerySet>) {
     if stats.is_some() {
         pass.end_pipeline_statistics_query();
     }

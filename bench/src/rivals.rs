@@ -306,13 +306,9 @@ impl Method for PresortedMethod<'_> {
         let mut pass = self
             .target
             .begin_pass(enc, trisort_gpu::clear_colour(self.mode), None);
-        if let Some(set) = stats {
-            pass.begin_pipeline_statistics_query(set, 0);
-        }
+        crate::methods::stats_begin(&mut pass, stats, 0);
         self.renderer.draw(&mut pass, frame);
-        if stats.is_some() {
-            pass.end_pipeline_statistics_query();
-        }
+        crate::methods::stats_end(&mut pass, stats);
     }
     fn image(&self, frame: u32) -> Result<Vec<u8>, BenchError> {
         Ok(self

@@ -3,8 +3,9 @@
 //! every triangle the camera can see is drawn exactly once.
 
 use glam::DVec3;
-use trisort_format::{AlphaMode, Environment, Geometry, Material, Node, Presorted, Vertex};
+use trisort_format::{AlphaMode, Environment, Geometry, Material, Presorted};
 use trisort_presort::{presort, PresortOptions};
+use trisort_testkit::fixtures::{scene, tri};
 
 /// A small deterministic generator (xorshift), so failures reproduce.
 struct Rng(u64);
@@ -35,30 +36,8 @@ fn material(double_sided: bool) -> Material {
 /// cycles), alternately single- and double-sided, plus one opaque triangle.
 fn soup(n: u32, m: u32, seed: u64) -> Geometry {
     let mut rng = Rng(seed);
-    let mut g = Geometry {
-        materials: vec![material(false), material(true), Material::default()],
-        nodes: vec![Node {
-            name: String::new(),
-            parent: None,
-            rest: glam::DMat4::IDENTITY.to_cols_array(),
-        }],
-        ..Geometry::default()
-    };
-    let mut push = |corners: [[f32; 3]; 3], material: u32| {
-        let base = g.vertices.len() as u32;
-        for position in corners {
-            g.vertices.push(Vertex {
-                position,
-                normal: [0.0, 0.0, 1.0],
-                uv: [0.0; 2],
-                material,
-                node: 0,
-                tangent: [0.0; 4],
-                uv1: [0.0; 2],
-            });
-        }
-        g.triangles.push([base, base + 1, base + 2]);
-    };
+    let mut g = scene(vec![material(false), material(true), Material::default()]);
+    let mut push = |corners: [[f32; 3]; 3], material: u32| tri(&mut g, corners, material);
     let mut k = 0;
     for x in 0..n {
         for y in 0..n {

@@ -95,7 +95,7 @@ impl<'g> PresortedRenderer<'g> {
         let frame_eyes: Vec<(usize, [f32; 3])> = partitions
             .iter()
             .zip(frames)
-            .map(|(&k, s)| (k, relative_eye(file, s)))
+            .map(|(&k, s)| (k, relative_eye(file.polyhedron.centre, s)))
             .collect();
         let device = &gpu.device;
         let target = Target::new(
@@ -234,12 +234,7 @@ impl<'g> PresortedRenderer<'g> {
             .polyhedron
             .partition_of(e.to_array())
             .map_err(|why| ReferenceError::Invalid(why.to_string()))?;
-        let c = self.polyhedron.centre;
-        let eye = [
-            (e.x - c[0]) as f32,
-            (e.y - c[1]) as f32,
-            (e.z - c[2]) as f32,
-        ];
+        let eye = relative_eye(self.polyhedron.centre, state);
         if !self
             .scene
             .set_frame(&self.gpu.queue, geometry, frame, state)
@@ -322,10 +317,9 @@ impl<'g> PresortedRenderer<'g> {
     }
 }
 
-/// The camera of `state` relative to the polyhedron's centre, as the shader tests it.
-fn relative_eye(file: &Presorted, state: &FrameState) -> [f32; 3] {
+/// The camera of `state` relative to the polyhedron's centre `c`, as the shader tests it.
+fn relative_eye(c: [f64; 3], state: &FrameState) -> [f32; 3] {
     let e = state.camera.eye();
-    let c = file.polyhedron.centre;
     [0, 1, 2].map(|a| (e[a] - c[a]) as f32)
 }
 

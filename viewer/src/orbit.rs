@@ -163,6 +163,7 @@ pub fn orbit(
         cursor: (0.0, 0.0),
         gfx: None,
         orbited: Orbited::default(),
+        title: String::new(),
         error: None,
         note,
     };
@@ -206,6 +207,8 @@ struct OrbitApp<'n> {
     cursor: (f64, f64),
     gfx: Option<OrbitGfx>,
     orbited: Orbited,
+    /// The window's title as last set.
+    title: String,
     error: Option<ViewerError>,
     note: &'n mut dyn FnMut(&str),
 }
@@ -353,14 +356,21 @@ impl OrbitApp<'_> {
         g.window.pre_present_notify();
         g.gpu.queue.present(texture);
         self.orbited.presented += 1;
-        self.orbited.partitions.push(k);
-        g.window.set_title(&format!(
+        if !self.orbited.partitions.contains(&k) {
+            self.orbited.partitions.push(k);
+        }
+        let title = format!(
             "{} · yaw {:.0}° pitch {:.0}° · partition {k} · {} copies · trisort",
             self.path.display(),
             self.camera.yaw,
             self.camera.pitch,
             g.renderer.triangles(0)
-        ));
+        );
+        // Only when it changes (a turntable turns 1.5° a frame; the title shows whole degrees).
+        if title != self.title {
+            g.window.set_title(&title);
+            self.title = title;
+        }
         if self
             .options
             .exit_after
