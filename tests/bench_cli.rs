@@ -336,3 +336,53 @@ fn bench_runs_the_presorted_method_and_leaves_it_out_inside_the_polyhedron() {
     );
     assert!(v["methods"]["presorted"].is_null());
 }
+
+/// `--methods …,occlusion-query` (paper 004): every frame from frame 0 to the last measured
+/// one sorted by occlusion queries, starting from the previous frame's order; its queries,
+/// readbacks and cycles in the JSON; its query passes counted in its triangles; blend only.
+#[test]
+fn bench_runs_the_occlusion_query_method_and_reports_its_queries() {
+    let Some(dir) = gpu_tempdir() else {
+        return;
+    };
+    let cmd = format!(
+        "bench demo:3000 --path {PATH} --size 64x64 --samples 4 --mode blend,depth \
+         --glass-opacity 0.5 --methods default,occlusion-query --repeats 1 --no-unvalidated \
+         --out oq"
+    );
+    let v = run_json(dir.path(), &args(&cmd));
+    let m = &v["methods"]["occlusion-query"];
+    assert!(f(&m["ms_per_frame"]) > 0.0, "{v}");
+    let q = &m["occlusion_queries"];
+    let objects = f(&q["objects"]);
+    assert!(objects >= 2.0, "the demo car's glass is in pieces: {q}");
+    // Frames 0..=last measured are walked (coherence along the path).
+    let last = v["frames"]
+        .as_array()
+        .expect("frames")
+        .iter()
+        .map(f)
+        .fold(0.0, f64::max);
+    assert_eq!(f(&q["frames"]), last + 1.0, "{q}");
+    // Scan 1 queries every object, scan 2 at least one; batching reads back less often.
+    assert!(f(&q["queries_per_frame"]) > objects, "{q}");
+    assert!(f(&q["readbacks_per_frame"]) >= 2.0, "{q}");
+    assert!(
+        f(&q["readbacks_per_frame"]) < f(&q["queries_per_frame"]),
+        "{q}"
+    );
+    assert!(
+        f(&m["triangles_per_frame"]) > f(&v["methods"]["default"]["triangles_per_frame"]),
+        "the query passes draw the objects again: {m}"
+    );
+    let depth = &v["groups"][1];
+    assert_eq!(depth["mode"], "depth");
+    assert!(
+        depth["rows"]
+            .as_array()
+            .expect("rows")
+            .iter()
+            .all(|r| r["method"] != "occlusion-query"),
+        "occlusion-query is a blend-mode method: {depth}"
+    );
+}

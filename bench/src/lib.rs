@@ -1,7 +1,7 @@
 //! trisort's benchmarks: what the speed/accuracy trade costs and buys.
 //!
 //! - [`methods`]: the renderers compared frame by frame (`default`, `source`, `merged`,
-//!   `oit`, `peeling`) behind one [`methods::Method`] trait.
+//!   `oit`, `peeling`, `presorted`, `occlusion-query`) behind one [`methods::Method`] trait.
 //! - [`harness`]: interleaved, repeated timing (GPU timestamps and wall time) and the
 //!   device-independent counts (triangles submitted, fragment-shader invocations, overdraw).
 #![deny(missing_docs)]
@@ -15,6 +15,7 @@ mod rivals;
 pub mod scaling;
 pub mod sweep;
 pub mod table;
+pub mod vis_sort;
 
 /// Errors of the benchmarks.
 #[derive(Debug, thiserror::Error)]

@@ -7,6 +7,8 @@
 //! | `merged` | the baked sliding window: one multi-draw-indirect | all |
 //! | `oit` | every triangle into per-sample linked lists, sorted and composited per sample (paper 001) | blend |
 //! | `peeling` | every triangle once per layer, exact per-sample depth peeling on the GPU | blend, depth |
+//! | `presorted` | paper 000's presorted lists: the opaque triangles, then the camera's partition in one draw | all |
+//! | `occlusion-query` | paper 004: the transparent objects ordered by occlusion queries each frame, drawn back to front after the opaque ones | blend |
 //!
 //! Every method renders into its own `Rgba16Float` target at the bench's size and sample count,
 //! resolved to one sample and quantized to 8-bit sRGB like the player's frames, so their
@@ -28,7 +30,8 @@ use crate::BenchError;
 
 /// A renderer the bench times and compares.
 pub trait Method {
-    /// Method name (`default`, `source`, `merged`, `oit`, `peeling`).
+    /// Method name (`default`, `source`, `merged`, `oit`, `peeling`, `presorted`,
+    /// `occlusion-query`).
     fn name(&self) -> &str;
     /// Compositing mode it renders.
     fn mode(&self) -> Mode;
@@ -58,6 +61,10 @@ pub trait Method {
     /// The triangle streams the method rasterizes for frame `frame`, in submission order, for
     /// the harness's fragment count (see [`crate::harness::FragmentCounter`]).
     fn streams(&self, frame: u32) -> Vec<Stream>;
+    /// What a method that sorts with occlusion queries spent on them (`occlusion-query`).
+    fn query_stats(&self) -> Option<crate::vis_sort::QueryStats> {
+        None
+    }
 }
 
 /// One draw of a method's frame as the fragment counter replays it.

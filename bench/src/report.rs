@@ -182,22 +182,23 @@ pub fn report_json(
     let head = &groups[0];
     let mut methods = serde_json::Map::new();
     for r in &head.rows {
-        methods.insert(
-            r.method.clone(),
-            json!({
-                "ms_per_frame": r.ms_per_frame,
-                "ms_p95": r.ms_p95,
-                "ms_max": r.ms_max,
-                "triangles_per_frame": r.triangles_per_frame,
-                "draws_per_frame_mean": r.draws_per_frame_mean,
-                "overdraw": r.overdraw,
-                "fragments_shaded_per_frame": r.fragments_shaded_per_frame,
-                "frames_exact": r.error.frames_exact,
-                "pixels_differing_fraction": r.error.pixels_differing_fraction,
-                "max_channel_diff": r.error.max_channel_diff,
-                "flip_mean": r.error.flip_mean,
-            }),
-        );
+        let mut entry = json!({
+            "ms_per_frame": r.ms_per_frame,
+            "ms_p95": r.ms_p95,
+            "ms_max": r.ms_max,
+            "triangles_per_frame": r.triangles_per_frame,
+            "draws_per_frame_mean": r.draws_per_frame_mean,
+            "overdraw": r.overdraw,
+            "fragments_shaded_per_frame": r.fragments_shaded_per_frame,
+            "frames_exact": r.error.frames_exact,
+            "pixels_differing_fraction": r.error.pixels_differing_fraction,
+            "max_channel_diff": r.error.max_channel_diff,
+            "flip_mean": r.error.flip_mean,
+        });
+        if let Some(q) = &r.occlusion_queries {
+            entry["occlusion_queries"] = json!(q);
+        }
+        methods.insert(r.method.clone(), entry);
     }
     let bake_json: Vec<serde_json::Value> = bakes
         .iter()

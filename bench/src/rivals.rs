@@ -170,7 +170,8 @@ impl Method for PeelingMethod<'_> {
     }
 }
 
-/// Builds the `oit`, `peeling` or `presorted` method of a group (`None` for the other kinds).
+/// Builds the `oit`, `peeling`, `presorted` or `occlusion-query` method of a group (`None` for
+/// the other kinds).
 pub(crate) fn build<'g>(
     kind: crate::table::MethodKind,
     gpu: &'g Gpu,
@@ -210,6 +211,16 @@ pub(crate) fn build<'g>(
                 &input.baked.environment,
                 input.view,
                 input.mode,
+            )?))
+        }
+        MethodKind::OcclusionQuery => {
+            progress("building occlusion-query (paper 004)");
+            Some(Box::new(crate::vis_sort::OcclusionQueryMethod::new(
+                gpu,
+                input.geometry,
+                input.frame_states,
+                &input.baked.environment,
+                input.view,
             )?))
         }
         _ => None,

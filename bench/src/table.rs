@@ -32,17 +32,21 @@ pub enum MethodKind {
     Peeling,
     /// Depth-presorted lists for free viewpoints (paper 000).
     Presorted,
+    /// Objects ordered by occlusion queries every frame (paper 004).
+    #[serde(rename = "occlusion-query")]
+    OcclusionQuery,
 }
 
 impl MethodKind {
     /// All methods, in table order.
-    pub const ALL: [MethodKind; 6] = [
+    pub const ALL: [MethodKind; 7] = [
         MethodKind::Default,
         MethodKind::Source,
         MethodKind::Merged,
         MethodKind::Oit,
         MethodKind::Peeling,
         MethodKind::Presorted,
+        MethodKind::OcclusionQuery,
     ];
 
     /// The name used on the command line and in JSON.
@@ -54,6 +58,7 @@ impl MethodKind {
             MethodKind::Oit => "oit",
             MethodKind::Peeling => "peeling",
             MethodKind::Presorted => "presorted",
+            MethodKind::OcclusionQuery => "occlusion-query",
         }
     }
 
@@ -62,11 +67,12 @@ impl MethodKind {
         MethodKind::ALL.into_iter().find(|m| m.name() == s)
     }
 
-    /// Whether the method renders `mode` (OIT: blend only; default and peeling: no saturate).
+    /// Whether the method renders `mode` (OIT and occlusion-query: blend only; default and
+    /// peeling: no saturate).
     pub fn supports(self, mode: Mode) -> bool {
         match self {
             MethodKind::Source | MethodKind::Merged | MethodKind::Presorted => true,
-            MethodKind::Oit => mode == Mode::Blend,
+            MethodKind::Oit | MethodKind::OcclusionQuery => mode == Mode::Blend,
             MethodKind::Default | MethodKind::Peeling => mode != Mode::Saturate,
         }
     }
@@ -163,6 +169,9 @@ pub struct MethodRow {
     pub overdraw: f64,
     /// Error against the exact reference.
     pub error: ErrorSummary,
+    /// The occlusion-query method's sort: queries, readbacks and cycles per frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub occlusion_queries: Option<crate::vis_sort::QueryStats>,
 }
 
 /// A group's rows, methods in table order.
@@ -317,7 +326,10 @@ fn build_methods<'a>(
                     )?));
                 }
             }
-            MethodKind::Oit | MethodKind::Peeling | MethodKind::Presorted => {
+            MethodKind::Oit
+            | MethodKind::Peeling
+            | MethodKind::Presorted
+            | MethodKind::OcclusionQuery => {
                 match crate::rivals::build(kind, gpu, input, progress) {
                     Ok(Some(m)) => methods.push(m),
                     Ok(None) => {}
@@ -497,6 +509,7 @@ impl Counts {
             pixels_covered_per_frame: self.covered / n,
             overdraw: self.overdraw / n,
             error: errors,
+            occlusion_queries: m.query_stats(),
         }
     }
 }

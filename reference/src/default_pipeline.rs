@@ -116,30 +116,57 @@ impl<'g> DefaultRenderer<'g> {
     /// `Rgba16Float` colour and a `Depth32Float` depth at its sample count): the opaque draw,
     /// then the transparent one.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, frame: u32) {
+        self.draw_with(pass, frame, (&self.transparent.0, self.transparent.1));
+    }
+
+    /// [`DefaultRenderer::draw`] with the transparent pass drawing `transparent` (an index
+    /// buffer and its index count) instead of the ascending ids: a renderer that orders the
+    /// transparent triangles itself (the occlusion-query sort of paper 004).
+    pub fn draw_with(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        frame: u32,
+        transparent: (&wgpu::Buffer, u32),
+    ) {
         pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
         pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
         for (pipeline, (index, count)) in [
-            (&self.opaque_pipeline, &self.opaque),
-            (&self.transparent_pipeline, &self.transparent),
+            (&self.opaque_pipeline, (&self.opaque.0, self.opaque.1)),
+            (&self.transparent_pipeline, transparent),
         ] {
-            if *count == 0 {
+            if count == 0 {
                 continue;
             }
             pass.set_pipeline(pipeline);
             pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..*count, 0, 0..1);
+            pass.draw_indexed(0..count, 0, 0..1);
         }
     }
 
     /// Renders frame `frame` over the player's background and returns it as 8-bit sRGB RGBA
     /// (quantized once, like the player's frames).
     pub fn render(&self, frame: u32) -> Result<Vec<u8>, ReferenceError> {
+        self.render_with(frame, (&self.transparent.0, self.transparent.1))
+    }
+
+    /// [`DefaultRenderer::render`] with [`DefaultRenderer::draw_with`]'s transparent draw.
+    pub fn render_with(
+        &self,
+        frame: u32,
+        transparent: (&wgpu::Buffer, u32),
+    ) -> Result<Vec<u8>, ReferenceError> {
         let bytes = self
             .target
             .render(self.gpu, clear_colour(Mode::Blend), |pass| {
-                self.draw(pass, frame);
+                self.draw_with(pass, frame, transparent);
                 Ok(())
             })?;
         Ok(quantize_rgba16f(&halves(&bytes), None))
+    }
+
+    /// The uploaded scene (its layout, bind group and vertices), for pipelines that draw it
+    /// beside this renderer's.
+    pub fn scene(&self) -> &SceneGpu {
+        &self.scene
     }
 }

@@ -30,6 +30,7 @@ pub mod presorted;
 pub mod report;
 mod target;
 pub mod verify;
+pub mod vis_sort;
 
 pub use compare::{compare, Comparison};
 pub use default_pipeline::DefaultRenderer;
@@ -39,6 +40,7 @@ pub use oit::{OitConfig, OitFrame, OitRenderer};
 pub use peeling::{PeeledFrame, PeelingConfig, PeelingRenderer};
 pub use presorted::PresortedRenderer;
 pub use verify::{FrameImageReport, ImageCheck, ImageVerifier, VerifiedFrame};
+pub use vis_sort::VisSortRenderer;
 
 /// Errors of the reference renderers.
 #[derive(Debug, thiserror::Error)]

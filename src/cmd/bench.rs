@@ -43,7 +43,8 @@ pub struct BenchArgs {
     mode: Vec<Mode>,
     /// Methods, comma-separated: default, source, merged, oit, peeling, presorted (paper 000;
     /// not by default: it presorts the scene first, and needs every camera outside the
-    /// scene's bounding polyhedron).
+    /// scene's bounding polyhedron), occlusion-query (paper 004, blend mode only; not by
+    /// default: it sorts every frame of the path from frame 0 with GPU readbacks).
     #[arg(long, default_value = "default,source,merged,oit,peeling", value_delimiter = ',', value_parser = parse_method)]
     methods: Vec<MethodKind>,
     /// Frames to measure, half-open `a..b` (default: all); the bake always covers the path.
