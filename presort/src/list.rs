@@ -26,7 +26,7 @@ use std::rc::Rc;
 use glam::DVec3;
 
 use crate::geom::{occlusion, region, Plane, Tri, INTERIOR};
-use crate::lp::separate;
+use crate::lp::{separate, MARGIN};
 use crate::partition::Partition;
 
 /// An instance of a triangle: the front, or the back of a double-sided one.
@@ -74,6 +74,8 @@ pub struct ListStats {
     pub regions: u64,
     /// Linear programs solved.
     pub linear_programs: u64,
+    /// Instance pairs the broad phase found occluding somewhere in the partition.
+    pub broad_pairs: u64,
 }
 
 /// Why a list could not be built.
@@ -120,6 +122,13 @@ struct Builder<'a, P: Planes> {
     cache: HashMap<(u32, u32), Option<Rc<[DVec3]>>>,
     /// Per instance: its extent along the partition's face normal (least, most).
     spans: Vec<(f64, f64)>,
+    /// Per instance: the instances that may occlude it ([`Builder::broad_phase`]).
+    occluders: Vec<Vec<u32>>,
+    /// Per instance: the instances it may occlude.
+    occludees: Vec<Vec<u32>>,
+    /// Per instance: the stamp of the last [`Builder::mark`] that marked it.
+    marks: Vec<u32>,
+    stamp: u32,
     next_uid: u32,
     stats: ListStats,
 }
@@ -143,28 +152,71 @@ impl<P: Planes> Builder<'_, P> {
         })
     }
 
-    /// Ō(x→y)'s vertices when `x` occludes `y` somewhere both are drawn.
+    /// Ō(x→y)'s vertices when `x` occludes `y` somewhere both are drawn. The callers ask only
+    /// for the pairs the broad phase let through (a copy's region is within its instance's,
+    /// so instances that cannot occlude each other cannot as copies either).
     fn occludes(&mut self, x: &ListCopy, y: &ListCopy) -> Option<Rc<[DVec3]>> {
         if let Some(v) = self.cache.get(&(x.uid, y.uid)) {
             return v.clone();
         }
+        let v = self.region_of(x, y);
+        self.cache.insert((x.uid, y.uid), v.clone());
+        v
+    }
+
+    /// Marks, with a new stamp, the instances that instance `x` may occlude (`behind`) or
+    /// that may occlude it (else), as the broad phase found them.
+    fn mark(&mut self, x: u32, behind: bool) -> u32 {
+        self.stamp += 1;
+        let related = if behind {
+            &self.occludees[x as usize]
+        } else {
+            &self.occluders[x as usize]
+        };
+        for &y in related {
+            self.marks[y as usize] = self.stamp;
+        }
+        self.stamp
+    }
+
+    /// Ō(x→y)'s vertices, computed.
+    fn region_of(&mut self, x: &ListCopy, y: &ListCopy) -> Option<Rc<[DVec3]>> {
+        let o = self.cheap(x.instance, y.instance)?;
+        self.stats.regions += 1;
+        // Planes with the whole partition on their positive side bound nothing within it:
+        // left out, the vertex enumeration (cubic in the planes) has less to do.
+        let cuts = |p: &Plane| {
+            !self
+                .partition
+                .vertices
+                .iter()
+                .all(|v| p.eval(*v) > INTERIOR)
+        };
+        let k = self.partition.planes.len();
+        let mut planes = self.partition.planes.clone();
+        planes.extend(x.region[k..].iter().copied().filter(cuts));
+        planes.extend(o.into_iter().filter(cuts));
+        // y's region beyond what x's already has: its front side and its cuts.
+        planes.extend(y.region[k..].iter().copied().filter(cuts));
+        region(&planes).map(Rc::from)
+    }
+
+    /// The planes of O(i→j) for instances `i` and `j`, unless a cheap test shows that `i`
+    /// occludes `j` from nowhere in the partition.
+    fn cheap(&self, i: u32, j: u32) -> Option<Vec<Plane>> {
         // Along the face's normal n, x must reach beyond y: a camera v = q + t(p − q), t ≥ 1,
         // p ∈ x, q ∈ y, has n·v ≤ n·p when n·(p − q) ≤ 0, and n·p is inside the face.
-        let (sx, sy) = (
-            self.spans[x.instance as usize],
-            self.spans[y.instance as usize],
-        );
-        if sx.1 <= sy.0 {
+        let (si, sj) = (self.spans[i as usize], self.spans[j as usize]);
+        if si.1 <= sj.0 {
             return None;
         }
-        let (tx, ty) = (
-            &self.instances[x.instance as usize].tri,
-            &self.instances[y.instance as usize].tri,
+        let (ti, tj) = (
+            &self.instances[i as usize].tri,
+            &self.instances[j as usize].tri,
         );
-        // Cheap rejections first, not cached (they cost less than a lookup's memory): the
-        // triangles' sides of each other's planes, then a plane of O(x→y) with the whole
+        // The triangles' sides of each other's planes, then a plane of O(i→j) with the whole
         // partition outside it.
-        let o = occlusion(tx, ty)?;
+        let o = occlusion(ti, tj)?;
         let outside = |p: &Plane| {
             self.partition
                 .vertices
@@ -174,14 +226,27 @@ impl<P: Planes> Builder<'_, P> {
         if o.iter().any(outside) {
             return None;
         }
-        self.stats.regions += 1;
-        let mut planes = x.region.clone();
-        planes.extend(o);
-        // y's region beyond what x's already has: its front side and its cuts.
-        planes.extend_from_slice(&y.region[self.partition.planes.len()..]);
-        let v: Option<Rc<[DVec3]>> = region(&planes).map(Rc::from);
-        self.cache.insert((x.uid, y.uid), v.clone());
-        v
+        Some(o)
+    }
+
+    /// The broad phase, over the drawn instances: per instance, the instances that pass the
+    /// cheap tests of occluding it ([`Builder::cheap`]), ascending. The scan rescans the
+    /// copies after a moved one many times; with this it skips the pairs that cannot matter
+    /// without testing them again.
+    fn broad_phase(&mut self, list: &[ListCopy]) {
+        let n = self.instances.len();
+        let (mut occluders, mut occludees) = (vec![Vec::new(); n], vec![Vec::new(); n]);
+        for x in list {
+            for y in list {
+                if x.instance != y.instance && self.cheap(x.instance, y.instance).is_some() {
+                    occluders[y.instance as usize].push(x.instance);
+                    occludees[x.instance as usize].push(y.instance);
+                }
+            }
+        }
+        self.stats.broad_pairs = occluders.iter().map(|o| o.len() as u64).sum();
+        self.occluders = occluders;
+        self.occludees = occludees;
     }
 }
 
@@ -212,6 +277,10 @@ pub fn build_list<P: Planes>(
                     })
             })
             .collect(),
+        occluders: Vec::new(),
+        occludees: Vec::new(),
+        marks: vec![0; instances.len()],
+        stamp: 0,
         next_uid: 0,
         stats: ListStats::default(),
     };
@@ -226,15 +295,19 @@ pub fn build_list<P: Planes>(
         .into_iter()
         .filter_map(|(_, k)| b.copy(k, Vec::new()))
         .collect();
+    b.broad_phase(&list);
     let mut p = 0usize;
     let mut steps = 0u64;
     while p < list.len() {
         steps += 1;
         let x = list[p].clone();
         let mut backs: Vec<(usize, Rc<[DVec3]>)> = Vec::new();
+        let stamp = b.mark(x.instance, true);
         for (q, y) in list.iter().enumerate().skip(p + 1) {
-            if let Some(v) = b.occludes(&x, y) {
-                backs.push((q, v));
+            if b.marks[y.instance as usize] == stamp {
+                if let Some(v) = b.occludes(&x, y) {
+                    backs.push((q, v));
+                }
             }
         }
         let Some(&(last, _)) = backs.last() else {
@@ -253,25 +326,20 @@ pub fn build_list<P: Planes>(
             });
         }
         let mut fronts: Vec<Rc<[DVec3]>> = Vec::new();
+        let stamp = b.mark(x.instance, false);
         for f in &list[p + 1..=last] {
-            if let Some(v) = b.occludes(f, &x) {
-                fronts.push(v);
-            }
-        }
-        let mut cut: Option<Plane> = None;
-        if !fronts.is_empty() {
-            let rb: Vec<DVec3> = backs.iter().flat_map(|(_, v)| v.iter().copied()).collect();
-            let mut rf: Vec<DVec3> = Vec::new();
-            for v in &fronts {
-                let mut candidate = rf.clone();
-                candidate.extend_from_slice(v);
-                b.stats.linear_programs += 1;
-                if let Some(plane) = separate(&rb, &candidate) {
-                    rf = candidate;
-                    cut = Some(plane);
+            if b.marks[f.instance as usize] == stamp {
+                if let Some(v) = b.occludes(f, &x) {
+                    fronts.push(v);
                 }
             }
         }
+        let cut = if fronts.is_empty() {
+            None
+        } else {
+            let rb: Vec<DVec3> = backs.iter().flat_map(|(_, v)| v.iter().copied()).collect();
+            cutting_plane(&rb, &fronts, &mut b.stats.linear_programs)
+        };
         match cut {
             None => {
                 // Nothing in the way (or nothing separable): move x after its last back edge.
@@ -310,4 +378,76 @@ pub fn build_list<P: Planes>(
         }
     }
     Ok((list, b.stats))
+}
+
+/// Linear programs [`cutting_plane`] tries one front at a time, after the one over all fronts.
+const MAX_GREEDY_PROGRAMS: u32 = 16;
+
+/// The cutting plane of a duplication: the plane with the back edges' regions (`rb`) on its
+/// negative side and, on its positive side, as many of the `fronts`' regions as can be added
+/// greedily in order (at most [`MAX_GREEDY_PROGRAMS`] tried by a program of their own), with
+/// the widest margin (the linear program over the greedy set); `None`
+/// when not even the first front can be separated. `linear_programs` counts those solved.
+///
+/// The greedy set is found with few programs: when all fronts separate at once it is all of
+/// them; else a front the current plane already separates (by more than the margin) joins
+/// without a program, since the set with it is separable too. The plane is then the program
+/// over the final set, as if each front had been tried with a program of its own.
+fn cutting_plane(rb: &[DVec3], fronts: &[Rc<[DVec3]>], linear_programs: &mut u64) -> Option<Plane> {
+    // The regions share many vertices (the partition's corners, common planes): one
+    // constraint each is enough.
+    let rb = distinct(rb.iter().copied());
+    let rb = rb.as_slice();
+    let fronts: Vec<Vec<DVec3>> = fronts.iter().map(|v| distinct(v.iter().copied())).collect();
+    let all = distinct(fronts.iter().flatten().copied());
+    *linear_programs += 1;
+    if let Some(plane) = separate(rb, &all) {
+        return Some(plane);
+    }
+    let mut rf: Vec<DVec3> = Vec::new();
+    let mut plane: Option<Plane> = None;
+    // The current plane is not the program over `rf` (a front joined without one).
+    let mut stale = false;
+    // Programs tried one front at a time; past the bound the rest stay unseparated, which is
+    // correct (their back edges are handled when the scan reaches them) but may duplicate
+    // more.
+    let mut budget = MAX_GREEDY_PROGRAMS;
+    for v in &fronts {
+        if let Some(p) = plane {
+            if v.iter().all(|q| p.eval(*q) > MARGIN) {
+                rf.extend_from_slice(v);
+                stale = true;
+                continue;
+            }
+        }
+        if budget == 0 {
+            break;
+        }
+        budget -= 1;
+        let mut candidate = rf.clone();
+        candidate.extend_from_slice(v);
+        let candidate = distinct(candidate.into_iter());
+        *linear_programs += 1;
+        if let Some(p) = separate(rb, &candidate) {
+            rf = candidate;
+            plane = Some(p);
+            stale = false;
+        }
+    }
+    if stale {
+        let rf = distinct(rf.into_iter());
+        *linear_programs += 1;
+        // The current plane separates the set; the program only widens the margin.
+        plane = separate(rb, &rf).or(plane);
+    }
+    plane
+}
+
+/// `points` without repeats: one of each group closer than 1e-9 per coordinate (a plane with
+/// a margin of [`MARGIN`] on one has nearly that margin on the others), in first-seen order.
+fn distinct(points: impl Iterator<Item = DVec3>) -> Vec<DVec3> {
+    let mut seen = std::collections::HashSet::new();
+    points
+        .filter(|p| seen.insert((*p * 1e9).round().to_array().map(|x| x as i64)))
+        .collect()
 }
