@@ -302,7 +302,8 @@ fn bench_sweep_robust_factor_plays_each_point_off_its_pattern() {
     no_temp_files(&out);
 }
 
-/// `--methods …,presorted` (paper 000): the scene presorted once, played on the bench's frames,
+/// `--methods …,presorted` (paper 000): the scene presorted once, played on the bench's frames
+/// with the test in the fragment stage and in the vertex stage (`presorted_vertex`), both
 /// exact where the default pipeline is not (glass at 0.5 over glass); and left out, saying
 /// why, on a path whose camera is inside the scene's bounding polyhedron.
 #[test]
@@ -324,6 +325,10 @@ fn bench_runs_the_presorted_method_and_leaves_it_out_inside_the_polyhedron() {
     );
     assert_eq!(p["max_channel_diff"], 0, "{p}");
     assert!(f(&p["triangles_per_frame"]) >= f(&v["methods"]["default"]["triangles_per_frame"]));
+    // Its vertex-stage variant, timed beside it, selects the same copies.
+    let pv = &v["methods"]["presorted_vertex"];
+    assert_eq!(pv["frames_exact"], frames, "{pv}");
+    assert_eq!(pv["triangles_per_frame"], p["triangles_per_frame"]);
     let inside = "bench demo:3000 --path orbit:frames=1,distance=0.2 --size 48x48 --samples 4 \
                   --mode blend --methods merged,presorted --repeats 1 --no-unvalidated --out inside";
     let v = run_json(dir.path(), &args(inside));

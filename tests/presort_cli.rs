@@ -58,6 +58,15 @@ fn a_presorted_demo_car_verifies_exact_from_random_cameras_and_a_reversed_one_do
         &args("verify car.presorted --path random:4:8 --size 96x96 --samples 4 --mode depth"),
     );
     assert_eq!(depth["ok"], true, "{depth}");
+    // The test in the vertex stage selects the same copies.
+    let vertex = run_json(
+        d,
+        &args(&format!(
+            "verify car.presorted --path random:6:9 --size 96x96 --samples 4 --scene {SCENE} \
+             --test-stage vertex"
+        )),
+    );
+    assert_eq!(vertex["ok"], true, "{vertex}");
 
     // The lists reversed (front to back in blend mode) and their tests dropped: each partition
     // draws every copy, nearest first. The check must see it.

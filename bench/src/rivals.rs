@@ -4,6 +4,7 @@
 use trisort_format::{FrameState, Geometry};
 use trisort_gpu::{Gpu, Lighting};
 use trisort_player::Mode;
+use trisort_reference::presorted::TestStage;
 use trisort_reference::{
     OitConfig, OitRenderer, PeelingConfig, PeelingRenderer, PresortedRenderer,
 };
@@ -170,16 +171,32 @@ impl Method for PeelingMethod<'_> {
     }
 }
 
-/// Builds the `oit`, `peeling`, `presorted` or `occlusion-query` method of a group (`None` for
-/// the other kinds).
+/// Builds the `oit`, `peeling`, `presorted` (with `presorted_vertex`, its vertex-stage
+/// variant) or `occlusion-query` methods of a group (none for the other kinds).
 pub(crate) fn build<'g>(
     kind: crate::table::MethodKind,
     gpu: &'g Gpu,
     input: &crate::table::GroupInput<'_>,
     progress: &dyn Fn(&str),
-) -> Result<Option<Box<dyn Method + 'g>>, BenchError> {
+) -> Result<Vec<Box<dyn Method + 'g>>, BenchError> {
     use crate::table::MethodKind;
-    Ok(match kind {
+    if kind == MethodKind::Presorted {
+        progress("presorting (paper 000, 6 partitions)");
+        let mut out: Vec<Box<dyn Method + 'g>> = Vec::new();
+        for stage in [TestStage::Fragment, TestStage::Vertex] {
+            out.push(Box::new(PresortedMethod::new(
+                gpu,
+                input.geometry,
+                input.frame_states,
+                &input.baked.environment,
+                input.view,
+                input.mode,
+                stage,
+            )?));
+        }
+        return Ok(out);
+    }
+    let method: Option<Box<dyn Method + 'g>> = match kind {
         MethodKind::Oit => {
             progress("building oit (per-sample linked lists)");
             Some(Box::new(OitMethod::new(
@@ -202,17 +219,6 @@ pub(crate) fn build<'g>(
                 input.baked.settings.max_layers.max(1),
             )?))
         }
-        MethodKind::Presorted => {
-            progress("presorting (paper 000, 6 partitions)");
-            Some(Box::new(PresortedMethod::new(
-                gpu,
-                input.geometry,
-                input.frame_states,
-                &input.baked.environment,
-                input.view,
-                input.mode,
-            )?))
-        }
         MethodKind::OcclusionQuery => {
             progress("building occlusion-query (paper 004)");
             Some(Box::new(crate::vis_sort::OcclusionQueryMethod::new(
@@ -224,7 +230,8 @@ pub(crate) fn build<'g>(
             )?))
         }
         _ => None,
-    })
+    };
+    Ok(method.into_iter().collect())
 }
 
 /// The `presorted` method (paper 000): the scene presorted for free viewpoints
@@ -234,6 +241,7 @@ pub(crate) fn build<'g>(
 pub struct PresortedMethod<'g> {
     gpu: &'g Gpu,
     mode: Mode,
+    stage: TestStage,
     file: trisort_format::Presorted,
     renderer: PresortedRenderer<'g>,
     target: trisort_gpu::FrameTarget,
@@ -249,6 +257,7 @@ impl<'g> PresortedMethod<'g> {
         environment: &trisort_format::Environment,
         view: BenchView,
         mode: Mode,
+        stage: TestStage,
     ) -> Result<PresortedMethod<'g>, BenchError> {
         // A path this method cannot draw (a camera inside the polyhedron, a moving node) or a
         // scene it cannot order leaves it out of the table, saying why.
@@ -259,13 +268,14 @@ impl<'g> PresortedMethod<'g> {
             .map_err(|e| unsupported(format!("presorting: {e}")))?;
         trisort_reference::presorted::partitions_of(&file, frames)
             .map_err(|e| unsupported(e.to_string()))?;
-        let renderer = PresortedRenderer::new(
+        let renderer = PresortedRenderer::with_stage(
             gpu,
             &file,
             frames,
             view.view(),
             Lighting::pbr(environment),
             mode,
+            stage,
         )?;
         let target = trisort_gpu::FrameTarget::new(
             &gpu.adapter,
@@ -278,6 +288,7 @@ impl<'g> PresortedMethod<'g> {
         Ok(PresortedMethod {
             gpu,
             mode,
+            stage,
             file,
             renderer,
             target,
@@ -287,7 +298,10 @@ impl<'g> PresortedMethod<'g> {
 
 impl Method for PresortedMethod<'_> {
     fn name(&self) -> &str {
-        "presorted"
+        match self.stage {
+            TestStage::Fragment => "presorted",
+            TestStage::Vertex => "presorted_vertex",
+        }
     }
     fn mode(&self) -> Mode {
         self.mode
@@ -298,10 +312,14 @@ impl Method for PresortedMethod<'_> {
     fn variant(&self) -> String {
         let s = &self.file.stats;
         format!(
-            "paper 000, {} partitions, {} copies for {} sorted triangles, fragment-stage test",
+            "paper 000, {} partitions, {} copies for {} sorted triangles, {}-stage test",
             self.file.segments.len(),
             s.list_triangles,
-            s.sorted_triangles
+            s.sorted_triangles,
+            match self.stage {
+                TestStage::Fragment => "fragment",
+                TestStage::Vertex => "vertex",
+            }
         )
     }
     fn triangles(&self, frame: u32) -> u64 {

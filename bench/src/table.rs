@@ -331,8 +331,7 @@ fn build_methods<'a>(
             | MethodKind::Presorted
             | MethodKind::OcclusionQuery => {
                 match crate::rivals::build(kind, gpu, input, progress) {
-                    Ok(Some(m)) => methods.push(m),
-                    Ok(None) => {}
+                    Ok(built) => methods.extend(built),
                     // A rival the device cannot run at this size (OIT's node pool over the
                     // storage-buffer limit) is left out of the table, saying why, rather
                     // than losing the other methods' figures.

@@ -2,9 +2,10 @@
 //! its polyhedron, for `play`, `verify` and `bench`.
 //!
 //! Per frame, the CPU picks the camera's partition (trivial) and the GPU selects the copies
-//! whose half-space tests the camera passes, in the fragment stage (`fs_presorted_*` in
-//! `shaders/reference/presorted.wgsl`, the variant paper 000 favours for models of more than
-//! a few thousand triangles). Passes, into the player's `Rgba16Float` MSAA target with a
+//! whose half-space tests the camera passes ([`TestStage`]): in the fragment stage by default
+//! (`fs_presorted_*` in `shaders/reference/presorted.wgsl`, the variant paper 000 favours for
+//! models of more than a few thousand triangles), or in the vertex stage (`vs_presorted`, the
+//! list drawn from three vertices a copy; BENCHMARKS § Free viewpoints compares them). Passes, into the player's `Rgba16Float` MSAA target with a
 //! depth buffer, resolved and quantized once like the player's frames:
 //!
 //! - `blend`: the opaque triangles (ascending ids, depth test and writes), then the partition's
@@ -55,6 +56,16 @@ pub fn partitions_of(
         .collect()
 }
 
+/// Where the half-space test selects a partition's copies (paper 000 measures both).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TestStage {
+    /// Per fragment: the list in one indexed draw, a fragment's copy by `primitive_index`
+    /// (the default: paper 000 finds it faster above a few thousand triangles).
+    Fragment,
+    /// Per vertex: the list drawn from three vertices a copy, a failing copy clipped away.
+    Vertex,
+}
+
 /// Renders a presorted file's frames.
 pub struct PresortedRenderer<'g> {
     gpu: &'g Gpu,
@@ -75,13 +86,16 @@ pub struct PresortedRenderer<'g> {
     bind_group: wgpu::BindGroup,
     /// (pipeline, what it draws: false opaque, true the segment), in order.
     passes: Vec<(wgpu::RenderPipeline, bool)>,
+    /// The vertex-stage variant's list: three vertices a copy, in drawing order.
+    expanded: Option<wgpu::Buffer>,
     target: Target,
 }
 
 impl<'g> PresortedRenderer<'g> {
-    /// Uploads `file` for the camera path `frames` at `view` in `mode`, lit as `lighting` says.
-    /// Errors naming the frame where a camera is inside the polyhedron or beyond its reach, or
-    /// a frame moves a node; or where the device lacks `PRIMITIVE_INDEX`.
+    /// Uploads `file` for the camera path `frames` at `view` in `mode`, lit as `lighting` says,
+    /// testing in the fragment stage. Errors naming the frame where a camera is inside the
+    /// polyhedron or beyond its reach, or a frame moves a node; or where the device lacks
+    /// `PRIMITIVE_INDEX`.
     pub fn new(
         gpu: &'g Gpu,
         file: &Presorted,
@@ -89,6 +103,19 @@ impl<'g> PresortedRenderer<'g> {
         view: View,
         lighting: Lighting<'_>,
         mode: Mode,
+    ) -> Result<PresortedRenderer<'g>, ReferenceError> {
+        Self::with_stage(gpu, file, frames, view, lighting, mode, TestStage::Fragment)
+    }
+
+    /// [`PresortedRenderer::new`] with the half-space test in `stage`.
+    pub fn with_stage(
+        gpu: &'g Gpu,
+        file: &Presorted,
+        frames: &[FrameState],
+        view: View,
+        lighting: Lighting<'_>,
+        mode: Mode,
+        stage: TestStage,
     ) -> Result<PresortedRenderer<'g>, ReferenceError> {
         check_device(gpu)?;
         let partitions = partitions_of(file, frames)?;
@@ -139,14 +166,15 @@ impl<'g> PresortedRenderer<'g> {
             // COPY_DST: a free camera rewrites its slot (`set_camera`).
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let fragment = wgpu::ShaderStages::FRAGMENT;
+        // Read by the stage that tests: the vertex or the fragment stage.
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("presorted"),
             entries: &[
-                uniform_entry(0, fragment, true, Some(32)),
-                storage_entry(1, fragment, true),
-                storage_entry(2, fragment, true),
-                storage_entry(3, fragment, true),
+                uniform_entry(0, stages, true, Some(32)),
+                storage_entry(1, stages, true),
+                storage_entry(2, stages, true),
+                storage_entry(3, stages, true),
             ],
         });
         let copy_tests = buffer(
@@ -177,7 +205,9 @@ impl<'g> PresortedRenderer<'g> {
             mode,
             view.samples,
             shading,
+            stage,
         );
+        let expanded = (stage == TestStage::Vertex).then(|| order.vertices(device, file));
         let mut opaque: Vec<u32> = file
             .opaque
             .iter()
@@ -206,6 +236,7 @@ impl<'g> PresortedRenderer<'g> {
             polyhedron: file.polyhedron.clone(),
             bind_group,
             passes,
+            expanded,
             target,
         })
     }
@@ -279,19 +310,25 @@ impl<'g> PresortedRenderer<'g> {
         let (first, count) = self.segments[k];
         pass.set_bind_group(0, &self.scene.bind_group, &self.scene.offsets(frame));
         pass.set_bind_group(1, &self.bind_group, &[frame * self.stride]);
-        pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
         for (pipeline, list) in &self.passes {
             pass.set_pipeline(pipeline);
             if *list {
                 if count == 0 {
                     continue;
                 }
+                if let Some(expanded) = &self.expanded {
+                    pass.set_vertex_buffer(0, expanded.slice(..));
+                    pass.draw(first * 3..(first + count) * 3, 0..1);
+                    continue;
+                }
+                pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
                 pass.set_index_buffer(self.sorted.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(first * 3..(first + count) * 3, 0, 0..1);
             } else {
                 if self.opaque.1 == 0 {
                     continue;
                 }
+                pass.set_vertex_buffer(0, self.scene.vertices.slice(..));
                 pass.set_index_buffer(self.opaque.0.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..self.opaque.1, 0, 0..1);
             }
@@ -343,6 +380,20 @@ struct DrawingOrder {
 }
 
 impl DrawingOrder {
+    /// The vertex stage's list: three vertices a copy, in this order.
+    fn vertices(&self, device: &wgpu::Device, file: &Presorted) -> wgpu::Buffer {
+        let vertices: Vec<trisort_format::Vertex> = self
+            .index
+            .iter()
+            .map(|&v| file.geometry.vertices[v as usize])
+            .collect();
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("presorted copies' vertices"),
+            contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        })
+    }
+
     /// `file`'s copies, each segment back to front, or front to back when `reverse`.
     fn of(file: &Presorted, reverse: bool) -> DrawingOrder {
         let mut order: Vec<u32> = Vec::with_capacity(file.copies.len());
@@ -381,6 +432,7 @@ fn passes(
     mode: Mode,
     samples: u32,
     shading: trisort_gpu::Shading,
+    stage: TestStage,
 ) -> Vec<(wgpu::RenderPipeline, bool)> {
     use wgpu::CompareFunction::{Less, LessEqual};
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -400,8 +452,16 @@ fn passes(
             },
             layouts,
             module: &module,
-            vertex: "vs_player",
-            fragment: if list { presorted_fs } else { player_fs },
+            vertex: if list && stage == TestStage::Vertex {
+                "vs_presorted"
+            } else {
+                "vs_player"
+            },
+            fragment: if list && stage == TestStage::Fragment {
+                presorted_fs
+            } else {
+                player_fs
+            },
             target: wgpu::ColorTargetState {
                 format: COLOR_FORMAT,
                 blend: Some(blend_state(mode)),

@@ -16,8 +16,9 @@ struct PlayerVarying {
     @location(5) view_position: vec3<f32>,
 }
 
-@vertex
-fn vs_player(v: VertexIn) -> PlayerVarying {
+// The player's vertex stage as a function (an entry point cannot be called): the presorted
+// renderer's vertex-stage variant adds its test after it.
+fn player_vertex(v: VertexIn) -> PlayerVarying {
     var out: PlayerVarying;
     out.position = transform_position(v.position, v.node);
     out.material = v.material;
@@ -30,6 +31,11 @@ fn vs_player(v: VertexIn) -> PlayerVarying {
     );
     out.view_position = view_position(v.position, v.node);
     return out;
+}
+
+@vertex
+fn vs_player(v: VertexIn) -> PlayerVarying {
+    return player_vertex(v);
 }
 
 // The texture coordinates and their derivatives: call at the top of a fragment entry point,

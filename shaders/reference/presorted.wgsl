@@ -1,8 +1,12 @@
 // Depth-presorted lists (paper 000), the free-viewpoint renderer (composed after COMMON and
-// PLAYER: colours are the player's `player_colour`). A partition's copies are drawn in one
-// indexed draw; each fragment's copy is the segment's first copy plus `primitive_index`, and
-// the copy is drawn where the camera passes every one of its half-space tests (the paper's
-// fragment-stage selection: one plane lookup and dot product per test).
+// PLAYER: colours are the player's `player_colour`). A copy is drawn where the camera passes
+// every one of its half-space tests (one plane lookup and dot product per test), selected in
+// one of the two stages paper 000 measures:
+// - fragment (`fs_presorted_*`): the partition's copies in one indexed draw; a fragment's copy
+//   is the segment's first copy plus `primitive_index`;
+// - vertex (`vs_presorted`): the copies drawn without indices from a vertex buffer of three
+//   vertices a copy, so a vertex's copy is `vertex_index / 3`; a failing copy's corners all
+//   go outside the clip volume, and the copy has no fragments.
 
 struct PresortParams {
     // The camera relative to the polyhedron's centre (xyz), world units.
@@ -33,6 +37,15 @@ fn presort_passes(copy: u32) -> bool {
         }
     }
     return true;
+}
+
+@vertex
+fn vs_presorted(v: VertexIn, @builtin(vertex_index) index: u32) -> PlayerVarying {
+    var out = player_vertex(v);
+    if (!presort_passes(index / 3u)) {
+        out.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+    }
+    return out;
 }
 
 @fragment

@@ -52,6 +52,9 @@ pub struct PlayArgs {
     /// Glass opacity (default: the recorded one).
     #[arg(long)]
     glass_opacity: Option<f32>,
+    /// Where a presorted file's half-space test runs: fragment (default) or vertex.
+    #[arg(long, value_enum)]
+    test_stage: Option<super::presort::StageArg>,
     /// Open a window (needs X11 or Wayland) to play, pause, step and scrub.
     ///
     /// Keys: Space play/pause, Right/Left step, Home/End first/last frame, drag with the left
@@ -215,6 +218,7 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
                 tone_map: a.shading.tonemap,
                 exit_after: a.window_frames,
                 json: a.json,
+                stage: a.test_stage.unwrap_or_default(),
             });
         }
         let run = super::presort::PresortedRun {
@@ -228,12 +232,14 @@ pub fn run(a: PlayArgs) -> Result<ExitCode> {
             shading: a.shading.shading,
             tone_map: a.shading.tonemap,
             json: a.json,
+            stage: a.test_stage.unwrap_or_default(),
         };
         return super::presort::play(&run, a.out_dir.as_deref());
     }
-    if a.path.is_some() {
+    if a.path.is_some() || a.test_stage.is_some() {
         anyhow::bail!(
-            "{}: --path plays presorted files; a baked file plays the path it was baked for",
+            "{}: --path and --test-stage play presorted files; a baked file plays the path it \
+             was baked for",
             a.baked.display()
         );
     }

@@ -246,6 +246,25 @@ pub fn frames_of(file: &Presorted, spec: &str, fps: f64) -> Result<Vec<FrameStat
     Ok(timeline.frames)
 }
 
+/// `--test-stage`: where the half-space test selects a presorted file's copies.
+#[derive(Clone, Copy, Debug, Default, clap::ValueEnum)]
+pub enum StageArg {
+    /// Per fragment, a fragment's copy by its primitive index (one indexed draw).
+    #[default]
+    Fragment,
+    /// Per vertex, the list drawn from three vertices a copy, failing copies clipped away.
+    Vertex,
+}
+
+impl From<StageArg> for trisort_reference::presorted::TestStage {
+    fn from(s: StageArg) -> Self {
+        match s {
+            StageArg::Fragment => Self::Fragment,
+            StageArg::Vertex => Self::Vertex,
+        }
+    }
+}
+
 /// How a presorted file is played or verified.
 pub struct PresortedRun<'a> {
     /// The file.
@@ -268,6 +287,8 @@ pub struct PresortedRun<'a> {
     pub tone_map: ToneMap,
     /// JSON output.
     pub json: bool,
+    /// Where the half-space test runs.
+    pub stage: StageArg,
 }
 
 struct Loaded {
@@ -311,7 +332,7 @@ fn load(r: &PresortedRun<'_>) -> Result<Loaded> {
 }
 
 fn renderer<'g>(gpu: &'g Gpu, l: &Loaded, r: &PresortedRun<'_>) -> Result<PresortedRenderer<'g>> {
-    Ok(PresortedRenderer::new(
+    Ok(PresortedRenderer::with_stage(
         gpu,
         &l.file,
         &l.frames,
@@ -322,6 +343,7 @@ fn renderer<'g>(gpu: &'g Gpu, l: &Loaded, r: &PresortedRun<'_>) -> Result<Presor
             environment: &l.file.environment,
         },
         r.mode,
+        r.stage.into(),
     )?)
 }
 
@@ -589,6 +611,8 @@ pub struct OrbitArgs<'a> {
     pub exit_after: Option<u64>,
     /// Print what was shown as JSON.
     pub json: bool,
+    /// Where the half-space test runs.
+    pub stage: StageArg,
 }
 
 /// `play FILE --window` on a presorted file: the free-viewpoint window
@@ -607,6 +631,7 @@ pub fn orbit_window(a: OrbitArgs<'_>) -> Result<ExitCode> {
         tone_map: a.tone_map,
         turntable_degrees: 1.5,
         exit_after: a.exit_after,
+        stage: a.stage.into(),
     };
     let shown = trisort_viewer::orbit(a.file, file, options, &mut |line| {
         eprintln!("trisort: {line}")

@@ -60,6 +60,10 @@ pub struct VerifyArgs {
     /// stores); a baked file is checked at its recorded opacity.
     #[arg(long, value_name = "ALPHA")]
     glass_opacity: Option<f32>,
+    /// Where a presorted file's half-space test runs: fragment (default) or vertex (paper 000
+    /// measures both; BENCHMARKS § Free viewpoints has ours).
+    #[arg(long, value_enum)]
+    test_stage: Option<super::presort::StageArg>,
     /// Compositing mode of the image check.
     #[arg(long, default_value = "blend")]
     mode: Mode,
@@ -189,14 +193,15 @@ fn presorted(a: &VerifyArgs) -> Option<Result<ExitCode>> {
             shading: a.shading.shading,
             tone_map: a.shading.tonemap,
             json: a.json,
+            stage: a.test_stage.unwrap_or_default(),
         };
         let diff_dir = a.diff_dir.as_deref().map(|d| (d, a.diff_all));
         return Some(super::presort::verify(&run, a.scene.as_deref(), diff_dir));
     }
-    (a.path.is_some() || a.glass_opacity.is_some()).then(|| {
+    (a.path.is_some() || a.glass_opacity.is_some() || a.test_stage.is_some()).then(|| {
         Err(anyhow::anyhow!(
-            "{}: --path and --glass-opacity apply to presorted files; a baked file is checked \
-             along its own path at its recorded opacity",
+            "{}: --path, --glass-opacity and --test-stage apply to presorted files; a baked \
+             file is checked along its own path at its recorded opacity",
             a.baked.display()
         ))
     })

@@ -51,6 +51,8 @@ pub struct OrbitOptions {
     pub turntable_degrees: f64,
     /// For tests and automation: quit after presenting this many frames.
     pub exit_after: Option<u64>,
+    /// Where the half-space test runs.
+    pub stage: trisort_reference::presorted::TestStage,
 }
 
 /// What an orbit session showed.
@@ -279,7 +281,7 @@ impl OrbitApp<'_> {
                 .unwrap_or(self.file.glass_opacity),
         };
         let state = self.camera.state(self.centre, self.radius);
-        let renderer = PresortedRenderer::new(
+        let renderer = PresortedRenderer::with_stage(
             gpu,
             &self.file,
             &[state],
@@ -290,6 +292,7 @@ impl OrbitApp<'_> {
                 environment: &self.file.environment,
             },
             mode,
+            self.options.stage,
         )
         .map_err(|source| ViewerError::Presorted {
             file: self.path.clone(),
