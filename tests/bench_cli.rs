@@ -340,6 +340,29 @@ fn bench_runs_the_presorted_method_and_leaves_it_out_inside_the_polyhedron() {
         "{skipped:?}"
     );
     assert!(v["methods"]["presorted"].is_null());
+
+    // `--presorted FILE`: a presort made once, played instead of presorting again; a file of
+    // another scene is refused before anything is baked, naming it.
+    run(
+        dir.path(),
+        &args("presort demo:3000 -o small.presorted --partitions 4"),
+        true,
+    );
+    let given = format!(
+        "bench demo:3000 --path {PATH} --size 48x48 --samples 4 --mode blend \
+         --glass-opacity 0.5 --methods presorted --presorted small.presorted --max-frames 2 \
+         --repeats 1 --no-unvalidated --out given"
+    );
+    let v = run_json(dir.path(), &args(&given));
+    let p = &v["methods"]["presorted"];
+    assert_eq!(p["frames_exact"], 2, "{p}");
+    let other = given.replace("bench demo:3000", "bench demo:2000");
+    let out = run(dir.path(), &args(&other), false);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("small.presorted") && err.contains("not the bench's"),
+        "{err}"
+    );
 }
 
 /// `--methods …,occlusion-query` (paper 004): every frame from frame 0 to the last measured

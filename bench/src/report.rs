@@ -455,6 +455,8 @@ pub struct Table<'a> {
     pub frames: &'a [u32],
     /// Repeats of each measurement.
     pub repeats: u32,
+    /// The file the `presorted` methods play (`None`: they presort the scene).
+    pub presorted: Option<&'a trisort_format::Presorted>,
 }
 
 /// Frames measured: `max` evenly spaced frames of `range` (all when `max` is 0).
@@ -510,6 +512,7 @@ pub fn run_groups(
                 repeats: a.repeats,
                 unvalidated: devices.unvalidated,
                 other_device: devices.other,
+                presorted: a.presorted,
             };
             let label = format!("{}x {}", b.samples, mode.name());
             groups.push(run_group(devices.gpu, &input, &|m| {

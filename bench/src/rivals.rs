@@ -181,18 +181,14 @@ pub(crate) fn build<'g>(
 ) -> Result<Vec<Box<dyn Method + 'g>>, BenchError> {
     use crate::table::MethodKind;
     if kind == MethodKind::Presorted {
-        progress("presorting (paper 000, 6 partitions)");
+        progress(if input.presorted.is_some() {
+            "building presorted (paper 000) from --presorted"
+        } else {
+            "presorting (paper 000, 6 partitions)"
+        });
         let mut out: Vec<Box<dyn Method + 'g>> = Vec::new();
         for stage in [TestStage::Fragment, TestStage::Vertex] {
-            out.push(Box::new(PresortedMethod::new(
-                gpu,
-                input.geometry,
-                input.frame_states,
-                &input.baked.environment,
-                input.view,
-                input.mode,
-                stage,
-            )?));
+            out.push(Box::new(PresortedMethod::new(gpu, input, stage)?));
         }
         return Ok(out);
     }
@@ -248,24 +244,43 @@ pub struct PresortedMethod<'g> {
 }
 
 impl<'g> PresortedMethod<'g> {
-    /// Presorts `geometry` (6 partitions) and uploads it for `frames`; errors where a camera
-    /// is inside the polyhedron or the presort finds no order.
+    /// Presorts the group's scene (6 partitions; or takes its `--presorted` file) and uploads
+    /// it for its frames, testing in `stage`; errors where a camera is inside the polyhedron
+    /// or the presort finds no order.
     pub fn new(
         gpu: &'g Gpu,
-        geometry: &Geometry,
-        frames: &[FrameState],
-        environment: &trisort_format::Environment,
-        view: BenchView,
-        mode: Mode,
+        input: &crate::table::GroupInput<'_>,
         stage: TestStage,
     ) -> Result<PresortedMethod<'g>, BenchError> {
+        let (geometry, frames, view, mode) =
+            (input.geometry, input.frame_states, input.view, input.mode);
+        let environment = &input.baked.environment;
         // A path this method cannot draw (a camera inside the polyhedron, a moving node) or a
         // scene it cannot order leaves it out of the table, saying why.
         let unsupported = |why: String| {
             BenchError::Reference(trisort_reference::ReferenceError::Unsupported(why))
         };
-        let file = presorted_once(geometry, environment, view.glass_opacity)
-            .map_err(|e| unsupported(format!("presorting: {e}")))?;
+        let file = match input.presorted {
+            // The file's scene must be the bench's, triangle for triangle (the same scene
+            // split at the same pose): the reference is rendered from the bench's.
+            Some(f)
+                if f.geometry.triangles != geometry.triangles
+                    || f.geometry.vertices != geometry.vertices =>
+            {
+                return Err(BenchError::Invalid(format!(
+                    "--presorted: the file's scene ({} triangles, {} vertices) is not the \
+                     bench's ({} and {}): presort the same scene (a path whose first frame \
+                     moves a node splits it at another pose)",
+                    f.geometry.triangles.len(),
+                    f.geometry.vertices.len(),
+                    geometry.triangles.len(),
+                    geometry.vertices.len()
+                )))
+            }
+            Some(f) => f.clone(),
+            None => presorted_once(geometry, environment, view.glass_opacity)
+                .map_err(|e| unsupported(format!("presorting: {e}")))?,
+        };
         trisort_reference::presorted::partitions_of(&file, frames)
             .map_err(|e| unsupported(e.to_string()))?;
         let renderer = PresortedRenderer::with_stage(

@@ -104,6 +104,8 @@ pub struct GroupInput<'a> {
     /// Also play `merged` on this device (`bench --backend/--limits`): the method
     /// `merged_device`, on the tier and draw path the device allows.
     pub other_device: Option<&'a Gpu>,
+    /// The file the `presorted` methods play (`None`: they presort `geometry` themselves).
+    pub presorted: Option<&'a trisort_format::Presorted>,
 }
 
 /// Error of one method's frames against the exact reference.

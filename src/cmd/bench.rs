@@ -70,6 +70,10 @@ pub struct BenchArgs {
     /// Skip timing `merged` with wgpu's indirect-call validation off.
     #[arg(long)]
     no_unvalidated: bool,
+    /// The `presorted` methods play this file (`trisort presort` of the same scene) instead of
+    /// presorting the scene first, which can take long on a large one.
+    #[arg(long, value_name = "FILE")]
+    presorted: Option<PathBuf>,
     /// `--backend`/`--limits` other than auto/default: `merged` is also played on that device
     /// (gl: OpenGL/GLES through EGL; webgl2: the player's GLES 3.0 / WebGL2 path), as the
     /// method `merged_device`; baking, the reference and the rivals stay on the default device.
@@ -102,6 +106,32 @@ fn parse_method(s: &str) -> Result<MethodKind, String> {
     MethodKind::parse(s).ok_or_else(|| {
         format!("unknown method `{s}` (expected default, source, merged, oit or peeling)")
     })
+}
+
+/// `--presorted FILE`, read and checked against the bench's scene (the one its reference
+/// renders): triangle for triangle, vertex for vertex.
+fn presorted_for(
+    path: &std::path::Path,
+    geometry: &trisort_format::Geometry,
+) -> Result<trisort_format::Presorted> {
+    let file: trisort_format::Presorted =
+        trisort_format::read_file(trisort_format::FileKind::Presorted, path)?;
+    file.check_structure()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    if file.geometry.triangles != geometry.triangles || file.geometry.vertices != geometry.vertices
+    {
+        anyhow::bail!(
+            "{}: --presorted: the file's scene ({} triangles, {} vertices) is not the bench's \
+             ({} and {}): presort the same scene (a path whose first frame moves a node splits \
+             it at another pose)",
+            path.display(),
+            file.geometry.triangles.len(),
+            file.geometry.vertices.len(),
+            geometry.triangles.len(),
+            geometry.vertices.len()
+        );
+    }
+    Ok(file)
 }
 
 /// Says what the bench is doing (stderr, so `--json` stays clean).
@@ -142,6 +172,11 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
         n,
         a.repeats
     ));
+    let presorted = a
+        .presorted
+        .as_deref()
+        .map(|p| presorted_for(p, &scene.geometry))
+        .transpose()?;
     let bakes = bake_samples(&a, &gpu, &working)?;
     let devices = Devices {
         gpu: &gpu,
@@ -155,6 +190,7 @@ pub fn run(a: BenchArgs) -> Result<ExitCode> {
         methods: &a.methods,
         frames: &frames,
         repeats: a.repeats,
+        presorted: presorted.as_ref(),
     };
     let groups = run_groups(&table, &devices, &working, &bakes, &say)?;
 
