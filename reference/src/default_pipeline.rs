@@ -28,6 +28,8 @@ pub fn is_transparent(geometry: &Geometry, triangle: usize) -> bool {
 pub struct DefaultRenderer<'g> {
     gpu: &'g Gpu,
     scene: SceneGpu,
+    /// The player's shader module its pipelines are built from.
+    module: wgpu::ShaderModule,
     opaque_pipeline: wgpu::RenderPipeline,
     transparent_pipeline: wgpu::RenderPipeline,
     opaque: (wgpu::Buffer, u32),
@@ -101,6 +103,7 @@ impl<'g> DefaultRenderer<'g> {
             opaque: upload(&lists[0]),
             transparent: upload(&lists[1]),
             scene,
+            module,
             opaque_pipeline,
             transparent_pipeline,
             target,
@@ -168,5 +171,11 @@ impl<'g> DefaultRenderer<'g> {
     /// beside this renderer's.
     pub fn scene(&self) -> &SceneGpu {
         &self.scene
+    }
+
+    /// The player's shader module (`vs_player` and its fragment stages), for pipelines that
+    /// draw the scene beside this renderer's.
+    pub fn module(&self) -> &wgpu::ShaderModule {
+        &self.module
     }
 }

@@ -33,8 +33,10 @@
 
 use std::collections::HashMap;
 
+use petgraph::unionfind::UnionFind;
+
 use trisort_format::{FrameState, Geometry};
-use trisort_gpu::scene_gpu::{vertex_layout, Lighting, View};
+use trisort_gpu::scene_gpu::{Lighting, ScenePipeline, View};
 use trisort_gpu::Gpu;
 use wgpu::util::DeviceExt;
 
@@ -157,32 +159,19 @@ pub fn objects(geometry: &Geometry) -> Vec<Vec<u32>> {
     let sorted: Vec<u32> = (0..geometry.triangles.len() as u32)
         .filter(|&t| geometry.needs_order(t))
         .collect();
-    let mut parent: Vec<usize> = (0..sorted.len()).collect();
-    fn root(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
+    let mut pieces: UnionFind<usize> = UnionFind::new(sorted.len());
     let mut first: HashMap<(u32, [u32; 3]), usize> = HashMap::new();
     for (i, &t) in sorted.iter().enumerate() {
         for &v in &geometry.triangles[t as usize] {
             let p = geometry.vertices[v as usize].position;
-            let key = (
-                geometry.triangle_node(t),
-                [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()],
-            );
-            let j = *first.entry(key).or_insert(i);
-            let (a, b) = (root(&mut parent, i), root(&mut parent, j));
-            parent[a.max(b)] = a.min(b);
+            let key = (geometry.triangle_node(t), p.map(f32::to_bits));
+            pieces.union(i, *first.entry(key).or_insert(i));
         }
     }
     let mut index: HashMap<usize, usize> = HashMap::new();
     let mut out: Vec<Vec<u32>> = Vec::new();
     for (i, &t) in sorted.iter().enumerate() {
-        let r = root(&mut parent, i);
-        let k = *index.entry(r).or_insert_with(|| {
+        let k = *index.entry(pieces.find_mut(i)).or_insert_with(|| {
             out.push(Vec::new());
             out.len() - 1
         });
@@ -237,47 +226,19 @@ impl<'g> VisSortRenderer<'g> {
             contents: bytemuck::cast_slice(&indices),
             usage: wgpu::BufferUsages::INDEX,
         });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("vis-sort depth"),
-            source: wgpu::ShaderSource::Wgsl(trisort_gpu::compose(&[], trisort_gpu::PLAYER).into()),
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("vis-sort depth"),
-            bind_group_layouts: &[Some(&default.scene().layout)],
-            immediate_size: 0,
-        });
         // Depth only: no fragment stage, no colour attachment.
         let pipeline = |label: &str, compare, write| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_player"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(vertex_layout())],
-                },
-                primitive: wgpu::PrimitiveState {
-                    front_face: wgpu::FrontFace::Ccw,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(write),
-                    depth_compare: Some(compare),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: wgpu::MultisampleState {
-                    count: view.samples,
-                    mask: !0,
-                    alpha_to_coverage_enabled: false,
-                },
-                fragment: None,
-                multiview_mask: None,
-                cache: None,
-            })
+            ScenePipeline {
+                label,
+                layouts: &[&default.scene().layout],
+                module: default.module(),
+                vertex: "vs_player",
+                fragment: "",
+                target: wgpu::ColorTargetState::from(trisort_gpu::COLOR_FORMAT),
+                depth: Some((DEPTH_FORMAT, compare, write)),
+                samples: view.samples,
+            }
+            .build_depth_only(device)
         };
         let query = pipeline("vis-sort query", wgpu::CompareFunction::Greater, false);
         let write = pipeline("vis-sort write", wgpu::CompareFunction::Less, true);

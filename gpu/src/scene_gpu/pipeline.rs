@@ -47,17 +47,29 @@ pub struct ScenePipeline<'a> {
 impl ScenePipeline<'_> {
     /// Creates the pipeline (a surface function, if it shades, choosing its model at run time).
     pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        self.build_with(device, &[])
+        self.build_with(device, &[], true)
+    }
+
+    /// Creates the pipeline without its fragment stage and colour target (`fragment` and
+    /// `target` are not used): a depth-only pass, for a render pass with no colour attachment
+    /// (the occlusion queries of paper 004's sort).
+    pub fn build_depth_only(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        self.build_with(device, &[], false)
     }
 
     /// Creates the pipeline with its surface function specialised to `shading`
     /// ([`shading_constants`]): for pipelines that shade, so they compile what the player's
     /// pipeline compiles.
     pub fn build_shaded(&self, device: &wgpu::Device, shading: Shading) -> wgpu::RenderPipeline {
-        self.build_with(device, shading_constants(shading))
+        self.build_with(device, shading_constants(shading), true)
     }
 
-    fn build_with(&self, device: &wgpu::Device, constants: &[(&str, f64)]) -> wgpu::RenderPipeline {
+    fn build_with(
+        &self,
+        device: &wgpu::Device,
+        constants: &[(&str, f64)],
+        fragment: bool,
+    ) -> wgpu::RenderPipeline {
         let layouts: Vec<Option<&wgpu::BindGroupLayout>> =
             self.layouts.iter().map(|l| Some(*l)).collect();
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -65,6 +77,7 @@ impl ScenePipeline<'_> {
             bind_group_layouts: &layouts,
             immediate_size: 0,
         });
+        let targets = [Some(self.target.clone())];
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(self.label),
             layout: Some(&layout),
@@ -93,14 +106,14 @@ impl ScenePipeline<'_> {
                 mask: !0,
                 alpha_to_coverage_enabled: false,
             },
-            fragment: Some(wgpu::FragmentState {
+            fragment: fragment.then(|| wgpu::FragmentState {
                 module: self.module,
                 entry_point: Some(self.fragment),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants,
                     ..Default::default()
                 },
-                targets: &[Some(self.target.clone())],
+                targets: &targets,
             }),
             multiview_mask: None,
             cache: None,
