@@ -74,8 +74,6 @@ pub struct ListStats {
     pub regions: u64,
     /// Linear programs solved.
     pub linear_programs: u64,
-    /// Instance pairs the broad phase found occluding somewhere in the partition.
-    pub broad_pairs: u64,
 }
 
 /// Why a list could not be built.
@@ -230,7 +228,7 @@ impl<P: Planes> Builder<'_, P> {
     }
 
     /// The broad phase, over the drawn instances: per instance, the instances that pass the
-    /// cheap tests of occluding it ([`Builder::cheap`]), ascending. The scan rescans the
+    /// cheap tests of occluding it ([`Builder::cheap`]). The scan rescans the
     /// copies after a moved one many times; with this it skips the pairs that cannot matter
     /// without testing them again.
     fn broad_phase(&mut self, list: &[ListCopy]) {
@@ -244,7 +242,6 @@ impl<P: Planes> Builder<'_, P> {
                 }
             }
         }
-        self.stats.broad_pairs = occluders.iter().map(|o| o.len() as u64).sum();
         self.occluders = occluders;
         self.occludees = occludees;
     }
