@@ -80,6 +80,24 @@ pub struct Stream {
     pub per_sample: bool,
 }
 
+/// Why a presorted file cannot stand for the bench's scene (`None`: it can): the `presorted`
+/// methods draw the file's scene and the reference renders the bench's, so the two must be
+/// the same triangle for triangle (the same scene split at the same pose).
+pub fn presorted_mismatch(file: &trisort_format::Presorted, geometry: &Geometry) -> Option<String> {
+    (file.geometry.triangles != geometry.triangles || file.geometry.vertices != geometry.vertices)
+        .then(|| {
+            format!(
+                "the file's scene ({} triangles, {} vertices) is not the bench's ({} and {}): \
+                 presort the same scene (a path whose first frame moves a node splits it at \
+                 another pose)",
+                file.geometry.triangles.len(),
+                file.geometry.vertices.len(),
+                geometry.triangles.len(),
+                geometry.vertices.len()
+            )
+        })
+}
+
 /// Size, sample count and glass opacity the bench renders at.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BenchView {

@@ -263,21 +263,12 @@ impl<'g> PresortedMethod<'g> {
         let file = match input.presorted {
             // The file's scene must be the bench's, triangle for triangle (the same scene
             // split at the same pose): the reference is rendered from the bench's.
-            Some(f)
-                if f.geometry.triangles != geometry.triangles
-                    || f.geometry.vertices != geometry.vertices =>
-            {
-                return Err(BenchError::Invalid(format!(
-                    "--presorted: the file's scene ({} triangles, {} vertices) is not the \
-                     bench's ({} and {}): presort the same scene (a path whose first frame \
-                     moves a node splits it at another pose)",
-                    f.geometry.triangles.len(),
-                    f.geometry.vertices.len(),
-                    geometry.triangles.len(),
-                    geometry.vertices.len()
-                )))
+            Some(f) => {
+                if let Some(why) = crate::methods::presorted_mismatch(f, geometry) {
+                    return Err(BenchError::Invalid(format!("--presorted: {why}")));
+                }
+                f.clone()
             }
-            Some(f) => f.clone(),
             None => presorted_once(geometry, environment, view.glass_opacity)
                 .map_err(|e| unsupported(format!("presorting: {e}")))?,
         };

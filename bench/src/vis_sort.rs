@@ -116,13 +116,13 @@ impl<'g> OcclusionQueryMethod<'g> {
         }
     }
 
-    /// Frame `frame`'s batches (empty before [`Method::prepare`]).
-    fn batches(&self, frame: u32) -> Vec<Vec<Op>> {
-        self.walked
-            .borrow()
+    /// `f` of frame `frame`'s batches (none before [`Method::prepare`]), borrowed: `encode`
+    /// runs in the timed loop.
+    fn with_batches<R>(&self, frame: u32, f: impl FnOnce(&[Vec<Op>]) -> R) -> R {
+        let walked = self.walked.borrow();
+        f(walked
             .get(frame as usize)
-            .map(|s| s.outcome.ops.clone())
-            .unwrap_or_default()
+            .map_or(&[][..], |s| s.outcome.ops.as_slice()))
     }
 }
 
@@ -185,31 +185,35 @@ impl Method for OcclusionQueryMethod<'_> {
     }
     fn triangles(&self, frame: u32) -> u64 {
         let (opaque, transparent) = self.renderer.triangles();
-        let queries: u64 = self
-            .batches(frame)
-            .iter()
-            .map(|b| self.renderer.batch_triangles(b))
-            .sum();
+        let queries: u64 = self.with_batches(frame, |batches| {
+            batches
+                .iter()
+                .map(|b| self.renderer.batch_triangles(b))
+                .sum()
+        });
         opaque as u64 + transparent as u64 + queries
     }
     fn draws(&self, frame: u32) -> u32 {
-        let ops: usize = self
-            .batches(frame)
-            .iter()
-            .map(|b| b.iter().filter(|o| **o != Op::Clear).count())
-            .sum();
+        let ops: usize = self.with_batches(frame, |batches| {
+            batches
+                .iter()
+                .map(|b| b.iter().filter(|o| **o != Op::Clear).count())
+                .sum()
+        });
         2 + ops as u32
     }
     fn stat_slots(&self, frame: u32) -> u32 {
-        self.batches(frame).len() as u32 + 1
+        self.with_batches(frame, |batches| batches.len() as u32 + 1)
     }
     fn encode(&self, enc: &mut wgpu::CommandEncoder, frame: u32, stats: Option<&wgpu::QuerySet>) {
         // The frame's query passes as the sort ran them (without the readbacks), then the draw.
-        let batches = self.batches(frame);
-        for (k, ops) in batches.iter().enumerate() {
-            self.renderer
-                .encode_batch(enc, frame, ops, false, stats.map(|s| (s, k as u32)));
-        }
+        let passes = self.with_batches(frame, |batches| {
+            for (k, ops) in batches.iter().enumerate() {
+                self.renderer
+                    .encode_batch(enc, frame, ops, false, stats.map(|s| (s, k as u32)));
+            }
+            batches.len() as u32
+        });
         let draws = self.draws.borrow();
         let Some(draw) = draws.get(&frame) else {
             return;
@@ -217,7 +221,7 @@ impl Method for OcclusionQueryMethod<'_> {
         let mut pass = self
             .target
             .begin_pass(enc, trisort_gpu::clear_colour(Mode::Blend), None);
-        crate::methods::stats_begin(&mut pass, stats, batches.len() as u32);
+        crate::methods::stats_begin(&mut pass, stats, passes);
         self.renderer
             .draw(&mut pass, frame, (&draw.buffer, draw.count));
         crate::methods::stats_end(&mut pass, stats);

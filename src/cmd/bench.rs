@@ -118,18 +118,8 @@ fn presorted_for(
         trisort_format::read_file(trisort_format::FileKind::Presorted, path)?;
     file.check_structure()
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    if file.geometry.triangles != geometry.triangles || file.geometry.vertices != geometry.vertices
-    {
-        anyhow::bail!(
-            "{}: --presorted: the file's scene ({} triangles, {} vertices) is not the bench's \
-             ({} and {}): presort the same scene (a path whose first frame moves a node splits \
-             it at another pose)",
-            path.display(),
-            file.geometry.triangles.len(),
-            file.geometry.vertices.len(),
-            geometry.triangles.len(),
-            geometry.vertices.len()
-        );
+    if let Some(why) = trisort_bench::methods::presorted_mismatch(&file, geometry) {
+        anyhow::bail!("{}: --presorted: {why}", path.display());
     }
     Ok(file)
 }
