@@ -34,6 +34,9 @@ fn a_presorted_demo_car_verifies_exact_from_random_cameras_and_a_reversed_one_do
     let sorted = figures["sorted_triangles"].as_u64().unwrap();
     assert!(sorted > 0, "the demo car has glass: {figures}");
     assert!(figures["list_triangles"].as_u64().unwrap() >= sorted);
+    // The demo car's glass has no cycle the cutting planes leave (the lists are exact).
+    assert_eq!(figures["unresolved_cycles"], 0, "{figures}");
+    assert_eq!(figures["cycles"].as_array().map(Vec::len), Some(0));
 
     let blend = run_json(
         d,

@@ -46,6 +46,8 @@ pub struct PresortOptions {
     pub reach: f64,
     /// Bound on the scan's steps per partition, in multiples of the partition's instances.
     pub max_steps_per_instance: u64,
+    /// Fail on an unresolved cycle ([`list`]) instead of keeping the list and reporting it.
+    pub strict: bool,
 }
 
 impl Default for PresortOptions {
@@ -54,6 +56,7 @@ impl Default for PresortOptions {
             partitions: 6,
             reach: 100.0,
             max_steps_per_instance: 64,
+            strict: false,
         }
     }
 }
@@ -77,6 +80,21 @@ pub struct Lists {
     pub planes: Vec<[f32; 4]>,
     /// Figures (`seconds` covers the lists only).
     pub stats: PresortStats,
+    /// Unresolved cycles ([`list`]), all partitions: where the lists are not exact.
+    pub cycles: Vec<Cycle>,
+}
+
+/// An unresolved cycle: a copy left before copies it occludes from some viewpoints of its
+/// partition, since the cutting planes could not break the cycle it is in. Frames from
+/// those viewpoints may draw these triangles out of order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Cycle {
+    /// The partition.
+    pub partition: usize,
+    /// Scene id of the copy's triangle.
+    pub triangle: u32,
+    /// Scene id of the last triangle it occludes that stays after it.
+    pub occluded: u32,
 }
 
 /// Why a presort failed.
@@ -91,6 +109,22 @@ pub enum PresortError {
     /// A position is not finite.
     #[error("triangle {0} has a corner that is not finite")]
     NotFinite(u32),
+    /// An unresolved cycle, with [`PresortOptions::strict`].
+    #[error(
+        "partition {partition}: triangles {a} and {b} are in an occlusion cycle that no cutting \
+         plane breaks ({count} such copies in this partition; without --strict the list keeps \
+         them out of order and says so)"
+    )]
+    Cycle {
+        /// The partition.
+        partition: usize,
+        /// Copies left in a cycle in the partition.
+        count: usize,
+        /// Scene ids.
+        a: u32,
+        /// Scene ids.
+        b: u32,
+    },
     /// A partition's list could not be ordered within the step bound.
     #[error(
         "partition {partition}: no order found after {steps} steps (triangles {a} and {b} \
@@ -127,6 +161,57 @@ fn world_triangles(geometry: &Geometry) -> Vec<[DVec3; 3]> {
         .collect()
 }
 
+/// Shared progress of the partitions' scans.
+struct Counter<'a> {
+    done: &'a AtomicUsize,
+    total: usize,
+    per_partition: usize,
+    progress: &'a (dyn Fn(usize, usize) + Sync),
+}
+
+/// Partition `k`'s list (its copies, figures and planes: the shared `own_planes` then its
+/// cutting planes), or why there is none.
+fn one_list(
+    k: usize,
+    part: &partition::Partition,
+    instances: &[Instance],
+    own_planes: &[Plane],
+    options: PresortOptions,
+    c: Counter,
+) -> Result<(Vec<list::ListCopy>, list::ListStats, Vec<Plane>), PresortError> {
+    let mut planes: Vec<Plane> = own_planes.to_vec();
+    let max_steps = options.max_steps_per_instance * (instances.len() as u64 + 16);
+    let mut counted = 0usize;
+    let mut advanced = || {
+        if counted < c.per_partition {
+            counted += 1;
+            (c.progress)(c.done.fetch_add(1, Ordering::Relaxed) + 1, c.total);
+        }
+    };
+    let r = build_list(instances, part, &mut planes, max_steps, &mut advanced).map_err(
+        |NoOrder { triangles, steps }| PresortError::NoOrder {
+            partition: k,
+            steps,
+            a: triangles.0,
+            b: triangles.1,
+        },
+    );
+    let rest = c.per_partition - counted;
+    (c.progress)(c.done.fetch_add(rest, Ordering::Relaxed) + rest, c.total);
+    match r {
+        Ok((_, stats)) if options.strict && !stats.cycles.is_empty() => {
+            let (a, b) = stats.cycles[0];
+            Err(PresortError::Cycle {
+                partition: k,
+                count: stats.cycles.len(),
+                a,
+                b,
+            })
+        }
+        r => r.map(|(list, stats)| (list, stats, planes)),
+    }
+}
+
 /// Presorts `geometry` (already split, static). `progress(done, total)` is called as the
 /// partitions' scans move on (from worker threads): `total` is the sorted instances times the
 /// partitions, each partition counting at most its instances until it finishes.
@@ -158,26 +243,13 @@ pub fn presort(
         .par_iter()
         .enumerate()
         .map(|(k, part)| {
-            let mut planes: Vec<Plane> = own_planes.clone();
-            let max_steps = options.max_steps_per_instance * (instances.len() as u64 + 16);
-            let mut counted = 0usize;
-            let mut advanced = || {
-                if counted < per_partition {
-                    counted += 1;
-                    progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-                }
+            let counter = Counter {
+                done: &done,
+                total,
+                per_partition,
+                progress,
             };
-            let r = build_list(&instances, part, &mut planes, max_steps, &mut advanced).map_err(
-                |NoOrder { triangles, steps }| PresortError::NoOrder {
-                    partition: k,
-                    steps,
-                    a: triangles.0,
-                    b: triangles.1,
-                },
-            );
-            let rest = per_partition - counted;
-            progress(done.fetch_add(rest, Ordering::Relaxed) + rest, total);
-            r.map(|(list, stats)| (list, stats, planes))
+            one_list(k, part, &instances, &own_planes, options, counter)
         })
         .collect();
     let mut out = Lists {
@@ -200,6 +272,7 @@ pub fn presort(
             sorted_triangles: sorted.len() as u64,
             ..PresortStats::default()
         },
+        cycles: Vec::new(),
     };
     let to_f32 = |p: &Plane| {
         [
@@ -210,8 +283,14 @@ pub fn presort(
         ]
     };
     out.planes.extend(own_planes.iter().map(to_f32));
-    for r in built {
+    for (partition, r) in built.into_iter().enumerate() {
         let (list, stats, planes) = r?;
+        out.cycles
+            .extend(stats.cycles.iter().map(|&(triangle, occluded)| Cycle {
+                partition,
+                triangle,
+                occluded,
+            }));
         // This list's cutting planes follow the shared ones.
         let base = out.planes.len() as u32 - own_planes.len() as u32;
         out.planes

@@ -12,10 +12,19 @@
 //!   many of the `f*`'s regions (∪ Ō(f→x), greedily, in list order) as possible on the other,
 //!   by linear programming. `x` stays where it is, restricted to the `f*` side, and a copy
 //!   restricted to the `b*` side goes after `q`. Back edges from the `f*` not separated now
-//!   point at that copy; they are handled when the scan reaches them.
+//!   point at that copy; they are handled when the scan reaches them. A plane clear of the
+//!   regions by a margin is sought first, then one that may touch them (regions that share a
+//!   face and do not overlap, as around nearly coplanar neighbours; see [`TOUCH`]).
 //! - if no `f` can be separated at all, `x` moves after `q` anyway and the `f*` inherit the
-//!   back edges (paper 000's fall-back; the scan's step bound catches a cycle that no order
-//!   resolves).
+//!   back edges (paper 000's fall-back).
+//!
+//! The fall-back can go round a cycle of copies for ever: paper 000 proves that a cycle has
+//! a separable pair of edges unless one viewpoint sees the whole cycle, but its separations
+//! are of single edges where the scan's are of x's back edges all together, and nearly
+//! coplanar slivers of a curved pane make cycles whose regions overlap only by tolerances. A
+//! copy that comes back to the scan's position after [`CYCLE_VISITS`] fall-back moves is left
+//! where it is, its back edges kept: an *unresolved cycle*, reported
+//! ([`ListStats::cycles`]) so that the caller can refuse the list or state the exception.
 //!
 //! A copy's rendering region E is the partition, its instance's front side and its tests; a
 //! copy whose region has no volume is dropped (no viewpoint draws it).
@@ -26,7 +35,7 @@ use std::rc::Rc;
 use glam::DVec3;
 
 use crate::geom::{occlusion, region, Plane, Tri, INTERIOR};
-use crate::lp::{separate, MARGIN};
+use crate::lp::{separate, MARGIN, TOUCH};
 use crate::partition::Partition;
 
 /// An instance of a triangle: the front, or the back of a double-sided one.
@@ -62,7 +71,7 @@ pub struct ListCopy {
 }
 
 /// Figures of one partition's list.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct ListStats {
     /// Copies made by duplication.
     pub duplicated: u64,
@@ -70,6 +79,11 @@ pub struct ListStats {
     pub moved: u64,
     /// Moves with no separable `f` (the fall-back).
     pub fallback_moves: u64,
+    /// Duplications whose cutting plane touches the regions it separates ([`TOUCH`]).
+    pub touching_cuts: u64,
+    /// Unresolved cycles: per copy left with back edges, its triangle's scene id and that of
+    /// the last copy it still occludes before it in the list.
+    pub cycles: Vec<(u32, u32)>,
     /// Occlusion regions computed.
     pub regions: u64,
     /// Linear programs solved.
@@ -131,7 +145,62 @@ struct Builder<'a, P: Planes> {
     stats: ListStats,
 }
 
-impl<P: Planes> Builder<'_, P> {
+impl<'a, P: Planes> Builder<'a, P> {
+    fn new(instances: &'a [Instance], partition: &'a Partition, planes: &'a mut P) -> Self {
+        Builder {
+            instances,
+            partition,
+            planes,
+            cache: HashMap::new(),
+            spans: instances
+                .iter()
+                .map(|i| {
+                    i.tri
+                        .v
+                        .iter()
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                            let d = partition.normal.dot(*v);
+                            (lo.min(d), hi.max(d))
+                        })
+                })
+                .collect(),
+            occluders: Vec::new(),
+            occludees: Vec::new(),
+            marks: vec![0; instances.len()],
+            stamp: 0,
+            next_uid: 0,
+            stats: ListStats::default(),
+        }
+    }
+
+    /// Duplicates the copy at `p` with `plane`: it stays, restricted to the plane's positive
+    /// side, and a copy restricted to the negative side goes after `last` (either dropped
+    /// where its region has no volume).
+    fn duplicate(&mut self, list: &mut Vec<ListCopy>, p: usize, last: usize, plane: Plane) {
+        self.stats.duplicated += 1;
+        let index = self.planes.add(plane);
+        let x = &list[p];
+        let (instance, mut stay_cuts) = (x.instance, x.cuts.clone());
+        let mut go_cuts = stay_cuts.clone();
+        stay_cuts.push(Test {
+            plane: index,
+            flipped: false,
+        });
+        go_cuts.push(Test {
+            plane: index,
+            flipped: true,
+        });
+        if let Some(go) = self.copy(instance, go_cuts) {
+            list.insert(last + 1, go);
+        }
+        match self.copy(instance, stay_cuts) {
+            Some(stay) => list[p] = stay,
+            None => {
+                list.remove(p);
+            }
+        }
+    }
+
     fn copy(&mut self, instance: u32, cuts: Vec<Test>) -> Option<ListCopy> {
         let inst = &self.instances[instance as usize];
         let mut region_planes = self.partition.planes.clone();
@@ -257,30 +326,7 @@ pub fn build_list<P: Planes>(
     max_steps: u64,
     advanced: &mut dyn FnMut(),
 ) -> Result<(Vec<ListCopy>, ListStats), NoOrder> {
-    let mut b = Builder {
-        instances,
-        partition,
-        planes,
-        cache: HashMap::new(),
-        spans: instances
-            .iter()
-            .map(|i| {
-                i.tri
-                    .v
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                        let d = partition.normal.dot(*v);
-                        (lo.min(d), hi.max(d))
-                    })
-            })
-            .collect(),
-        occluders: Vec::new(),
-        occludees: Vec::new(),
-        marks: vec![0; instances.len()],
-        stamp: 0,
-        next_uid: 0,
-        stats: ListStats::default(),
-    };
+    let mut b = Builder::new(instances, partition, planes);
     // Preliminary order: back to front from the partition's viewpoint (centroid distance,
     // farthest first), of the instances drawn from somewhere in the partition.
     let eye = partition.viewpoint;
@@ -295,6 +341,8 @@ pub fn build_list<P: Planes>(
     b.broad_phase(&list);
     let mut p = 0usize;
     let mut steps = 0u64;
+    // Fall-back moves per copy (by uid) since the scan last moved on.
+    let mut visits: HashMap<u32, u32> = HashMap::new();
     while p < list.len() {
         steps += 1;
         let x = list[p].clone();
@@ -309,6 +357,7 @@ pub fn build_list<P: Planes>(
         }
         let Some(&(last, _)) = backs.last() else {
             p += 1;
+            visits.clear();
             advanced();
             continue;
         };
@@ -335,7 +384,13 @@ pub fn build_list<P: Planes>(
             None
         } else {
             let rb: Vec<DVec3> = backs.iter().flat_map(|(_, v)| v.iter().copied()).collect();
-            cutting_plane(&rb, &fronts, &mut b.stats.linear_programs)
+            let lps = &mut b.stats.linear_programs;
+            cutting_plane(&rb, &fronts, MARGIN, lps).or_else(|| {
+                // Regions that only touch: a plane through their common face.
+                let cut = cutting_plane(&rb, &fronts, -TOUCH, lps);
+                b.stats.touching_cuts += u64::from(cut.is_some());
+                cut
+            })
         };
         match cut {
             None => {
@@ -343,39 +398,34 @@ pub fn build_list<P: Planes>(
                 if fronts.is_empty() {
                     b.stats.moved += 1;
                 } else {
+                    let seen = visits.entry(x.uid).or_insert(0);
+                    *seen += 1;
+                    if *seen > CYCLE_VISITS {
+                        // Round a cycle again: x stays, with its back edges.
+                        b.stats.cycles.push((
+                            instances[x.instance as usize].tri.id,
+                            instances[list[last].instance as usize].tri.id,
+                        ));
+                        p += 1;
+                        visits.clear();
+                        advanced();
+                        continue;
+                    }
                     b.stats.fallback_moves += 1;
                 }
                 let c = list.remove(p);
                 list.insert(last, c);
             }
-            Some(plane) => {
-                b.stats.duplicated += 1;
-                let index = b.planes.add(plane);
-                let mut stay_cuts = x.cuts.clone();
-                stay_cuts.push(Test {
-                    plane: index,
-                    flipped: false,
-                });
-                let mut go_cuts = x.cuts.clone();
-                go_cuts.push(Test {
-                    plane: index,
-                    flipped: true,
-                });
-                let go = b.copy(x.instance, go_cuts);
-                if let Some(go) = go {
-                    list.insert(last + 1, go);
-                }
-                match b.copy(x.instance, stay_cuts) {
-                    Some(stay) => list[p] = stay,
-                    None => {
-                        list.remove(p);
-                    }
-                }
-            }
+            Some(plane) => b.duplicate(&mut list, p, last, plane),
         }
     }
     Ok((list, b.stats))
 }
+
+/// Fall-back moves of one copy from the scan's position after which it is taken to be in a
+/// cycle (a copy comes back to the position only when every copy moved past it has moved
+/// again: more than a few times, the same moves repeat).
+pub const CYCLE_VISITS: u32 = 8;
 
 /// Linear programs [`cutting_plane`] tries one front at a time, after the one over all fronts.
 const MAX_GREEDY_PROGRAMS: u32 = 16;
@@ -383,14 +433,20 @@ const MAX_GREEDY_PROGRAMS: u32 = 16;
 /// The cutting plane of a duplication: the plane with the back edges' regions (`rb`) on its
 /// negative side and, on its positive side, as many of the `fronts`' regions as can be added
 /// greedily in order (at most [`MAX_GREEDY_PROGRAMS`] tried by a program of their own), with
-/// the widest margin (the linear program over the greedy set); `None`
-/// when not even the first front can be separated. `linear_programs` counts those solved.
+/// the widest margin (the linear program over the greedy set), each region more than
+/// `margin` from it ([`separate`]); `None` when not even the first front can be separated.
+/// `linear_programs` counts those solved.
 ///
 /// The greedy set is found with few programs: when all fronts separate at once it is all of
 /// them; else a front the current plane already separates (by more than the margin) joins
 /// without a program, since the set with it is separable too. The plane is then the program
 /// over the final set, as if each front had been tried with a program of its own.
-fn cutting_plane(rb: &[DVec3], fronts: &[Rc<[DVec3]>], linear_programs: &mut u64) -> Option<Plane> {
+fn cutting_plane(
+    rb: &[DVec3],
+    fronts: &[Rc<[DVec3]>],
+    margin: f64,
+    linear_programs: &mut u64,
+) -> Option<Plane> {
     // The regions share many vertices (the partition's corners, common planes): one
     // constraint each is enough.
     let rb = distinct(rb.iter().copied());
@@ -398,7 +454,7 @@ fn cutting_plane(rb: &[DVec3], fronts: &[Rc<[DVec3]>], linear_programs: &mut u64
     let fronts: Vec<Vec<DVec3>> = fronts.iter().map(|v| distinct(v.iter().copied())).collect();
     let all = distinct(fronts.iter().flatten().copied());
     *linear_programs += 1;
-    if let Some(plane) = separate(rb, &all) {
+    if let Some(plane) = separate(rb, &all, margin) {
         return Some(plane);
     }
     let mut rf: Vec<DVec3> = Vec::new();
@@ -411,7 +467,7 @@ fn cutting_plane(rb: &[DVec3], fronts: &[Rc<[DVec3]>], linear_programs: &mut u64
     let mut budget = MAX_GREEDY_PROGRAMS;
     for v in &fronts {
         if let Some(p) = plane {
-            if v.iter().all(|q| p.eval(*q) > MARGIN) {
+            if v.iter().all(|q| p.eval(*q) > margin) {
                 rf.extend_from_slice(v);
                 stale = true;
                 continue;
@@ -425,7 +481,7 @@ fn cutting_plane(rb: &[DVec3], fronts: &[Rc<[DVec3]>], linear_programs: &mut u64
         candidate.extend_from_slice(v);
         let candidate = distinct(candidate.into_iter());
         *linear_programs += 1;
-        if let Some(p) = separate(rb, &candidate) {
+        if let Some(p) = separate(rb, &candidate, margin) {
             rf = candidate;
             plane = Some(p);
             stale = false;
@@ -435,7 +491,7 @@ fn cutting_plane(rb: &[DVec3], fronts: &[Rc<[DVec3]>], linear_programs: &mut u64
         let rf = distinct(rf.into_iter());
         *linear_programs += 1;
         // The current plane separates the set; the program only widens the margin.
-        plane = separate(rb, &rf).or(plane);
+        plane = separate(rb, &rf, margin).or(plane);
     }
     plane
 }

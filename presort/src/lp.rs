@@ -9,20 +9,40 @@ use crate::geom::Plane;
 /// Smallest margin (normalised units) a cutting plane must leave on each side.
 pub const MARGIN: f64 = 1e-6;
 
+/// Margin (normalised units) by which two regions may overlap and still count as touching:
+/// a cutting plane between them, [`separate`] with `-TOUCH`, leaves each region at most this
+/// far on the other side, far below [`crate::geom::INTERIOR`], so the piece of a region cut
+/// off on the wrong side has no volume and its occlusion is gone. Regions that touch along
+/// a face are common where nearly coplanar neighbours fold (a gently curved pane): every pair
+/// of a cycle of three such copies may touch and none overlap, so no plane leaves them
+/// [`MARGIN`] apart, while one through their common face separates them.
+pub const TOUCH: f64 = 1e-9;
+
 /// A plane with every point of `positive` on its positive side and every point of `negative`
-/// on its negative side, each at least [`MARGIN`] away, maximising that margin (normal bounded
-/// per component); `None` when the hulls come closer than that (they overlap or touch).
+/// on its negative side, each more than `margin` away, maximising that distance (normal
+/// bounded per component); `None` when the hulls come closer than that. `margin` is
+/// [`MARGIN`] for a clear cut, `-TOUCH` for one between regions that touch.
 ///
 /// By constraint generation: the program is solved over a few extreme points of each set,
 /// then the points its plane violates are added and it is solved again, until none is
 /// violated. A plane optimal for a subset of the constraints that satisfies them all is
 /// optimal for all of them, and a subset without a separating plane means the whole has none;
 /// the programs stay a few dozen constraints where the sets have thousands of points.
-pub fn separate(negative: &[DVec3], positive: &[DVec3]) -> Option<Plane> {
+pub fn separate(negative: &[DVec3], positive: &[DVec3], margin: f64) -> Option<Plane> {
     let sets = [(negative, -1.0), (positive, 1.0)];
     let mut working: [Vec<usize>; 2] = [extremes(negative), extremes(positive)];
+    // At a margin of zero or less the null plane (normal 0, margin 0) is a solution: the
+    // normal is then held to lean from the negative set's centroid towards the positive's
+    // (as every separating plane's does, for sets with volume).
+    let along = (margin <= 0.0).then(|| {
+        let centroid = |v: &[DVec3]| v.iter().copied().sum::<DVec3>() / v.len().max(1) as f64;
+        (centroid(positive) - centroid(negative)).normalize_or_zero()
+    });
+    if along == Some(DVec3::ZERO) {
+        return None;
+    }
     let (normal, d, s) = loop {
-        let (normal, d, s) = solve(&sets, &working)?;
+        let (normal, d, s) = solve(&sets, &working, along)?;
         let mut added = false;
         for ((points, sign), w) in sets.iter().zip(&mut working) {
             let mut violated: Vec<(f64, usize)> = points
@@ -44,8 +64,7 @@ pub fn separate(negative: &[DVec3], positive: &[DVec3]) -> Option<Plane> {
         }
     };
     let len = normal.length();
-    let margin = s / len.max(1e-300);
-    if !(margin > MARGIN && len > 1e-12) {
+    if !(s / len.max(1e-300) > margin && len > 1e-12) {
         return None;
     }
     let plane = Plane {
@@ -53,8 +72,9 @@ pub fn separate(negative: &[DVec3], positive: &[DVec3]) -> Option<Plane> {
         d: d / len,
     };
     // Trust, but check: the LP's tolerance is absolute.
-    let ok = negative.iter().all(|p| plane.eval(*p) < -MARGIN * 0.5)
-        && positive.iter().all(|p| plane.eval(*p) > MARGIN * 0.5);
+    let least = margin.min(MARGIN * 0.5);
+    let ok = negative.iter().all(|p| -plane.eval(*p) > least)
+        && positive.iter().all(|p| plane.eval(*p) > least);
     ok.then_some(plane)
 }
 
@@ -87,8 +107,12 @@ fn extremes(points: &[DVec3]) -> Vec<usize> {
 }
 
 /// The program over the working sets' points: (normal, offset, margin) maximising the margin,
-/// or `None` when it has no solution.
-fn solve(sets: &[(&[DVec3], f64); 2], working: &[Vec<usize>; 2]) -> Option<(DVec3, f64, f64)> {
+/// or `None` when it has no solution; with `along`, the normal's component along it is 1/2.
+fn solve(
+    sets: &[(&[DVec3], f64); 2],
+    working: &[Vec<usize>; 2],
+    along: Option<DVec3>,
+) -> Option<(DVec3, f64, f64)> {
     let mut lp = Problem::new(OptimizationDirection::Maximize);
     let n = [
         lp.add_var(0.0, (-1.0, 1.0)),
@@ -114,6 +138,13 @@ fn solve(sets: &[(&[DVec3], f64); 2], working: &[Vec<usize>; 2]) -> Option<(DVec
             );
         }
     }
+    if let Some(u) = along {
+        lp.add_constraint(
+            [(n[0], u.x), (n[1], u.y), (n[2], u.z)],
+            ComparisonOp::Eq,
+            0.5,
+        );
+    }
     let solution = lp.solve().ok()?.into_solution().ok()?;
     let normal = DVec3::new(
         solution.var_value(n[0]),
@@ -135,10 +166,26 @@ mod tests {
             DVec3::new(0.0, 1.0, 1.0),
         ];
         let b: Vec<DVec3> = a.iter().map(|p| *p + DVec3::new(3.0, 0.0, 0.0)).collect();
-        let p = separate(&a, &b).expect("disjoint");
+        let p = separate(&a, &b, MARGIN).expect("disjoint");
         assert!(a.iter().all(|x| p.eval(*x) < 0.0) && b.iter().all(|x| p.eval(*x) > 0.0));
         // Moved within its own plane (normal (1, -1, 1)): the triangles overlap.
         let c: Vec<DVec3> = a.iter().map(|p| *p + DVec3::new(0.3, 0.3, 0.0)).collect();
-        assert!(separate(&a, &c).is_none());
+        assert!(separate(&a, &c, MARGIN).is_none());
+    }
+
+    #[test]
+    fn touching_boxes_separate_only_when_touching_is_allowed() {
+        let cube = |x0: f64| -> Vec<DVec3> {
+            (0..8)
+                .map(|k| DVec3::new(x0 + (k & 1) as f64, ((k >> 1) & 1) as f64, (k >> 2) as f64))
+                .collect()
+        };
+        // Sharing the face x = 1.
+        let (a, b) = (cube(0.0), cube(1.0));
+        assert!(separate(&a, &b, MARGIN).is_none());
+        let p = separate(&a, &b, -TOUCH).expect("they only touch");
+        assert!(a.iter().all(|x| p.eval(*x) < TOUCH) && b.iter().all(|x| p.eval(*x) > -TOUCH));
+        // Overlapping by more than the allowance.
+        assert!(separate(&a, &cube(1.0 - 1e-6), -TOUCH).is_none());
     }
 }

@@ -275,3 +275,60 @@ fn bad_partition_counts_are_refused() {
         assert!(e.to_string().contains("--partitions"), "{e}");
     }
 }
+
+/// Three thin single-sided triangles in a pinwheel seen from above (+Z): each passes over the
+/// next and under the one before, apart in space (no two intersect), so cameras above see a
+/// cycle no order resolves (paper 000 assumes none; only splitting a triangle would).
+fn pinwheel() -> Geometry {
+    let mut g = scene(vec![material(false)]);
+    let q = |k: usize| {
+        let a = std::f64::consts::FRAC_PI_2 - k as f64 * 2.0 * std::f64::consts::FRAC_PI_3;
+        DVec3::new(a.cos(), a.sin(), 0.0)
+    };
+    for i in 0..3 {
+        // From the crossing with the one before (z = 0) to the one with the next (z = 1).
+        let (from, to) = (q(i), q((i + 1) % 3));
+        let at = |t: f64| from + (to - from) * t + DVec3::Z * t;
+        let side = (to - from).cross(DVec3::Z).normalize() * 0.1;
+        let mut c = [at(-0.5) + side, at(-0.5) - side, at(1.5)];
+        if (c[1] - c[0]).cross(c[2] - c[0]).z < 0.0 {
+            c.swap(1, 2);
+        }
+        tri(&mut g, c.map(|v| v.as_vec3().to_array()), 0);
+    }
+    g
+}
+
+#[test]
+fn a_cycle_seen_from_one_camera_is_reported_or_refused() {
+    let g = pinwheel();
+    let lists = presort(&g, PresortOptions::default(), &|_, _| {}).unwrap();
+    assert!(
+        !lists.cycles.is_empty(),
+        "the pinwheel is a cycle from above"
+    );
+    for c in &lists.cycles {
+        assert!(
+            c.triangle < 3 && c.occluded < 3 && c.triangle != c.occluded,
+            "{c:?}"
+        );
+    }
+    // The cycle is seen from above only: the partition whose face looks along +Z.
+    let up = lists
+        .polyhedron
+        .faces
+        .iter()
+        .position(|f| f[2] > 0.9)
+        .expect("a cube has a face up");
+    assert!(
+        lists.cycles.iter().all(|c| c.partition == up),
+        "{:?}",
+        lists.cycles
+    );
+    let strict = PresortOptions {
+        strict: true,
+        ..PresortOptions::default()
+    };
+    let e = presort(&g, strict, &|_, _| {}).unwrap_err();
+    assert!(e.to_string().contains("occlusion cycle"), "{e}");
+}

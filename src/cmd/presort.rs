@@ -50,6 +50,10 @@ pub struct PresortArgs {
     /// Do not split triangles that pass through each other first (no order exists for them).
     #[arg(long)]
     keep_intersections: bool,
+    /// Fail (exit 1, no file) on an occlusion cycle no cutting plane breaks, instead of
+    /// keeping its copies out of order and reporting them (`unresolved_cycles`).
+    #[arg(long)]
+    strict: bool,
     /// Print the figures as JSON.
     #[arg(long)]
     json: bool,
@@ -99,6 +103,7 @@ pub fn run(a: PresortArgs) -> Result<ExitCode> {
     let options = PresortOptions {
         partitions: a.partitions,
         reach: a.reach,
+        strict: a.strict,
         ..PresortOptions::default()
     };
     let lists = presort(&scene.geometry, options, &|done, total| {
@@ -107,6 +112,19 @@ pub fn run(a: PresortArgs) -> Result<ExitCode> {
     })
     .with_context(|| format!("presorting {}", a.scene))?;
     bar.finish_and_clear();
+    let cycles = lists.cycles.clone();
+    if let Some(c) = cycles.first() {
+        eprintln!(
+            "trisort: warning: {} copies left in occlusion cycles no cutting plane breaks (the \
+             first: triangle {} before triangle {} in partition {}); frames from where they \
+             overlap may draw them out of order: check with `trisort verify`, or refuse such \
+             lists with --strict",
+            cycles.len(),
+            c.triangle,
+            c.occluded,
+            c.partition
+        );
+    }
     let mut file = lists.into_presorted(scene.geometry, environment, a.glass_opacity, scene_hash);
     file.stats.seconds = t0.elapsed().as_secs_f64();
     trisort_format::write_file_atomic(FileKind::Presorted, &a.output, &file)?;
@@ -126,13 +144,19 @@ pub fn run(a: PresortArgs) -> Result<ExitCode> {
             "regions": s.regions,
             "linear_programs": s.linear_programs,
             "planes": file.planes.len(),
+            "unresolved_cycles": cycles.len(),
+            "cycles": cycles.iter().map(|c| json!({
+                "partition": c.partition,
+                "triangle": c.triangle,
+                "occluded": c.occluded,
+            })).collect::<Vec<_>>(),
             "output": a.output,
         }));
     } else {
         println!(
             "presorted {}: {} triangles, {} need an order; {} partitions, {} copies in all \
              ({ratio:.2}× the sorted triangles, {:.0} a partition; {} duplicated, {} moved, \
-             {} planes) in {:.2} s → {}",
+             {} planes, {} unresolved cycles) in {:.2} s → {}",
             a.scene,
             s.triangles,
             s.sorted_triangles,
@@ -142,6 +166,7 @@ pub fn run(a: PresortArgs) -> Result<ExitCode> {
             s.duplicated,
             s.moved,
             file.planes.len(),
+            cycles.len(),
             s.seconds,
             a.output.display()
         );
