@@ -161,12 +161,21 @@ fn world_triangles(geometry: &Geometry) -> Vec<[DVec3; 3]> {
         .collect()
 }
 
-/// Shared progress of the partitions' scans.
+/// Shared progress of the partitions' scans: per partition, the copies the scan has placed
+/// and the copies in its list so far (duplicates lengthen it).
 struct Counter<'a> {
-    done: &'a AtomicUsize,
-    total: usize,
-    per_partition: usize,
+    placed: &'a [AtomicUsize],
+    lengths: &'a [AtomicUsize],
     progress: &'a (dyn Fn(usize, usize) + Sync),
+}
+
+impl Counter<'_> {
+    fn set(&self, k: usize, placed: usize, length: usize) {
+        self.placed[k].store(placed, Ordering::Relaxed);
+        self.lengths[k].store(length, Ordering::Relaxed);
+        let sum = |v: &[AtomicUsize]| v.iter().map(|a| a.load(Ordering::Relaxed)).sum();
+        (self.progress)(sum(self.placed), sum(self.lengths));
+    }
 }
 
 /// Partition `k`'s list (its copies, figures and planes: the shared `own_planes` then its
@@ -181,13 +190,7 @@ fn one_list(
 ) -> Result<(Vec<list::ListCopy>, list::ListStats, Vec<Plane>), PresortError> {
     let mut planes: Vec<Plane> = own_planes.to_vec();
     let max_steps = options.max_steps_per_instance * (instances.len() as u64 + 16);
-    let mut counted = 0usize;
-    let mut advanced = || {
-        if counted < c.per_partition {
-            counted += 1;
-            (c.progress)(c.done.fetch_add(1, Ordering::Relaxed) + 1, c.total);
-        }
-    };
+    let mut advanced = |placed: usize, length: usize| c.set(k, placed, length);
     let r = build_list(instances, part, &mut planes, max_steps, &mut advanced).map_err(
         |NoOrder { triangles, steps }| PresortError::NoOrder {
             partition: k,
@@ -196,8 +199,9 @@ fn one_list(
             b: triangles.1,
         },
     );
-    let rest = c.per_partition - counted;
-    (c.progress)(c.done.fetch_add(rest, Ordering::Relaxed) + rest, c.total);
+    if let Ok((list, _)) = &r {
+        c.set(k, list.len(), list.len());
+    }
     match r {
         Ok((_, stats)) if options.strict && !stats.cycles.is_empty() => {
             let (a, b) = stats.cycles[0];
@@ -212,9 +216,10 @@ fn one_list(
     }
 }
 
-/// Presorts `geometry` (already split, static). `progress(done, total)` is called as the
-/// partitions' scans move on (from worker threads): `total` is the sorted instances times the
-/// partitions, each partition counting at most its instances until it finishes.
+/// Presorts `geometry` (already split, static). `progress(placed, total)` is called as the
+/// partitions' scans move on (from worker threads): `total` is the copies in all lists so far
+/// (the sorted instances times the partitions at first; duplicates add to it), `placed` those
+/// the scans have passed.
 pub fn presort(
     geometry: &Geometry,
     options: PresortOptions,
@@ -235,18 +240,19 @@ pub fn presort(
     let (sorted, opaque): (Vec<u32>, Vec<u32>) =
         (0..geometry.triangles.len() as u32).partition(|&t| geometry.needs_order(t));
     let (own_planes, instances) = instances(geometry, &sorted, &world, norm);
-    let done = AtomicUsize::new(0);
-    let per_partition = instances.len();
-    let total = parts.len() * per_partition;
-    progress(0, total);
+    let placed: Vec<AtomicUsize> = parts.iter().map(|_| AtomicUsize::new(0)).collect();
+    let lengths: Vec<AtomicUsize> = parts
+        .iter()
+        .map(|_| AtomicUsize::new(instances.len()))
+        .collect();
+    progress(0, parts.len() * instances.len());
     let built: Vec<Result<_, PresortError>> = parts
         .par_iter()
         .enumerate()
         .map(|(k, part)| {
             let counter = Counter {
-                done: &done,
-                total,
-                per_partition,
+                placed: &placed,
+                lengths: &lengths,
                 progress,
             };
             one_list(k, part, &instances, &own_planes, options, counter)

@@ -317,14 +317,14 @@ impl<'a, P: Planes> Builder<'a, P> {
 }
 
 /// The list of `partition` over `instances` (those drawn from it), new cutting planes added to
-/// `planes`. `max_steps` bounds the scan; `advanced` is called each time the scan moves on
-/// past a copy (for progress).
+/// `planes`. `max_steps` bounds the scan; `advanced(placed, length)` is called each time the
+/// scan moves on past a copy (for progress), with the copies passed and the list's length.
 pub fn build_list<P: Planes>(
     instances: &[Instance],
     partition: &Partition,
     planes: &mut P,
     max_steps: u64,
-    advanced: &mut dyn FnMut(),
+    advanced: &mut dyn FnMut(usize, usize),
 ) -> Result<(Vec<ListCopy>, ListStats), NoOrder> {
     let mut b = Builder::new(instances, partition, planes);
     // Preliminary order: back to front from the partition's viewpoint (centroid distance,
@@ -358,7 +358,7 @@ pub fn build_list<P: Planes>(
         let Some(&(last, _)) = backs.last() else {
             p += 1;
             visits.clear();
-            advanced();
+            advanced(p, list.len());
             continue;
         };
         if steps > max_steps {
@@ -408,7 +408,7 @@ pub fn build_list<P: Planes>(
                         ));
                         p += 1;
                         visits.clear();
-                        advanced();
+                        advanced(p, list.len());
                         continue;
                     }
                     b.stats.fallback_moves += 1;
