@@ -79,8 +79,6 @@ pub struct ListStats {
     pub moved: u64,
     /// Moves with no separable `f` (the fall-back).
     pub fallback_moves: u64,
-    /// Duplications whose cutting plane touches the regions it separates ([`TOUCH`]).
-    pub touching_cuts: u64,
     /// Unresolved cycles: per copy left with back edges, its triangle's scene id and that of
     /// the last copy it still occludes before it in the list.
     pub cycles: Vec<(u32, u32)>,
@@ -385,12 +383,9 @@ pub fn build_list<P: Planes>(
         } else {
             let rb: Vec<DVec3> = backs.iter().flat_map(|(_, v)| v.iter().copied()).collect();
             let lps = &mut b.stats.linear_programs;
-            cutting_plane(&rb, &fronts, MARGIN, lps).or_else(|| {
-                // Regions that only touch: a plane through their common face.
-                let cut = cutting_plane(&rb, &fronts, -TOUCH, lps);
-                b.stats.touching_cuts += u64::from(cut.is_some());
-                cut
-            })
+            // Else regions that only touch: a plane through their common face.
+            cutting_plane(&rb, &fronts, MARGIN, lps)
+                .or_else(|| cutting_plane(&rb, &fronts, -TOUCH, lps))
         };
         match cut {
             None => {
